@@ -1,0 +1,92 @@
+"""symid: continuous-time grey-box system identification by bilinear optimisation.
+
+The light core (models, data, errors, the zoo) is imported eagerly; the estimators,
+simulators and the identifiability report load on first use (PEP 562), so that
+``import symid`` costs little more than importing sympy.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from symid.data import BlackBox, FrequencyData, IOData, SpectralData
+from symid.errors import (
+    DataError,
+    IdentifiabilityWarning,
+    ModelError,
+    NonAffineError,
+    SolverError,
+    SymidError,
+)
+from symid.parametric import StateSpaceMatrices
+from symid.result import IdentificationResult, StartOutcome
+from symid.secondorder import SecondOrderModel
+from symid.statespace import StateSpaceModel
+from symid.symbols import parameters
+from symid.zoo import ZooEntry, list_models, load_model
+
+if TYPE_CHECKING:
+    from symid.comparison import Comparison, MethodStats, compare
+    from symid.identification import identify
+    from symid.simulate import simulate_frf, simulate_io, simulate_spectra
+    from symid.structural import IdentifiabilityReport, identifiability
+
+__version__ = "0.1.0"
+
+_LAZY = {
+    "Comparison": "symid.comparison",
+    "MethodStats": "symid.comparison",
+    "compare": "symid.comparison",
+    "identify": "symid.identification",
+    "simulate_frf": "symid.simulate",
+    "simulate_io": "symid.simulate",
+    "simulate_spectra": "symid.simulate",
+    "IdentifiabilityReport": "symid.structural",
+    "identifiability": "symid.structural",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'symid' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
+
+__all__ = [
+    "BlackBox",
+    "Comparison",
+    "DataError",
+    "FrequencyData",
+    "IOData",
+    "IdentifiabilityReport",
+    "IdentifiabilityWarning",
+    "IdentificationResult",
+    "MethodStats",
+    "ModelError",
+    "NonAffineError",
+    "SecondOrderModel",
+    "SolverError",
+    "SpectralData",
+    "StartOutcome",
+    "StateSpaceMatrices",
+    "StateSpaceModel",
+    "SymidError",
+    "ZooEntry",
+    "compare",
+    "identifiability",
+    "identify",
+    "list_models",
+    "load_model",
+    "parameters",
+    "simulate_frf",
+    "simulate_io",
+    "simulate_spectra",
+]

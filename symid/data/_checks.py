@@ -1,0 +1,150 @@
+"""Shared validation of the data containers (private).
+
+Every helper raises :class:`symid.errors.DataError` with a message naming the array and
+what was expected; none lets a numpy exception through. Arrays returned are fresh,
+C-contiguous, read-only copies.
+
+Conventions fixed here:
+
+* Angular frequencies (rad/s) are strictly positive, finite and strictly increasing.
+  ω = 0 is refused: a second-order model with a rigid-body mode is singular there,
+  and the identification formulations divide by or scale with ω; give a small positive
+  frequency instead.
+* Hermitian spectra are checked to the tolerance ``HERMITIAN_RTOL`` relative to the
+  Frobenius norm of each matrix: ``max |Φ − Φᴴ| <= HERMITIAN_RTOL * ||Φ||_F``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from symid.errors import DataError
+
+__all__ = [
+    "HERMITIAN_RTOL",
+    "as_array",
+    "check_finite",
+    "check_hermitian",
+    "check_positive_scalar",
+    "frequencies",
+    "frozen",
+    "shape_text",
+]
+
+HERMITIAN_RTOL = 1e-8
+
+
+def frozen(arr: np.ndarray) -> np.ndarray:
+    """A read-only, C-contiguous copy of ``arr``."""
+    out = np.array(arr, copy=True, order="C")
+    out.flags.writeable = False
+    return out
+
+
+def shape_text(shape: tuple[int, ...]) -> str:
+    """A shape as ``(3, 1, 1)``, for messages."""
+    return "(" + ", ".join(str(int(d)) for d in shape) + ("," if len(shape) == 1 else "") + ")"
+
+
+def as_array(x: Any, name: str, *, complex_ok: bool) -> np.ndarray:
+    """Convert ``x`` to a float (or complex) array, refusing strings, ragged lists and bad dtypes.
+
+    Parameters
+    ----------
+    x : array_like
+        The user's input.
+    name : str
+        Name of the array in messages.
+    complex_ok : bool
+        Whether complex values are allowed. The result is ``complex128`` when True and
+        ``float64`` when False.
+    """
+    if x is None:
+        raise DataError(f"{name} is missing (got None)")
+    try:
+        arr = np.asarray(x)
+    except (ValueError, TypeError):
+        raise DataError(f"{name} must be a numeric array; got a ragged or non-numeric sequence") from None
+    if arr.dtype.kind in "USV" or arr.dtype.kind == "M" or arr.dtype.kind == "m":
+        raise DataError(f"{name} must hold numbers; got dtype {arr.dtype}")
+    if arr.dtype.kind == "b":
+        raise DataError(f"{name} must hold numbers; got booleans")
+    target = np.complex128 if complex_ok else np.float64
+    if arr.dtype.kind == "c" and not complex_ok:
+        raise DataError(f"{name} must be real; got complex values")
+    if arr.dtype.kind == "O":
+        try:
+            arr = arr.astype(np.complex128)
+        except (TypeError, ValueError):
+            raise DataError(f"{name} must hold numbers; got objects that are not numbers") from None
+        if not complex_ok:
+            if np.any(arr.imag != 0):
+                raise DataError(f"{name} must be real; got complex values")
+            arr = arr.real
+    try:
+        return np.array(arr, dtype=target, copy=True, order="C")
+    except (TypeError, ValueError, OverflowError):
+        raise DataError(f"{name} must hold numbers; got dtype {arr.dtype}") from None
+
+
+def check_finite(arr: np.ndarray, name: str) -> None:
+    """Raise if ``arr`` holds NaN or ±inf, naming the first bad index."""
+    bad = ~np.isfinite(arr)
+    if np.any(bad):
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = ", ".join(map(str, idx))
+        val = arr[idx]
+        raise DataError(f"{name} must be finite: {name}[{where}] = {val} ({int(bad.sum())} non-finite value(s))")
+
+
+def frequencies(w: Any, name: str = "w") -> np.ndarray:
+    """Validate angular frequencies: real, 1-D, non-empty, finite, > 0, strictly increasing.
+
+    A scalar is accepted as one frequency. Returns a read-only float64 copy.
+    """
+    arr = as_array(w, name, complex_ok=False)
+    if arr.ndim == 0:
+        arr = arr.reshape(1)
+    if arr.ndim != 1:
+        raise DataError(f"{name} must be 1-D (one angular frequency per sample); got shape {shape_text(arr.shape)}")
+    if arr.size == 0:
+        raise DataError(f"{name} is empty; at least one frequency is needed")
+    check_finite(arr, name)
+    nonpos = np.flatnonzero(arr <= 0)
+    if nonpos.size:
+        i = int(nonpos[0])
+        raise DataError(f"{name} must be positive angular frequencies in rad/s: {name}[{i}] = {float(arr[i])!r} "
+                        f"(ω = 0 and negative frequencies are not allowed)")
+    d = np.diff(arr)
+    bad = np.flatnonzero(d <= 0)
+    if bad.size:
+        i = int(bad[0]) + 1
+        kind = "duplicate" if arr[i] == arr[i - 1] else "unsorted"
+        raise DataError(f"{name} must be strictly increasing: {name}[{i}] = {float(arr[i])!r} is not greater than "
+                        f"{name}[{i - 1}] = {float(arr[i - 1])!r} ({kind})")
+    return frozen(arr)
+
+
+def check_hermitian(Phi: np.ndarray, name: str, rtol: float = HERMITIAN_RTOL) -> None:
+    """Raise unless every ``Phi[i]`` (shape (s, k, k)) is Hermitian to ``rtol`` relative to its norm."""
+    dev = np.abs(Phi - np.conj(np.swapaxes(Phi, -1, -2))).max(axis=(-1, -2))
+    scale = np.linalg.norm(Phi, axis=(-1, -2))
+    bad = np.flatnonzero(dev > rtol * scale)
+    if bad.size:
+        i = int(bad[0])
+        raise DataError(f"{name}[{i}] is not Hermitian: max |Φ − Φᴴ| = {dev[i]:.3g} exceeds "
+                        f"{rtol:g} × ||Φ||_F = {rtol * scale[i]:.3g} ({bad.size} frequency(ies) affected)")
+
+
+def check_positive_scalar(x: Any, name: str) -> float:
+    """A finite, strictly positive real scalar (a sample time, for instance)."""
+    arr = as_array(x, name, complex_ok=False)
+    if arr.size != 1:
+        raise DataError(f"{name} must be a scalar; got shape {shape_text(arr.shape)}")
+    val = float(arr.reshape(()))
+    if not math.isfinite(val) or val <= 0:
+        raise DataError(f"{name} must be a finite number > 0; got {val!r}")
+    return val

@@ -1,0 +1,172 @@
+"""Sampled input/output time series with a uniform sample time."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, Self
+
+import numpy as np
+
+from symid.data import _checks, _files
+from symid.data._base import DataContainer, naming_file
+from symid.errors import DataError
+
+__all__ = ["IOData"]
+
+
+def _signal(x: Any, name: str, width: str) -> np.ndarray:
+    arr = _checks.as_array(x, name, complex_ok=False)
+    if arr.ndim == 1:
+        arr = arr.reshape(-1, 1)
+    elif arr.ndim != 2:
+        raise DataError(f"{name} must have shape (N, {width}) (one row per sample), or (N,) for a single "
+                        f"channel; got shape {_checks.shape_text(arr.shape)}")
+    if arr.shape[1] < 1:
+        raise DataError(f"{name} must have at least one channel; got shape {_checks.shape_text(arr.shape)}")
+    _checks.check_finite(arr, name)
+    return arr
+
+
+@dataclass(frozen=True, init=False, eq=False, repr=False)
+class IOData(DataContainer):
+    """Input/output samples u[k], y[k] at times t_k = k·dt, k = 0..N−1.
+
+    Parameters
+    ----------
+    u : array_like, shape (N, m) or (N,)
+        Input samples, one row per sample; a 1-D array is a single input.
+    y : array_like, shape (N, p) or (N,)
+        Output samples, one row per sample; a 1-D array is a single output.
+    dt : float
+        Sample time in seconds, finite and > 0.
+
+    Raises
+    ------
+    DataError
+        On NaN or inf, wrong shapes, ``u`` and ``y`` of different lengths, fewer than
+        two samples, or a ``dt`` that is not a finite positive number.
+
+    Notes
+    -----
+    A 2-D array is always read as (samples, channels): an input of shape (1, N) is one
+    sample of N channels and is refused for being shorter than two samples, not
+    transposed.
+
+    CSV layout (see :meth:`to_csv`)::
+
+        # symid IOData csv v1
+        # dt: 0.01
+        # n_inputs: m
+        # n_outputs: p
+        u[0],...,u[m-1],y[0],...,y[p-1]
+        <one row per sample>
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.data import IOData
+    >>> io = IOData(u=np.ones(5), y=np.arange(5.0), dt=0.1)
+    >>> io.u.shape, io.n_samples, io.n_outputs
+    ((5, 1), 5, 1)
+    >>> io.t
+    array([0. , 0.1, 0.2, 0.3, 0.4])
+    """
+
+    u: np.ndarray
+    y: np.ndarray
+    dt: float
+
+    _kind: ClassVar[str] = "IOData"
+    _npz_keys: ClassVar[tuple[str, ...]] = ("u", "y", "dt")
+
+    def __init__(self, u: Any, y: Any, dt: Any):
+        u_ = _signal(u, "u", "m")
+        y_ = _signal(y, "y", "p")
+        if u_.shape[0] != y_.shape[0]:
+            raise DataError(f"u and y must have the same number of samples N: u has {u_.shape[0]} "
+                            f"(shape {_checks.shape_text(u_.shape)}), y has {y_.shape[0]} "
+                            f"(shape {_checks.shape_text(y_.shape)})")
+        if u_.shape[0] < 2:
+            raise DataError(f"u and y must hold at least 2 samples (rows); got N = {u_.shape[0]}")
+        dt_ = _checks.check_positive_scalar(dt, "dt")
+        object.__setattr__(self, "u", _checks.frozen(u_))
+        object.__setattr__(self, "y", _checks.frozen(y_))
+        object.__setattr__(self, "dt", dt_)
+
+    @classmethod
+    def _from_npz_arrays(cls, arrays: dict[str, np.ndarray]) -> Self:
+        return cls(arrays["u"], arrays["y"], arrays["dt"])
+
+    # -- properties -----------------------------------------------------------------
+    @property
+    def n_samples(self) -> int:
+        """Number of samples N."""
+        return int(self.u.shape[0])
+
+    @property
+    def n_inputs(self) -> int:
+        """Number of inputs m."""
+        return int(self.u.shape[1])
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of outputs p."""
+        return int(self.y.shape[1])
+
+    @property
+    def t(self) -> np.ndarray:
+        """Sample times k·dt, k = 0..N−1 (a new array)."""
+        return np.arange(self.n_samples) * self.dt
+
+    @property
+    def duration(self) -> float:
+        """Time span of the record, (N − 1)·dt."""
+        return (self.n_samples - 1) * self.dt
+
+    # -- text -----------------------------------------------------------------------
+    def __repr__(self) -> str:
+        return (f"IOData({self.n_samples} samples, dt = {self.dt:.4g} s, "
+                f"{self.n_inputs} input(s), {self.n_outputs} output(s))")
+
+    def summary(self) -> str:
+        """A short readable description: sizes, sample time, rms of every channel."""
+        rms_u = np.sqrt(np.mean(self.u**2, axis=0))
+        rms_y = np.sqrt(np.mean(self.y**2, axis=0))
+        return "\n".join([
+            "IOData",
+            f"  samples N   : {self.n_samples}",
+            f"  dt          : {self.dt:.6g} s (duration {self.duration:.6g} s)",
+            f"  inputs m    : {self.n_inputs}, rms {', '.join(f'{v:.4g}' for v in rms_u)}",
+            f"  outputs p   : {self.n_outputs}, rms {', '.join(f'{v:.4g}' for v in rms_y)}",
+        ])
+
+    # -- CSV ------------------------------------------------------------------------
+    @staticmethod
+    def _columns(m: int, p: int) -> list[str]:
+        return [f"u[{j}]" for j in range(m)] + [f"y[{i}]" for i in range(p)]
+
+    def to_csv(self, path: _files.PathLike) -> None:
+        """Write the data as CSV text (layout in the class notes); the round trip is exact."""
+        table = np.hstack([self.u, self.y])
+        rows = [[_files.fmt(x) for x in row] for row in table.tolist()]
+        meta = {"dt": _files.fmt(self.dt), "n_inputs": self.n_inputs, "n_outputs": self.n_outputs}
+        _files.write_csv(path, self._kind, meta, self._columns(self.n_inputs, self.n_outputs), rows)
+
+    @classmethod
+    def from_csv(cls, path: _files.PathLike) -> Self:
+        """Read a file written by :meth:`to_csv`.
+
+        Raises
+        ------
+        DataError
+            If the file is not a symid IOData CSV file or its contents fail the
+            constructor's checks.
+        """
+        meta, columns, rows = _files.read_csv(path, cls._kind)
+        m = _files.meta_int(meta, "n_inputs", path)
+        p = _files.meta_int(meta, "n_outputs", path)
+        dt = _files.meta_float(meta, "dt", path)
+        _files.expect_columns(columns, cls._columns(m, p), path)
+        table = _files.parse_float_rows(rows, path, len(columns))
+        with naming_file(path):
+            return cls(table[:, :m], table[:, m:], dt)

@@ -1,0 +1,61 @@
+"""Error and warning types of symid.
+
+Every error symid raises on purpose derives from :class:`SymidError` and from the
+built-in type a caller would expect (``ValueError`` for bad values, ``TypeError`` for
+bad types), so ``except ValueError`` keeps working.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "DataError",
+    "IdentifiabilityWarning",
+    "ModelError",
+    "NonAffineError",
+    "SolverError",
+    "SymidError",
+]
+
+
+class SymidError(Exception):
+    """Base class of every error raised by symid."""
+
+
+class ModelError(SymidError, ValueError):
+    """A model is malformed: wrong matrix shapes, unknown output kind, bad parameters."""
+
+
+class NonAffineError(ModelError):
+    """A matrix entry is not affine in the parameters.
+
+    Attributes
+    ----------
+    matrix : str
+        Name of the matrix holding the entry (``"A"``, ``"M"``, ...).
+    entry : tuple of int
+        Zero-based (row, column) index of the offending entry.
+    expression : str
+        The entry as sympy prints it.
+    parameters : tuple of str
+        The parameters involved in the non-affine part.
+    """
+
+    def __init__(self, message: str, *, matrix: str = "", entry: tuple[int, int] = (-1, -1),
+                 expression: str = "", parameters: tuple[str, ...] = ()):
+        super().__init__(message)
+        self.matrix = matrix
+        self.entry = entry
+        self.expression = expression
+        self.parameters = parameters
+
+
+class DataError(SymidError, ValueError):
+    """Measured or simulated data are malformed (shape, NaN/inf, frequencies, symmetry)."""
+
+
+class SolverError(SymidError, RuntimeError):
+    """A numerical back end failed in a way that leaves no result to report."""
+
+
+class IdentifiabilityWarning(UserWarning):
+    """Parameters asked for are not (locally) identifiable from the data kind."""

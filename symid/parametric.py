@@ -1,0 +1,173 @@
+"""Shared machinery of the symbolic model classes: parameter order, θ handling, affine maps."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+import sympy as sp
+
+from symid.affine import AffineMap, affine_map, order_parameters
+from symid.errors import ModelError
+
+__all__ = ["ParametricModel", "StateSpaceMatrices", "Theta"]
+
+Theta = Mapping[str, float] | Mapping[sp.Symbol, float] | Sequence[float] | np.ndarray
+
+
+class StateSpaceMatrices(NamedTuple):
+    """Numeric continuous-time state-space matrices (x' = A x + B u, y = C x + D u)."""
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+
+
+def _unify_symbols(mats: list[tuple[str, sp.Matrix]]) -> list[tuple[str, sp.Matrix]]:
+    """Merge symbols that share a name (e.g. one parsed from a string, one from parameters())."""
+    by_name: dict[str, list[sp.Symbol]] = {}
+    for _, m in mats:
+        for s in m.free_symbols:
+            by_name.setdefault(s.name, [])
+            if s not in by_name[s.name]:
+                by_name[s.name].append(s)
+    repl = {}
+    for syms in by_name.values():
+        if len(syms) > 1:
+            keep = next((s for s in syms if s.is_positive), None) or next((s for s in syms if s.is_real), syms[0])
+            for s in syms:
+                if s != keep:
+                    repl[s] = keep
+    if not repl:
+        return mats
+    return [(n, m.xreplace(repl)) for n, m in mats]
+
+
+class ParametricModel:
+    """Base class: named symbolic matrices, their affine maps and the parameter vector θ.
+
+    Subclasses call :meth:`_setup` with their matrices in signature order.
+    """
+
+    _kind = "model"
+
+    def _setup(self, matrices: list[tuple[str, sp.Matrix]], parameters: Sequence[Any] | None,
+               name: str | None) -> None:
+        matrices = _unify_symbols(matrices)
+        found = order_parameters(matrices)
+        if parameters is None:
+            params = found
+        else:
+            params = []
+            by_name = {s.name: s for s in found}
+            for p in parameters:
+                pname = p.name if isinstance(p, sp.Symbol) else str(p)
+                if pname not in by_name:
+                    raise ModelError(f"parameter {pname!r} given in parameters= does not appear in any matrix")
+                params.append(by_name[pname])
+            if len({p.name for p in params}) != len(params):
+                raise ModelError("parameters= lists a parameter twice")
+            missing = [s.name for s in found if s not in params]
+            if missing:
+                raise ModelError(f"symbols {', '.join(missing)} appear in the matrices but not in parameters=")
+            params = tuple(params)
+        for p in params:
+            if p.is_real is False or (p.is_complex and not p.is_real):
+                raise ModelError(f"parameter {p} is declared non-real; symid parameters are real")
+        self._parameters: tuple[sp.Symbol, ...] = tuple(params)
+        self._symbolic: dict[str, sp.Matrix] = dict(matrices)
+        self._maps: dict[str, AffineMap] = {n: affine_map(m, self._parameters, n) for n, m in matrices}
+        self.name = name
+
+    # -- parameters ---------------------------------------------------------------
+    @property
+    def parameters(self) -> tuple[sp.Symbol, ...]:
+        """The parameter symbols, in the order of θ."""
+        return self._parameters
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        """The parameter names, in the order of θ."""
+        return tuple(p.name for p in self._parameters)
+
+    @property
+    def n_parameters(self) -> int:
+        """Number of unknown parameters."""
+        return len(self._parameters)
+
+    @property
+    def positive(self) -> tuple[bool, ...]:
+        """Per parameter, whether it was declared positive."""
+        return tuple(bool(p.is_positive) for p in self._parameters)
+
+    @property
+    def maps(self) -> dict[str, AffineMap]:
+        """The affine map of every matrix, by matrix name."""
+        return dict(self._maps)
+
+    @property
+    def symbolic(self) -> dict[str, sp.Matrix]:
+        """The symbolic matrices, by matrix name."""
+        return {k: sp.Matrix(v) for k, v in self._symbolic.items()}
+
+    def theta_vector(self, theta: Theta) -> np.ndarray:
+        """Convert θ given as a dict (by name or symbol) or a sequence to a float vector.
+
+        Raises
+        ------
+        ModelError
+            On a missing or unknown name, a wrong length, or a non-finite value.
+        """
+        names = self.parameter_names
+        if theta is None:
+            raise ModelError(f"theta is required: a dict by name or a sequence of {len(names)} value(s) "
+                             f"({', '.join(names)})")
+        if isinstance(theta, Mapping):
+            given = {(k.name if isinstance(k, sp.Symbol) else str(k)): v for k, v in theta.items()}
+            unknown = sorted(set(given) - set(names))
+            missing = [n for n in names if n not in given]
+            if unknown:
+                raise ModelError(f"theta names unknown parameter(s) {', '.join(unknown)}; "
+                                 f"the model's parameters are {', '.join(names) or 'none'}")
+            if missing:
+                raise ModelError(f"theta is missing parameter(s) {', '.join(missing)}")
+            vals = [given[n] for n in names]
+        else:
+            vals = list(np.asarray(theta, dtype=object).reshape(-1)) if np.ndim(theta) else [theta]
+            if len(vals) != len(names):
+                raise ModelError(f"theta has {len(vals)} value(s); the model has {len(names)} parameter(s) "
+                                 f"({', '.join(names)})")
+        try:
+            vec = np.array([float(v) for v in vals], dtype=float)
+        except (TypeError, ValueError):
+            raise ModelError(f"theta values must be real numbers; got {vals!r}") from None
+        bad = [names[i] for i in np.flatnonzero(~np.isfinite(vec))]
+        if bad:
+            raise ModelError(f"theta is not finite for {', '.join(bad)}")
+        return vec
+
+    def theta_dict(self, theta: Theta) -> dict[str, float]:
+        """θ as a dict by parameter name."""
+        return dict(zip(self.parameter_names, self.theta_vector(theta).tolist(), strict=True))
+
+    def matrices(self, theta: Theta) -> dict[str, np.ndarray]:
+        """Numeric value of every matrix at θ, by matrix name."""
+        vec = self.theta_vector(theta)
+        return {n: m(vec) for n, m in self._maps.items()}
+
+    def _matrix_text(self) -> str:
+        lines = []
+        for n, m in self._symbolic.items():
+            lines.append(f"{n} =")
+            lines.append(sp.pretty(m, use_unicode=True))
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        label = f" {self.name!r}" if self.name else ""
+        return (f"<{type(self).__name__}{label}: {self._shape_text()}, "
+                f"parameters ({', '.join(self.parameter_names)})>")
+
+    def _shape_text(self) -> str:  # pragma: no cover - overridden
+        return ""

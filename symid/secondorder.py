@@ -1,0 +1,175 @@
+"""Symbolic second-order models M(θ) q'' + V(θ) q' + K(θ) q = B(θ) u, y = C(θ) q (or q', q'')."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from symid.errors import ModelError
+from symid.parametric import ParametricModel, StateSpaceMatrices, Theta
+from symid.statespace import as_frequencies
+from symid.symbols import as_symbolic_matrix
+
+__all__ = ["OUTPUT_KINDS", "SecondOrderModel"]
+
+OUTPUT_KINDS = ("position", "velocity", "acceleration")
+
+
+class SecondOrderModel(ParametricModel):
+    """A linear second-order (matrix differential equation) model.
+
+    ``M(θ) q''(t) + V(θ) q'(t) + K(θ) q(t) = B(θ) u(t)`` with the output
+    ``y = C(θ) q``, ``C(θ) q'`` or ``C(θ) q''`` for ``output="position"``,
+    ``"velocity"`` or ``"acceleration"`` (thesis (4-2), (4-9)).
+
+    Parameters
+    ----------
+    M, V, K : array_like or sympy.Matrix
+        Mass, damping and stiffness matrices, each (n, n), affine in the parameters.
+    B : array_like or sympy.Matrix
+        Input matrix (n, m).
+    C : array_like or sympy.Matrix
+        Output matrix (p, n).
+    output : {"position", "velocity", "acceleration"}
+        What the sensors measure.
+    parameters : sequence of sympy.Symbol or str, optional
+        Fixes the order of θ; by default the order of first appearance, row by row,
+        through M, V, K, B, C.
+    name : str, optional
+        A label used in reports.
+
+    Notes
+    -----
+    The first-order form with state ``x = [q; q']`` is thesis (7-2):
+    ``A = [[0, I], [−M⁻¹K, −M⁻¹V]]``, ``B = [[0], [M⁻¹B]]``. The thesis's (4-3)
+    prints ``−M⁻¹B``; the sign there is a typo (it contradicts (4-2) and (7-2)).
+    The output matrix is ``[C, 0]`` for position, ``[0, C]`` for velocity and, for
+    acceleration, ``[−CM⁻¹K, −CM⁻¹V]`` with the feedthrough ``D = CM⁻¹B``.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> ss = model.state_space({"m": 2.0, "c": 1.0, "k": 4.0})
+    >>> ss.A
+    array([[ 0. ,  1. ],
+           [-2. , -0.5]])
+    """
+
+    _kind = "second-order"
+
+    def __init__(self, M: Any, V: Any, K: Any, B: Any, C: Any, output: str = "position", *,
+                 parameters: Sequence[Any] | None = None, name: str | None = None):
+        if output not in OUTPUT_KINDS:
+            raise ModelError(f"output must be one of {', '.join(map(repr, OUTPUT_KINDS))}; got {output!r}")
+        M_ = as_symbolic_matrix(M, "M")
+        if M_.rows != M_.cols:
+            raise ModelError(f"M must be square; got shape {M_.shape}")
+        n = M_.rows
+        V_ = as_symbolic_matrix(V, "V", shape=(n, n))
+        K_ = as_symbolic_matrix(K, "K", shape=(n, n))
+        B_ = as_symbolic_matrix(B, "B", shape=(n, None))
+        C_ = as_symbolic_matrix(C, "C", shape=(None, n))
+        self.output = output
+        self._setup([("M", M_), ("V", V_), ("K", K_), ("B", B_), ("C", C_)], parameters, name)
+
+    @property
+    def n_dof(self) -> int:
+        """Number of degrees of freedom n (size of M)."""
+        return self._maps["M"].shape[0]
+
+    @property
+    def n_states(self) -> int:
+        """Number of states of the first-order form, 2n."""
+        return 2 * self.n_dof
+
+    @property
+    def n_inputs(self) -> int:
+        """Number of inputs m."""
+        return self._maps["B"].shape[1]
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of outputs p."""
+        return self._maps["C"].shape[0]
+
+    def _shape_text(self) -> str:
+        return (f"{self.n_dof} DOF, {self.n_inputs} input(s), {self.n_outputs} {self.output} output(s)")
+
+    def _minv(self, M: np.ndarray, theta: np.ndarray) -> np.ndarray:
+        try:
+            Minv = np.linalg.inv(M)
+        except np.linalg.LinAlgError:
+            raise ModelError(f"M(θ) is singular at θ = {self.theta_dict(theta)}") from None
+        return Minv
+
+    def state_space(self, theta: Theta) -> StateSpaceMatrices:
+        """First-order form (A, B, C, D) at θ (thesis (7-2); see the class notes)."""
+        vec = self.theta_vector(theta)
+        mats = self.matrices(vec)
+        M, V, K, B, C = (mats[k] for k in "MVKBC")
+        n = self.n_dof
+        Minv = self._minv(M, vec)
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ V]])
+        Bss = np.vstack([np.zeros_like(B), Minv @ B])
+        D = np.zeros((C.shape[0], B.shape[1]))
+        if self.output == "position":
+            Css = np.hstack([C, np.zeros_like(C)])
+        elif self.output == "velocity":
+            Css = np.hstack([np.zeros_like(C), C])
+        else:
+            Css = np.hstack([-C @ Minv @ K, -C @ Minv @ V])
+            D = C @ Minv @ B
+        return StateSpaceMatrices(A, Bss, Css, D)
+
+    def symbolic_state_space(self) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix, sp.Matrix]:
+        """Symbolic first-order form (A, B, C, D); holds M⁻¹, so it is rational in θ."""
+        s = self.symbolic
+        M, V, K, B, C = (s[k] for k in "MVKBC")
+        n = self.n_dof
+        Minv = M.inv()
+        Z, I = sp.zeros(n, n), sp.eye(n)
+        A = sp.BlockMatrix([[Z, I], [-Minv * K, -Minv * V]]).as_explicit()
+        Bss = sp.Matrix.vstack(sp.zeros(*B.shape), Minv * B)
+        D = sp.zeros(C.rows, B.cols)
+        if self.output == "position":
+            Css = sp.Matrix.hstack(C, sp.zeros(*C.shape))
+        elif self.output == "velocity":
+            Css = sp.Matrix.hstack(sp.zeros(*C.shape), C)
+        else:
+            Css = sp.Matrix.hstack(-C * Minv * K, -C * Minv * V)
+            D = C * Minv * B
+        return A, Bss, Css, D
+
+    def frequency_response(self, theta: Theta, w: Any) -> np.ndarray:
+        """H(ω) = C (−ω²M + jωV + K)⁻¹ B, times jω (velocity) or −ω² (acceleration).
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex array of shape (len(w), p, m).
+        """
+        w = as_frequencies(w)
+        mats = self.matrices(theta)
+        M, V, K, B, C = (mats[k] for k in "MVKBC")
+        Z = -(w**2)[:, None, None] * M + 1j * w[:, None, None] * V + K
+        try:
+            X = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
+        except np.linalg.LinAlgError:
+            raise ModelError("−ω²M + jωV + K is singular at one of the frequencies "
+                             "(an undamped resonance or a rigid-body mode at ω = 0)") from None
+        H = C @ X
+        if self.output == "velocity":
+            H = H * (1j * w)[:, None, None]
+        elif self.output == "acceleration":
+            H = H * (-(w**2))[:, None, None]
+        return H
+
+    def summary(self) -> str:
+        """Parameters and matrices as readable text."""
+        head = f"SecondOrderModel{' ' + repr(self.name) if self.name else ''}: {self._shape_text()}"
+        return f"{head}\nparameters: {', '.join(self.parameter_names) or '(none)'}\n{self._matrix_text()}"

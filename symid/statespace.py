@@ -1,0 +1,140 @@
+"""Symbolic first-order continuous-time models x' = A(θ) x + B(θ) u, y = C(θ) x + D(θ) u."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from symid.errors import DataError, ModelError
+from symid.parametric import ParametricModel, StateSpaceMatrices, Theta
+from symid.symbols import as_symbolic_matrix
+
+__all__ = ["StateSpaceModel", "as_frequencies"]
+
+
+def as_frequencies(w: Any, name: str = "w") -> np.ndarray:
+    """Validate angular frequencies (rad/s): a finite, real 1-D array (a scalar becomes length 1)."""
+    arr = np.asarray(w)
+    if np.iscomplexobj(arr):
+        raise DataError(f"{name} must be real angular frequencies in rad/s; got complex values")
+    try:
+        arr = np.atleast_1d(arr.astype(float))
+    except (TypeError, ValueError):
+        raise DataError(f"{name} must hold numbers; got dtype {arr.dtype}") from None
+    if arr.ndim != 1:
+        raise DataError(f"{name} must be 1-D (one frequency per sample); got shape {arr.shape}")
+    if arr.size == 0:
+        raise DataError(f"{name} is empty")
+    if not np.all(np.isfinite(arr)):
+        raise DataError(f"{name} holds NaN or inf at index {int(np.flatnonzero(~np.isfinite(arr))[0])}")
+    return arr
+
+
+class StateSpaceModel(ParametricModel):
+    """A linear continuous-time state-space model with affinely parameterised matrices.
+
+    ``x'(t) = A(θ) x(t) + B(θ) u(t)``, ``y(t) = C(θ) x(t) + D(θ) u(t)``.
+
+    Parameters
+    ----------
+    A, B, C : array_like or sympy.Matrix
+        System matrices of shapes (n, n), (n, m), (p, n). Entries are numbers, sympy
+        expressions or strings parsed by sympy, each affine in the parameters.
+    D : array_like or sympy.Matrix, optional
+        Feedthrough of shape (p, m); zero when omitted.
+    parameters : sequence of sympy.Symbol or str, optional
+        Fixes the order of θ. By default it is the order of first appearance, row by
+        row, through A, B, C, D.
+    name : str, optional
+        A label used in reports.
+
+    Raises
+    ------
+    NonAffineError
+        If an entry is not affine in the parameters.
+    ModelError
+        On inconsistent shapes or unparsable entries.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> a, b = si.parameters("a b")
+    >>> model = si.StateSpaceModel(A=[[0, 1], [-a, -b]], B=[[0], [1]], C=[[1, 0]])
+    >>> model.parameter_names
+    ('a', 'b')
+    >>> model.frequency_response({"a": 1.0, "b": 0.5}, [0.0]).real
+    array([[[1.]]])
+    """
+
+    _kind = "state-space"
+
+    def __init__(self, A: Any, B: Any, C: Any, D: Any | None = None, *,
+                 parameters: Sequence[Any] | None = None, name: str | None = None):
+        A_ = as_symbolic_matrix(A, "A")
+        if A_.rows != A_.cols:
+            raise ModelError(f"A must be square; got shape {A_.shape}")
+        n = A_.rows
+        B_ = as_symbolic_matrix(B, "B", shape=(n, None))
+        C_ = as_symbolic_matrix(C, "C", shape=(None, n))
+        D_ = sp.zeros(C_.rows, B_.cols) if D is None else as_symbolic_matrix(D, "D", shape=(C_.rows, B_.cols))
+        self._setup([("A", A_), ("B", B_), ("C", C_), ("D", D_)], parameters, name)
+
+    @property
+    def n_states(self) -> int:
+        """Number of states n."""
+        return self._maps["A"].shape[0]
+
+    @property
+    def n_inputs(self) -> int:
+        """Number of inputs m."""
+        return self._maps["B"].shape[1]
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of outputs p."""
+        return self._maps["C"].shape[0]
+
+    def _shape_text(self) -> str:
+        return f"{self.n_states} states, {self.n_inputs} input(s), {self.n_outputs} output(s)"
+
+    def state_space(self, theta: Theta) -> StateSpaceMatrices:
+        """Numeric matrices (A, B, C, D) at θ."""
+        mats = self.matrices(theta)
+        return StateSpaceMatrices(mats["A"], mats["B"], mats["C"], mats["D"])
+
+    def symbolic_state_space(self) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix, sp.Matrix]:
+        """Symbolic matrices (A, B, C, D)."""
+        s = self.symbolic
+        return s["A"], s["B"], s["C"], s["D"]
+
+    def frequency_response(self, theta: Theta, w: Any) -> np.ndarray:
+        """Frequency response H(ω) = C (jωI − A)⁻¹ B + D at angular frequencies ``w`` (rad/s).
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex array of shape (len(w), p, m).
+        """
+        ss = self.state_space(theta)
+        return frequency_response_ss(ss, as_frequencies(w))
+
+    def summary(self) -> str:
+        """Parameters and matrices as readable text."""
+        head = f"StateSpaceModel{' ' + repr(self.name) if self.name else ''}: {self._shape_text()}"
+        return f"{head}\nparameters: {', '.join(self.parameter_names) or '(none)'}\n{self._matrix_text()}"
+
+
+def frequency_response_ss(ss: StateSpaceMatrices, w: np.ndarray) -> np.ndarray:
+    """H(ω) = C (jωI − A)⁻¹ B + D for numeric matrices, shape (len(w), p, m)."""
+    A, B, C, D = ss
+    n = A.shape[0]
+    Z = 1j * w[:, None, None] * np.eye(n) - A
+    try:
+        X = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
+    except np.linalg.LinAlgError:
+        bad = [float(x) for x in w if abs(np.linalg.det(1j * x * np.eye(n) - A)) < 1e-300]
+        raise ModelError(f"jωI − A is singular at ω = {bad[:3]} (a pole on the imaginary axis)") from None
+    return C @ X + D

@@ -1,0 +1,153 @@
+"""The model zoo: systems from the thesis with their true values and data recipes.
+
+Each zoo model is one Python file in the top-level ``models/`` folder (shipped in the
+wheel as the package ``symid.zoo_models``). A file defines ``entry() -> ZooEntry``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import pkgutil
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from symid.errors import ModelError
+
+__all__ = ["ZooEntry", "list_models", "load_model"]
+
+
+@dataclass(frozen=True)
+class ZooEntry:
+    """A model with its true parameter values and the recipe of its data.
+
+    Attributes
+    ----------
+    name : str
+        Zoo name (the file name without ``.py``).
+    title : str
+        One-line description.
+    source : str
+        Where it comes from (thesis equations).
+    model : StateSpaceModel or SecondOrderModel
+        The symbolic model.
+    truth : dict of str to float
+        True parameter values.
+    recipe : str
+        The data recipe in words (what ``data()`` simulates).
+    make_data : callable
+        ``make_data(model, truth, noise=None, seed=None)`` returning a data object.
+    notes : str
+        Remarks: transcription choices, discrepancies with the printed thesis.
+    extra : dict
+        Anything else the entry carries (e.g. printed matrices of the thesis).
+    """
+
+    name: str
+    title: str
+    source: str
+    model: Any
+    truth: dict[str, float]
+    recipe: str
+    make_data: Callable[..., Any] = field(repr=False)
+    notes: str = ""
+    extra: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    def data(self, noise: float | None = None, seed: int | None = None) -> Any:
+        """Simulate the entry's data recipe from the truth (optionally with relative noise)."""
+        return self.make_data(self.model, self.truth, noise=noise, seed=seed)
+
+    def summary(self) -> str:
+        """Model, truth and recipe as readable text."""
+        truth = "\n".join(f"  {k:>10s} = {v:.6g}" for k, v in self.truth.items())
+        parts = [f"{self.name}: {self.title}", f"source: {self.source}", self.model.summary(),
+                 f"truth:\n{truth}", f"data recipe: {self.recipe}"]
+        if self.notes:
+            parts.append(f"notes: {self.notes}")
+        return "\n".join(parts)
+
+
+_ZOO_PACKAGE = "symid.zoo_models"
+
+
+def _zoo_package():
+    """The zoo package: installed as ``symid.zoo_models``, or ``models/`` of a source checkout.
+
+    A wheel maps the top-level ``models/`` folder to ``symid.zoo_models``. When symid is
+    imported from a source tree instead (``python -m symid.cli`` run in the repository
+    root puts the checkout's ``symid/`` first on ``sys.path``), that mapping does not
+    exist, so the checkout's ``models/`` folder is registered under the same name.
+    """
+    try:
+        return importlib.import_module(_ZOO_PACKAGE)
+    except ModuleNotFoundError as exc:
+        if exc.name != _ZOO_PACKAGE:
+            raise
+    folder = Path(__file__).resolve().parents[1] / "models"
+    init = folder / "__init__.py"
+    if not init.is_file():
+        raise ModelError(f"the model zoo is missing: no package {_ZOO_PACKAGE} and no {folder}; "
+                         "reinstall symid with `pip install .`")
+    spec = importlib.util.spec_from_file_location(_ZOO_PACKAGE, init, submodule_search_locations=[str(folder)])
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[_ZOO_PACKAGE] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def list_models() -> list[str]:
+    """Names of the models in the zoo, sorted."""
+    pkg = _zoo_package()
+    return sorted(m.name for m in pkgutil.iter_modules(pkg.__path__) if not m.name.startswith("_"))
+
+
+def load_model(name_or_path: str | Path) -> ZooEntry:
+    """Load a zoo model by name (``"belt_drive"``) or from a Python file defining ``entry()``.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A name listed by :func:`list_models`, or the path of a ``.py`` file whose
+        ``entry()`` returns a :class:`ZooEntry`.
+
+    Returns
+    -------
+    ZooEntry
+
+    Raises
+    ------
+    ModelError
+        If no such model exists or the file does not define ``entry()``.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> entry = si.load_model("belt_drive")
+    >>> entry.model.parameter_names
+    ('theta1', 'theta2', 'theta3', 'theta4')
+    """
+    text = str(name_or_path)
+    path = Path(text)
+    if text.endswith(".py") or path.is_file():
+        if not path.is_file():
+            raise ModelError(f"model file {text!r} does not exist")
+        spec = importlib.util.spec_from_file_location(f"symid_user_model_{path.stem}", path)
+        if spec is None or spec.loader is None:
+            raise ModelError(f"cannot import model file {text!r}")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    else:
+        names = list_models()
+        if text not in names:
+            raise ModelError(f"no zoo model named {text!r}; available: {', '.join(names)}")
+        module = importlib.import_module(f"{_ZOO_PACKAGE}.{text}")
+    factory = getattr(module, "entry", None)
+    if not callable(factory):
+        raise ModelError(f"{text!r} does not define entry() returning a ZooEntry")
+    result = factory()
+    if not isinstance(result, ZooEntry):
+        raise ModelError(f"entry() of {text!r} returned {type(result).__name__}, not a ZooEntry")
+    return result

@@ -1,0 +1,268 @@
+"""Symbolic models: parameters, exact affine maps, first-order forms, frequency responses."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import symid as si
+from symid.statespace import frequency_response_ss
+
+TRUTH_2DOF = {"m1": 1, "m2": 1, "c1": 0.1, "c2": 0.3, "k1": 2, "k2": 1}  # thesis (4-20)
+
+
+def two_dof(output="position"):
+    """The 2-DOF mass-damper of thesis (4-19), with the parameter names of design.md."""
+    m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+    return si.SecondOrderModel(
+        M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]], K=[[k1 + k2, -k2], [-k2, k2]],
+        B=[[1], [0]], C=[[1, 0]], output=output)
+
+
+# -- parameters and parameter order -------------------------------------------------------
+
+def test_parameters_returns_symbols_with_assumptions():
+    a, b = si.parameters("a, b", positive=True)
+    c = si.parameters("c")
+    assert a.is_positive and b.is_positive
+    assert isinstance(c, sp.Symbol) and c.is_real and c.is_positive is None
+
+
+@pytest.mark.parametrize("names, phrase", [("", "at least one"), ("a a", "repeated"), ("1x", "identifier")])
+def test_parameters_rejects_bad_names(names, phrase):
+    with pytest.raises(si.ModelError, match=phrase):
+        si.parameters(names)
+
+
+def test_parameter_order_is_first_appearance_row_by_row():
+    model = two_dof()
+    assert model.parameter_names == ("m1", "m2", "c1", "c2", "k1", "k2")
+    b, a = si.parameters("b a")
+    ss = si.StateSpaceModel(A=[[0, 1], [b, a]], B=[["u0"], [0]], C=[[1, 0]])
+    # entry (1, 0) holds b before (1, 1) holds a; u0 comes from B, after A
+    assert ss.parameter_names == ("b", "a", "u0")
+    # within one entry the order is sympy's canonical (alphabetical) one
+    ss2 = si.StateSpaceModel(A=[["z + y"]], B=[[1]], C=[[1]])
+    assert ss2.parameter_names == ("y", "z")
+
+
+def test_explicit_parameter_order_and_errors():
+    model = si.StateSpaceModel(A=[["-a"]], B=[["b"]], C=[[1]], parameters=["b", "a"])
+    assert model.parameter_names == ("b", "a")
+    with pytest.raises(si.ModelError, match="not in parameters="):
+        si.StateSpaceModel(A=[["-a"]], B=[["b"]], C=[[1]], parameters=["a"])
+    with pytest.raises(si.ModelError, match="does not appear"):
+        si.StateSpaceModel(A=[["-a"]], B=[["b"]], C=[[1]], parameters=["a", "b", "z"])
+
+
+def test_string_entries_merge_with_declared_symbols():
+    m = si.parameters("m", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[["c"]], K=[["2*m + k"]], B=[[1]], C=[[1]])
+    assert model.parameter_names == ("m", "c", "k")
+    assert model.positive == (True, False, False)
+
+
+def test_parameters_in_B_C_D():
+    g, h, d = si.parameters("g h d")
+    model = si.StateSpaceModel(A=[[-1]], B=[[g]], C=[[h]], D=[[d]])
+    ss = model.state_space([2.0, 3.0, 0.5])
+    np.testing.assert_allclose(ss.B, [[2.0]], rtol=0, atol=0)
+    np.testing.assert_allclose(ss.C, [[3.0]], rtol=0, atol=0)
+    np.testing.assert_allclose(ss.D, [[0.5]], rtol=0, atol=0)
+    # H(0) = C (−A)⁻¹ B + D = 3·2 + 0.5, computed by hand
+    np.testing.assert_allclose(model.frequency_response([2.0, 3.0, 0.5], [0.0])[0, 0, 0], 6.5, rtol=1e-14)
+
+
+# -- affine maps ----------------------------------------------------------------------------
+
+def test_affine_map_coefficients_are_exact():
+    k1, k2 = si.parameters("k1 k2")
+    model = si.StateSpaceModel(A=[[sp.Rational(1, 3) * k1 - k2, 0], [0, 2]], B=[[1], [0]], C=[[1, 0]])
+    amap = model.maps["A"]
+    assert amap.coefficients[0][0, 0] == sp.Rational(1, 3)
+    assert amap.coefficients[1][0, 0] == -1
+    assert amap.constant == sp.Matrix([[0, 0], [0, 2]])
+    assert amap.depends_on == (0, 1)
+    assert model.maps["B"].is_constant
+
+
+@pytest.mark.parametrize("entry, involved", [("1/m", ("m",)), ("k*c", ("c", "k")), ("sin(a)", ("a",)),
+                                             ("m**2 + 1", ("m",))])
+def test_non_affine_entry_is_named(entry, involved):
+    with pytest.raises(si.NonAffineError) as info:
+        si.StateSpaceModel(A=[[0, 1], [entry, -1]], B=[[0], [1]], C=[[1, 0]])
+    err = info.value
+    assert err.matrix == "A" and err.entry == (1, 0)
+    assert err.parameters == involved
+    msg = str(err)
+    assert "matrix A, entry (1, 0)" in msg and "Hint: introduce a new parameter" in msg
+    for p in involved:
+        assert p in msg
+
+
+def test_non_affine_hint_for_inverse_mass():
+    with pytest.raises(si.NonAffineError, match=r"minv = 1/m"):
+        si.SecondOrderModel(M=[[1]], V=[["c/m"]], K=[[1]], B=[[1]], C=[[1]])
+
+
+def test_non_affine_in_B_named():
+    with pytest.raises(si.NonAffineError, match=r"matrix B, entry \(0, 0\)"):
+        si.StateSpaceModel(A=[[-1]], B=[["g*h"]], C=[[1]])
+
+
+@st.composite
+def random_affine_model(draw):
+    n = draw(st.integers(1, 3))
+    m = draw(st.integers(1, 2))
+    p = draw(st.integers(1, 2))
+    names = [f"t{i}" for i in range(draw(st.integers(1, 4)))]
+    syms = sp.symbols(names, real=True)
+    coef = st.integers(-3, 3)
+
+    def entry():
+        expr = sp.Rational(draw(coef), draw(st.integers(1, 3)))
+        for s in syms:
+            if draw(st.booleans()):
+                expr += sp.Rational(draw(coef), draw(st.integers(1, 3))) * s
+        return expr
+
+    def mat(r, c):
+        return sp.Matrix(r, c, lambda i, j: entry())
+
+    A, B, C, D = mat(n, n), mat(n, m), mat(p, n), mat(p, m)
+    theta = draw(st.lists(st.floats(-5, 5, allow_nan=False), min_size=len(syms), max_size=len(syms)))
+    return A, B, C, D, syms, theta
+
+
+@settings(max_examples=60, deadline=None)
+@given(random_affine_model())
+def test_affine_maps_equal_substitution(case):
+    """Property: X0 + Σ θi Xi equals substituting θ into the symbolic matrix."""
+    A, B, C, D, syms, theta = case
+    used = set().union(*(X.free_symbols for X in (A, B, C, D)))
+    params = [s for s in syms if s in used]
+    if not params:
+        return
+    model = si.StateSpaceModel(A, B, C, D, parameters=params)
+    values = dict(zip(syms, theta, strict=True))
+    vec = [values[s] for s in params]
+    for name, X in zip("ABCD", (A, B, C, D), strict=True):
+        expected = np.array(X.subs(values).evalf(), dtype=float)
+        np.testing.assert_allclose(model.maps[name](vec), expected, rtol=1e-12, atol=1e-12)
+        assert sp.simplify(model.maps[name].symbolic() - X) == sp.zeros(*X.shape)
+
+
+# -- theta handling --------------------------------------------------------------------------
+
+def test_theta_as_dict_or_sequence():
+    model = two_dof()
+    vec = model.theta_vector(TRUTH_2DOF)
+    np.testing.assert_array_equal(vec, [1, 1, 0.1, 0.3, 2, 1])
+    np.testing.assert_array_equal(model.theta_vector(list(vec)), vec)
+
+
+@pytest.mark.parametrize("theta, phrase", [
+    ({"m1": 1}, "missing"), ({**TRUTH_2DOF, "zz": 1}, "unknown"), ([1, 2], "has 2 value"),
+    ({**TRUTH_2DOF, "m1": float("nan")}, "not finite for m1"), ({**TRUTH_2DOF, "m1": "x"}, "real numbers")])
+def test_theta_errors(theta, phrase):
+    with pytest.raises(si.ModelError, match=phrase):
+        two_dof().state_space(theta)
+
+
+# -- first-order forms and frequency responses --------------------------------------------------
+
+def test_second_order_state_space_is_thesis_7_2():
+    model = two_dof()
+    ss = model.state_space(TRUTH_2DOF)
+    M = np.diag([1.0, 1.0])
+    K = np.array([[3.0, -1.0], [-1.0, 1.0]])
+    V = np.array([[0.4, -0.3], [-0.3, 0.3]])
+    Minv = np.linalg.inv(M)
+    # thesis (7-2): A = [[0, I], [-M^-1 K, -M^-1 V]], B = [[0], [M^-1 F]], C = [H, 0]
+    np.testing.assert_allclose(ss.A, np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ K, -Minv @ V]]), atol=0)
+    np.testing.assert_allclose(ss.B, [[0], [0], [1], [0]], atol=0)
+    np.testing.assert_allclose(ss.C, [[1, 0, 0, 0]], atol=0)
+    np.testing.assert_allclose(ss.D, [[0]], atol=0)
+
+
+@pytest.mark.parametrize("output", ["position", "velocity", "acceleration"])
+def test_second_order_response_matches_first_order(output):
+    model = two_dof(output)
+    w = np.logspace(np.log10(0.5), np.log10(2), 30)  # thesis §4-6-2 band
+    H_direct = model.frequency_response(TRUTH_2DOF, w)
+    H_ss = frequency_response_ss(model.state_space(TRUTH_2DOF), w)
+    np.testing.assert_allclose(H_direct, H_ss, rtol=1e-10, atol=0)
+
+
+def test_acceleration_output_has_feedthrough_and_factor():
+    pos, acc = two_dof("position"), two_dof("acceleration")
+    w = np.array([0.3, 1.0, 5.0])
+    ss = acc.state_space(TRUTH_2DOF)
+    np.testing.assert_allclose(ss.D, [[1.0]], rtol=1e-15)  # C M^-1 B with M = I, B = e1, C = e1
+    np.testing.assert_allclose(acc.frequency_response(TRUTH_2DOF, w),
+                               -(w**2)[:, None, None] * pos.frequency_response(TRUTH_2DOF, w), rtol=1e-12)
+    vel = two_dof("velocity")
+    np.testing.assert_allclose(vel.frequency_response(TRUTH_2DOF, w),
+                               (1j * w)[:, None, None] * pos.frequency_response(TRUTH_2DOF, w), rtol=1e-12)
+
+
+def test_single_dof_frequency_response_by_hand():
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    w = np.array([0.5, 2.0])
+    expected = 1.0 / (-(w**2) * 2.0 + 1j * w * 0.5 + 3.0)  # 1/(k − ω²m + jωc)
+    np.testing.assert_allclose(model.frequency_response([2.0, 0.5, 3.0], w)[:, 0, 0], expected, rtol=1e-14)
+
+
+def test_symbolic_state_space_agrees_with_numeric():
+    for output in ("position", "velocity", "acceleration"):
+        model = two_dof(output)
+        sym = model.symbolic_state_space()
+        subs = {model.parameters[i]: v for i, v in enumerate(model.theta_vector(TRUTH_2DOF))}
+        num = model.state_space(TRUTH_2DOF)
+        for S, N in zip(sym, num, strict=True):
+            np.testing.assert_allclose(np.array(S.subs(subs).evalf(), dtype=float), N, rtol=1e-12, atol=1e-14)
+
+
+# -- malformed models ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("kwargs, phrase", [
+    (dict(A=[[1, 2]], B=[[1]], C=[[1]]), "A must be square"),
+    (dict(A=[[1]], B=[[1], [2]], C=[[1]]), r"B has shape \(2, 1\); expected \(1, any\)"),
+    (dict(A=[[1]], B=[1], C=[[1]]), "1-D sequence"),
+    (dict(A=[[1, 2], [3]], B=[[1], [1]], C=[[1, 1]]), "ragged"),
+    (dict(A=[[float("nan")]], B=[[1]], C=[[1]]), "finite"),
+    (dict(A=[["a +"]], B=[[1]], C=[[1]]), "cannot be parsed"),
+    (dict(A=[[1]], B=[[1]], C=[[1]], D=[[1, 2]]), "D has shape"),
+    (dict(A=[["I*a"]], B=[[1]], C=[[1]]), "must be real"),
+])
+def test_malformed_state_space(kwargs, phrase):
+    with pytest.raises(si.ModelError, match=phrase):
+        si.StateSpaceModel(**kwargs)
+
+
+def test_bad_output_kind_and_singular_mass():
+    with pytest.raises(si.ModelError, match="output must be one of"):
+        si.SecondOrderModel(M=[[1]], V=[[1]], K=[[1]], B=[[1]], C=[[1]], output="displacement")
+    m = si.parameters("m")
+    model = si.SecondOrderModel(M=[[m]], V=[[1]], K=[[1]], B=[[1]], C=[[1]])
+    with pytest.raises(si.ModelError, match=r"M.*singular"):
+        model.state_space([0.0])
+
+
+def test_frequency_errors():
+    model = two_dof()
+    with pytest.raises(si.DataError, match="NaN or inf"):
+        model.frequency_response(TRUTH_2DOF, [1.0, np.nan])
+    with pytest.raises(si.DataError, match="1-D"):
+        model.frequency_response(TRUTH_2DOF, np.ones((2, 2)))
+
+
+def test_summary_and_repr_mention_parameters():
+    model = two_dof()
+    text = model.summary()
+    assert "m1, m2, c1, c2, k1, k2" in text and "M =" in text
+    assert "2 DOF" in repr(model)
