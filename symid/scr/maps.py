@@ -1,0 +1,235 @@
+"""Numeric affine maps X(x) = X0 + Σ_u x[idx_u] X_u, from sympy or from arrays.
+
+A :class:`LocalMap` stores only the entries of x a matrix depends on (``idx``), so a
+problem with hundreds of terms, each touching a few shared and a few private variables,
+stays linear in size. :class:`Affine` is the public numeric constructor; sympy matrices
+are compiled by :func:`compile_sympy` with one expansion per entry.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from symid.errors import ModelError, NonAffineError
+from symid.scr.variables import Layout
+
+__all__ = ["Affine", "LocalMap", "as_map", "compile_sympy"]
+
+
+@dataclass(frozen=True, eq=False)
+class LocalMap:
+    """X(x) = const + Σ_u x[idx[u]] coef[:, :, u] (complex entries allowed, x real)."""
+
+    const: np.ndarray  # (r, c) complex
+    idx: np.ndarray  # (u,) int
+    coef: np.ndarray  # (r, c, u) complex
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.const.shape
+
+    @property
+    def is_complex(self) -> bool:
+        return bool(np.any(self.const.imag != 0) or np.any(self.coef.imag != 0))
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        return self.const + self.coef @ x[self.idx]
+
+    def rows(self, sel: np.ndarray) -> LocalMap:
+        return LocalMap(self.const[sel], self.idx, self.coef[sel])
+
+    def cols(self, sel: np.ndarray) -> LocalMap:
+        return LocalMap(self.const[:, sel], self.idx, self.coef[:, sel])
+
+    def constant_rows(self) -> np.ndarray:
+        return ~np.any(self.coef != 0, axis=(1, 2))
+
+    def constant_cols(self) -> np.ndarray:
+        return ~np.any(self.coef != 0, axis=(0, 2))
+
+    def on(self, idx: np.ndarray) -> np.ndarray:
+        """Coefficients re-expressed on a (super)set of indices ``idx``: array (r, c, len(idx))."""
+        out = np.zeros((*self.const.shape, len(idx)), dtype=complex)
+        pos = {int(i): k for k, i in enumerate(idx)}
+        for u, i in enumerate(self.idx):
+            out[:, :, pos[int(i)]] += self.coef[:, :, u]
+        return out
+
+
+def _clean(idx: np.ndarray, coef: np.ndarray, const: np.ndarray) -> LocalMap:
+    """Merge duplicate indices and drop variables with all-zero coefficients."""
+    idx = np.asarray(idx, dtype=np.int64).reshape(-1)
+    if idx.size:
+        uniq, inv = np.unique(idx, return_inverse=True)
+        merged = np.zeros((*const.shape, uniq.size), dtype=complex)
+        np.add.at(merged.transpose(2, 0, 1), inv, coef.transpose(2, 0, 1))
+        keep = np.any(merged != 0, axis=(0, 1))
+        idx, coef = uniq[keep], merged[:, :, keep]
+    else:
+        coef = np.zeros((*const.shape, 0), dtype=complex)
+    return LocalMap(np.asarray(const, dtype=complex), idx, coef)
+
+
+class Affine:
+    """A numeric affine matrix map, the sympy-free way to pose problem data.
+
+    ``Affine(const, {var: coef, ...})`` is the matrix
+    ``const + Σ_var Σ_e var[e] * coef[..., e]`` where ``coef`` has shape
+    ``const.shape + var.shape``. For a complex variable the map is complex-linear in it.
+
+    Parameters
+    ----------
+    const : array_like, shape (r, c)
+        Constant part (real or complex). A vector is taken as a column.
+    coefs : mapping, optional
+        Keys are variable names, sympy symbols or :class:`Variable`; values are arrays of
+        shape ``const.shape + var.shape``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid import scr
+    >>> G = scr.Variable("G", (2, 1), complex=True)
+    >>> jw = scr.Affine(np.zeros((2, 1)), {G: 1j * 0.5 * np.eye(2).reshape(2, 1, 2, 1)})
+    >>> lay = scr.Layout([G])
+    >>> m = jw.compile(lay)
+    >>> m(lay.pack({"G": [[1.0], [2.0]]}))
+    array([[0.+0.5j],
+           [0.+1.j ]])
+    """
+
+    def __init__(self, const: Any, coefs: Mapping[Any, Any] | None = None):
+        c0 = np.asarray(const)
+        if c0.ndim == 1:
+            c0 = c0.reshape(-1, 1)
+        if c0.ndim == 0:
+            c0 = c0.reshape(1, 1)
+        if c0.ndim != 2:
+            raise ModelError(f"Affine: the constant part must be a matrix, got shape {c0.shape}")
+        self.const = c0.astype(complex)
+        self.coefs = dict(coefs or {})
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.const.shape
+
+    def compile(self, layout: Layout, name: str = "matrix") -> LocalMap:
+        """The :class:`LocalMap` of this map on the problem's layout."""
+        if not np.all(np.isfinite(self.const)):
+            raise ModelError(f"{name}: the constant part holds NaN or inf")
+        r, c = self.const.shape
+        idxs, cols = [], []
+        for key, arr in self.coefs.items():
+            v = layout.variable(key)
+            a = np.asarray(arr, dtype=complex)
+            want = (r, c, *v.shape)
+            if a.shape != want and a.size == int(np.prod(want)):
+                a = a.reshape(want)
+            if a.shape != want:
+                raise ModelError(f"{name}: the coefficient of {v.name} has shape {a.shape}, expected {want}")
+            if not np.all(np.isfinite(a)):
+                raise ModelError(f"{name}: the coefficient of {v.name} holds NaN or inf")
+            a = a.reshape(r, c, -1)
+            sl = layout.slice(v)
+            if v.complex:
+                ne = a.shape[2]
+                idxs.append(np.arange(sl.start, sl.start + 2 * ne))
+                cols.append(np.concatenate([a, 1j * a], axis=2))
+            else:
+                idxs.append(np.arange(sl.start, sl.stop))
+                cols.append(a)
+        if not idxs:
+            return _clean(np.zeros(0, dtype=np.int64), np.zeros((r, c, 0)), self.const)
+        return _clean(np.concatenate(idxs), np.concatenate(cols, axis=2), self.const)
+
+
+def _sympy_matrix(value: Any, name: str) -> sp.Matrix:
+    if isinstance(value, sp.MatrixBase):
+        return sp.Matrix(value)
+    if isinstance(value, sp.Expr) or isinstance(value, (int, float, complex, str)):
+        return sp.Matrix([[sp.sympify(value)]])
+    try:
+        m = sp.Matrix(value)
+    except (TypeError, ValueError, sp.SympifyError) as exc:
+        raise ModelError(f"{name} cannot be read as a matrix: {exc}") from None
+    return m
+
+
+def compile_sympy(value: Any, layout: Layout, name: str) -> LocalMap:
+    """Compile a sympy matrix (or scalar) affine in the layout's symbols.
+
+    Raises
+    ------
+    NonAffineError
+        If an entry is not affine; the message names ``name`` and the entry.
+    ModelError
+        If an entry holds a symbol that is not a variable of the problem.
+    """
+    mat = _sympy_matrix(value, name)
+    rows, cols = mat.shape
+    index = layout.symbol_index
+    syms = set(index)
+    const = np.zeros((rows, cols), dtype=complex)
+    idx: list[int] = []
+    ent: list[tuple[int, int, complex]] = []
+    for i in range(rows):
+        for j in range(cols):
+            expr = sp.sympify(mat[i, j])
+            fs = expr.free_symbols
+            stray = fs - syms
+            if stray:
+                raise ModelError(f"{name}[{i}, {j}] = {expr} holds symbol(s) {', '.join(sorted(map(str, stray)))} "
+                                 f"that are not variables of the problem ({', '.join(layout.names) or 'none'})")
+            if not fs:
+                const[i, j] = complex(sp.N(expr))
+                continue
+            for term in sp.Add.make_args(sp.expand(expr)):
+                tfs = term.free_symbols
+                if not tfs:
+                    const[i, j] += complex(sp.N(term))
+                    continue
+                if len(tfs) == 1:
+                    s = next(iter(tfs))
+                    coef, dep = term.as_independent(s, as_Add=False)
+                    if dep == s:
+                        idx.append(index[s])
+                        ent.append((i, j, complex(sp.N(coef))))
+                        continue
+                raise NonAffineError(
+                    f"{name}, entry ({i}, {j}) = {expr} is not affine in the variables: the term {term} is "
+                    f"nonlinear in {', '.join(sorted(map(str, tfs)))}. SCR needs every matrix of a bilinear term, "
+                    f"equality and LMI to be affine; move products of variables into the A(x) P B(x) product",
+                    matrix=name, entry=(i, j), expression=str(expr), parameters=tuple(sorted(map(str, tfs))))
+    if not np.all(np.isfinite(const)):
+        raise ModelError(f"{name} has a constant entry that is NaN or inf")
+    coef = np.zeros((rows, cols, len(ent)), dtype=complex)
+    for u, (i, j, v) in enumerate(ent):
+        coef[i, j, u] = v
+    return _clean(np.asarray(idx, dtype=np.int64), coef, const)
+
+
+def as_map(value: Any, layout: Layout, name: str) -> LocalMap:
+    """Compile any accepted matrix input: :class:`Affine`, :class:`LocalMap`, array or sympy."""
+    if isinstance(value, LocalMap):
+        return value
+    if isinstance(value, Affine):
+        return value.compile(layout, name)
+    if isinstance(value, (sp.Basic, sp.MatrixBase, str)):
+        return compile_sympy(value, layout, name)
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        arr = np.asarray([], dtype=object)
+    if arr.dtype != object and arr.size:
+        if arr.ndim > 2:
+            raise ModelError(f"{name} must be a matrix, got an array of shape {arr.shape}")
+        a = arr.astype(complex).reshape((1, 1) if arr.ndim == 0 else ((-1, 1) if arr.ndim == 1 else arr.shape))
+        if not np.all(np.isfinite(a)):
+            raise ModelError(f"{name} holds NaN or inf")
+        return LocalMap(a, np.zeros(0, dtype=np.int64), np.zeros((*a.shape, 0), dtype=complex))
+    return compile_sympy(value, layout, name)

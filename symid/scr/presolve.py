@@ -1,0 +1,306 @@
+"""Presolve: keep bilinear only what is bilinear (scr-lessons 1 and 7), go real, normalise.
+
+1. For every bilinear term, rows of A(x) that are constant make the same rows of
+   A(x) P B(x) − C(x) affine, and so do constant columns of B(x): those rows and columns
+   become linear equalities and leave the nuclear-norm block.
+2. Variables that the linear equalities determine (e_k in the row space of D) are fixed
+   at their value and substituted everywhere; that can make more rows constant, so 1 and
+   2 repeat until nothing changes. A term with no row or column left disappears, and a
+   problem with no bilinear term left is convex and is solved exactly in one step.
+3. Equalities are reduced to linearly independent rows of unit norm.
+4. Complex terms go through the real representation (2-8), with half the weight, so that
+   λ weighs the nuclear norm of the complex matrix.
+5. Each remaining term is equilibrated without changing its solution set: P is divided
+   by its spectral norm (C with it), each row of the equation by the largest coefficient
+   of that row of A and C, each column by the largest coefficient of that column of B
+   and C. A weight λ therefore means the same in problems whose data have other units.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+from scipy.sparse.csgraph import connected_components
+
+from symid.scr.maps import LocalMap, _clean
+from symid.scr.problem import BilinearProblem, CompiledTerm
+
+__all__ = ["RealTerm", "Reduced", "presolve"]
+
+
+@dataclass(frozen=True, eq=False)
+class RealTerm:
+    """A real bilinear term on the free variables z, after presolve and scaling."""
+
+    A: LocalMap
+    P: np.ndarray
+    B: LocalMap
+    C: LocalMap
+    weight: float
+    source: int  # index of the user's term
+    complex_pair: bool  # built by the real representation (2-8)
+
+    @property
+    def dims(self) -> tuple[int, int, int, int]:
+        j, k = self.A.shape
+        l, m = self.B.shape
+        return j, k, l, m
+
+
+@dataclass(eq=False)
+class Reduced:
+    """The problem the back ends see: variables z = x[free], all data real."""
+
+    n: int
+    free: np.ndarray
+    xfix: np.ndarray
+    terms: list[RealTerm]
+    D: sps.csr_matrix
+    d: np.ndarray
+    lmis: list[LocalMap]
+    H: sps.csr_matrix
+    g: np.ndarray
+    c: float
+    inconsistent: float = 0.0  # residual of inconsistent equalities (0 when consistent)
+    info: dict = field(default_factory=dict)
+
+    @property
+    def nz(self) -> int:
+        return int(self.free.size)
+
+    def lift(self, z: np.ndarray) -> np.ndarray:
+        x = self.xfix.copy()
+        x[self.free] = z
+        return x
+
+    def objective(self, z: np.ndarray) -> float:
+        return float(z @ (self.H @ z) + self.g @ z + self.c)
+
+
+def _substitute(m: LocalMap, fixed: np.ndarray, xfix: np.ndarray) -> LocalMap:
+    if not m.idx.size:
+        return m
+    mask = fixed[m.idx]
+    if not mask.any():
+        return m
+    const = m.const + m.coef[:, :, mask] @ xfix[m.idx[mask]]
+    return LocalMap(const, m.idx[~mask], m.coef[:, :, ~mask])
+
+
+def _union(*maps: LocalMap) -> np.ndarray:
+    return np.unique(np.concatenate([m.idx for m in maps])).astype(np.int64)
+
+
+def _split_term(t: CompiledTerm) -> tuple[CompiledTerm | None, list[LocalMap]]:
+    """Move the affine rows/columns of A P B − C out of the term, as equalities."""
+    A, B, C, P = t.A, t.B, t.C, t.P
+    eqs: list[LocalMap] = []
+    crow = A.constant_rows()
+    if crow.any():
+        idx = _union(B, C)
+        A0P = A.const[crow] @ P
+        const = A0P @ B.const - C.const[crow]
+        coef = np.einsum("il,lmu->imu", A0P, B.on(idx)) - C.on(idx)[crow]
+        eqs.append(_clean(idx, coef, const))
+    keep = ~crow
+    if not keep.any():
+        return None, eqs
+    A, C = A.rows(keep), C.rows(keep)
+    ccol = B.constant_cols()
+    if ccol.any():
+        idx = _union(A, C)
+        PB0 = P @ B.const[:, ccol]
+        const = A.const @ PB0 - C.const[:, ccol]
+        coef = np.einsum("iku,kc->icu", A.on(idx), PB0) - C.on(idx)[:, ccol]
+        eqs.append(_clean(idx, coef, const))
+    keepc = ~ccol
+    if not keepc.any():
+        return None, eqs
+    B, C = B.cols(keepc), C.cols(keepc)
+    return CompiledTerm(t.name, A, P, B, C, t.weight), eqs
+
+
+def _rows(maps: list[LocalMap], n: int) -> tuple[sps.csr_matrix, np.ndarray]:
+    """Real rows D x = d of the equalities 'map(x) = 0' (complex entries give two rows)."""
+    ri, ci, vs, dd = [], [], [], []
+    r = 0
+    for m in maps:
+        nr = m.const.size
+        co = m.coef.reshape(nr, -1)
+        c0 = m.const.reshape(-1)
+        for part, keep in ((np.real, None), (np.imag, True)):
+            cp, c0p = part(co), part(c0)
+            if keep:
+                sel = np.flatnonzero(np.any(cp != 0, axis=1) | (c0p != 0))
+            else:
+                sel = np.arange(nr)
+            if not sel.size:
+                continue
+            rr, uu = np.nonzero(cp[sel])
+            ri.append(r + rr)
+            ci.append(m.idx[uu])
+            vs.append(cp[sel][rr, uu])
+            dd.append(-c0p[sel])
+            r += sel.size
+    if not dd:
+        return sps.csr_matrix((0, n)), np.zeros(0)
+    D = sps.csr_matrix((np.concatenate(vs), (np.concatenate(ri), np.concatenate(ci))), shape=(r, n))
+    return D, np.concatenate(dd)
+
+
+def _analyse(D: sps.csr_matrix, d: np.ndarray, active: np.ndarray):
+    """Independent rows, determined variables and their values, and inconsistency, per component."""
+    n = D.shape[1]
+    nrm = np.sqrt(np.asarray(D.multiply(D).sum(axis=1)).ravel())
+    empty = nrm == 0
+    bad = float(np.max(np.abs(d[empty]), initial=0.0))
+    D = sps.diags(np.where(empty, 0.0, 1.0 / np.where(empty, 1.0, nrm))) @ D
+    d = np.where(empty, 0.0, d / np.where(empty, 1.0, nrm))
+    rows_keep: list[int] = []
+    determined = np.zeros(n, dtype=bool)
+    values = np.zeros(n)
+    live = np.flatnonzero(~empty)
+    if live.size:
+        Dl = D[live].tocsc()
+        cols = np.flatnonzero(np.diff(Dl.indptr) > 0)
+        Dc = Dl[:, cols]
+        pat = abs(Dc).T @ abs(Dc)
+        ncomp, lab = connected_components(pat, directed=False)
+        row_lab = lab[np.asarray(abs(Dc).argmax(axis=1)).ravel()]
+        for comp in range(ncomp):
+            vc = np.flatnonzero(lab == comp)
+            rc = np.flatnonzero(row_lab == comp)
+            Dd = Dc[rc][:, vc].toarray()
+            dc = d[live[rc]]
+            Qm, R, piv = sla.qr(Dd.T, mode="economic", pivoting=True)
+            diag = np.abs(np.diag(R))
+            rank = int(np.sum(diag > 1e-10 * max(diag[0], 1e-300))) if diag.size else 0
+            rows_keep.extend(live[rc[piv[:rank]]].tolist())
+            xs = np.linalg.lstsq(Dd, dc, rcond=None)[0]
+            res = np.linalg.norm(Dd @ xs - dc)
+            if res > 1e-8 * (1 + np.linalg.norm(dc)):
+                bad = max(bad, float(res))
+            lev = np.sum(Qm[:, :rank] ** 2, axis=1)
+            det = lev > 1 - 1e-9
+            gv = cols[vc[det]]
+            determined[gv] = True
+            values[gv] = xs[det]
+    determined &= active
+    keep = np.sort(np.asarray(rows_keep, dtype=np.int64))
+    return D[keep], d[keep], determined, values, bad
+
+
+def _realrep(m: LocalMap) -> LocalMap:
+    X, Y = m.const.real, m.const.imag
+    const = np.block([[X, -Y], [Y, X]]).astype(complex)
+    cx, cy = m.coef.real, m.coef.imag
+    coef = np.concatenate([np.concatenate([cx, -cy], axis=1), np.concatenate([cy, cx], axis=1)], axis=0)
+    return LocalMap(const, m.idx, coef.astype(complex))
+
+
+def _realrep_p(P: np.ndarray) -> np.ndarray:
+    return np.block([[P.real, -P.imag], [P.imag, P.real]])
+
+
+def _reindex(m: LocalMap, pos: np.ndarray) -> LocalMap:
+    return LocalMap(m.const, pos[m.idx], m.coef)
+
+
+def _rowmax(m: LocalMap) -> np.ndarray:
+    return np.maximum(np.abs(m.const).max(axis=1), np.abs(m.coef).max(axis=(1, 2), initial=0.0))
+
+
+def _colmax(m: LocalMap) -> np.ndarray:
+    return np.maximum(np.abs(m.const).max(axis=0), np.abs(m.coef).max(axis=(0, 2), initial=0.0))
+
+
+def _scale(t: CompiledTerm) -> CompiledTerm:
+    pn = float(np.linalg.norm(t.P, 2))
+    P = t.P / pn
+    rs = np.maximum(_rowmax(t.A), _rowmax(t.C) / pn)
+    rs = np.where(rs > 0, 1.0 / np.where(rs > 0, rs, 1.0), 1.0)
+    A = LocalMap(t.A.const * rs[:, None], t.A.idx, t.A.coef * rs[:, None, None])
+    C = LocalMap(t.C.const * rs[:, None] / pn, t.C.idx, t.C.coef * rs[:, None, None] / pn)
+    cs = np.maximum(_colmax(t.B), _colmax(C))
+    cs = np.where(cs > 0, 1.0 / np.where(cs > 0, cs, 1.0), 1.0)
+    B = LocalMap(t.B.const * cs[None, :], t.B.idx, t.B.coef * cs[None, :, None])
+    C = LocalMap(C.const * cs[None, :], C.idx, C.coef * cs[None, :, None])
+    return CompiledTerm(t.name, A, P, B, C, t.weight)
+
+
+def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = True) -> Reduced:
+    """Reduce ``prob`` to the real problem on the free variables that the back ends solve.
+
+    Parameters
+    ----------
+    prob : BilinearProblem
+    split : bool, optional
+        Move affine rows/columns of the bilinear terms to linear equalities and eliminate
+        variables the equalities determine (default ``True``). ``False`` keeps every term
+        whole, as in the thesis, for experiments.
+    normalize : bool, optional
+        Equilibrate each bilinear term (default ``True``); see the module docstring.
+    """
+    n = prob.n
+    fixed = np.zeros(n, dtype=bool)
+    xfix = np.zeros(n)
+    terms: list[tuple[int, CompiledTerm]] = list(enumerate(prob.terms))
+    eqmaps = list(prob.equalities)
+    bad = 0.0
+    passes = 0
+    while True:
+        passes += 1
+        new_eq = 0
+        if split:
+            kept = []
+            for src, t in terms:
+                t = CompiledTerm(t.name, _substitute(t.A, fixed, xfix), t.P, _substitute(t.B, fixed, xfix),
+                                 _substitute(t.C, fixed, xfix), t.weight)
+                rest, eqs = _split_term(t)
+                eqmaps.extend(eqs)
+                new_eq += len(eqs)
+                if rest is not None:
+                    kept.append((src, rest))
+            terms = kept
+        D, d = _rows([_substitute(m, fixed, xfix) for m in eqmaps], n)
+        D, d, det, val, bad = _analyse(D, d, ~fixed)
+        if not split or (not det.any() and not new_eq) or passes > 20:
+            break
+        fixed |= det
+        xfix[det] = val[det]
+        eqmaps = [_substitute(m, fixed, xfix) for m in eqmaps]
+        eqmaps = [m for m in eqmaps if m.idx.size or np.any(m.const != 0)]
+    free = np.flatnonzero(~fixed)
+    pos = np.full(n, -1, dtype=np.int64)
+    pos[free] = np.arange(free.size)
+    real_terms = []
+    for src, t in terms:
+        t = CompiledTerm(t.name, _substitute(t.A, fixed, xfix), t.P, _substitute(t.B, fixed, xfix),
+                         _substitute(t.C, fixed, xfix), t.weight)
+        if normalize:
+            t = _scale(t)
+        cplx = bool(t.A.is_complex or t.B.is_complex or t.C.is_complex or np.any(t.P.imag != 0))
+        A, B, C, P, w = t.A, t.B, t.C, t.P, t.weight
+        if cplx:
+            A, B, C, P, w = _realrep(A), _realrep(B), _realrep(C), _realrep_p(P), w / 2
+        A, B, C = (LocalMap(m.const.real, pos[m.idx], m.coef.real) for m in (A, B, C))
+        real_terms.append(RealTerm(A, np.asarray(P.real, dtype=float), B, C, w, src, cplx))
+    lmis = []
+    for m in prob.lmis:
+        m = _substitute(m, fixed, xfix)
+        if m.is_complex:
+            m = _realrep(m)
+        s = max(float(np.abs(m.const).max()), float(np.abs(m.coef).max(initial=0.0)), 1e-300)
+        lmis.append(LocalMap(m.const.real / s, pos[m.idx], m.coef.real / s))
+    Dz = D[:, free] if D.shape[0] else sps.csr_matrix((0, free.size))
+    H = prob.H
+    Hx = H @ xfix
+    Hz = sps.csr_matrix(H[free][:, free])
+    gz = prob.g[free] + 2 * Hx[free]
+    c = prob.objective_value(xfix)
+    info = {"passes": passes, "fixed": int(fixed.sum()), "equalities": int(Dz.shape[0]),
+            "bilinear_terms": len(real_terms)}
+    return Reduced(n, free, xfix, real_terms, sps.csr_matrix(Dz), np.asarray(d), lmis, Hz, gz, c, bad, info)

@@ -1,0 +1,230 @@
+"""Algorithm 2.1 (Sequential Convex Relaxation) driving either back end."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from symid.errors import ModelError
+from symid.scr.backend_admm import ADMMBackend, ADMMOptions
+from symid.scr.blocks import TermGroup, group_lmis, group_terms
+from symid.scr.presolve import Reduced
+from symid.scr.presolve import presolve as _presolve
+from symid.scr.problem import BilinearProblem
+from symid.scr.result import Iteration, SCRSolution
+
+__all__ = ["solve"]
+
+_BACKENDS = ("admm", "cvxpy")
+_HEURISTICS = ("nuclear", "truncated")
+
+
+def _relaxation(red: Reduced, groups: list[TermGroup], built: list[tuple[np.ndarray, np.ndarray]],
+                W: list[np.ndarray] | None, z: np.ndarray) -> float:
+    val = red.objective(z)
+    for k, g in enumerate(groups):
+        m0, G = built[k]
+        M = m0 + np.einsum("spu,su->sp", G, g.gather(z)).reshape(m0.shape)
+        sv = np.linalg.svd(M, compute_uv=False)
+        val += float(g.weight @ sv.sum(axis=1))
+        if W is not None:
+            val -= float(g.weight @ np.einsum("sij,sij->s", W[k], M))
+    return val
+
+
+def _truncation(groups: list[TermGroup], ranks: list[np.ndarray], Q_old: list[np.ndarray],
+                R_old: list[np.ndarray], Q: list[np.ndarray], R: list[np.ndarray], z: np.ndarray) -> list[np.ndarray]:
+    """W_t = U V^T for the truncated nuclear norm (Hu et al. 2012).
+
+    U_r, V_r are the leading rank(P_t) singular vectors of the last sub-problem's optimal
+    M_t(x; Q_old, R_old) (Hu et al.'s X_l), carried to the new Q, R by the identity
+    M(x; Q', R') = [[I, Q'−Q], [0, I]] M(x; Q, R) [[I, 0], [R'−R, I]].
+    """
+    out = []
+    for k, g in enumerate(groups):
+        j, _, _, m = g.dims
+        m0, G = g.build(Q_old[k], R_old[k])
+        M = m0 + np.einsum("spu,su->sp", G, g.gather(z)).reshape(m0.shape)
+        U, _, Vt = np.linalg.svd(M, full_matrices=False)
+        r = int(ranks[k].max())
+        U, V = U[:, :, :r], Vt[:, :r, :].transpose(0, 2, 1)
+        U = U.copy()
+        U[:, :j] += (Q[k] - Q_old[k]) @ U[:, j:]
+        V = V.copy()
+        V[:, :m] += (R[k] - R_old[k]).transpose(0, 2, 1) @ V[:, m:]
+        U, _ = np.linalg.qr(U)
+        V, _ = np.linalg.qr(V)
+        out.append(U @ V.transpose(0, 2, 1))
+    return out
+
+
+def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend: str = "admm",
+          max_iter: int = 100, tol: float = 1e-6, step_tol: float | None = None, heuristic: str = "nuclear",
+          truncate_after: int = 0, presolve: bool = True, normalize: bool = True,
+          admm: ADMMOptions | None = None, solver_options: dict | None = None) -> SCRSolution:
+    """Solve a bilinear problem by Sequential Convex Relaxation (thesis Algorithm 2.1).
+
+    Every iteration minimises f(x) + Σ_t λ_t ||M_t(x; Q_t, R_t)||_* subject to the
+    linear equalities and LMIs, with M of (2-6), then sets Q_t := −A_t(x), R_t := −B_t(x).
+    Q, R start at −A(x0), −B(x0).
+
+    Parameters
+    ----------
+    prob : BilinearProblem
+    x0 : dict, optional
+        Starting values by variable name, sympy symbol or Variable; missing variables
+        start at 0. Unknown names and non-finite values raise :class:`ModelError`.
+    backend : {"admm", "cvxpy"}
+        ``"admm"``: numpy ADMM with singular value thresholding and PSD projection
+        (fast, inexact). ``"cvxpy"``: the SDP (2-9) with Clarabel, compiled once.
+    max_iter : int
+        Maximum number of SCR iterations.
+    tol : float
+        Stop when the largest bilinear residual of the normalised, presolved terms is
+        ≤ ``tol`` and the step ||x_k − x_{k−1}||_∞ is ≤ ``step_tol``.
+    step_tol : float, optional
+        Default ``max(10 * tol, 1e-8) * max(1, ||x||_∞)``.
+    heuristic : {"nuclear", "truncated"}
+        Rank surrogate. ``"truncated"`` is the truncated nuclear norm (Hu et al. 2012;
+        thesis §6-7-1): after ``truncate_after`` plain iterations (at least one), each
+        sub-problem minimises ||M||_* − <U_r V_rᵀ, M> with U_r, V_r the leading rank(P)
+        singular vectors of the previous sub-problem's optimal M, carried to the new Q, R.
+        Groups of terms share the largest rank(P) of the group.
+    truncate_after : int
+        Plain nuclear-norm iterations before the truncated ones start.
+    presolve : bool
+        Move the affine rows/columns of the bilinear terms to linear equalities and
+        eliminate variables they determine (default ``True``); see :mod:`symid.scr.presolve`.
+    normalize : bool
+        Equilibrate each term so one λ means the same across problems (default ``True``).
+    admm : ADMMOptions, optional
+        Options of the ADMM back end.
+    solver_options : dict, optional
+        Extra keyword arguments for ``cvxpy.Problem.solve`` (cvxpy back end).
+
+    Returns
+    -------
+    SCRSolution
+        ``success`` is ``True`` only when the stopping rule was met; a back-end failure
+        gives ``status="solver_error"`` and keeps the last good iterate.
+
+    Examples
+    --------
+    Rosenbrock, thesis Algorithm 2.3 with λ = 0.1 from (−1.9, 2):
+
+    >>> import sympy as sp
+    >>> from symid import scr
+    >>> x, y, a = sp.symbols("x y a")
+    >>> prob = scr.BilinearProblem(
+    ...     variables=[x, y, a],
+    ...     bilinear=[scr.Bilinear(A=[[x]], P=[[1]], B=[[x]], C=[[y - a]], weight=0.1)],
+    ...     objective=100 * a**2 + (1 - x)**2)
+    >>> sol = scr.solve(prob, x0={x: -1.9, y: 2}, backend="cvxpy", max_iter=6)
+    >>> round(sol.iterates[0]["x"], 3), round(sol.iterates[0]["y"], 3)
+    (0.9, -6.03)
+    >>> abs(sol.x["x"] - 1) < 1e-3 and abs(sol.x["y"] - 1) < 1e-3
+    True
+    """
+    t_start = time.perf_counter()
+    if not isinstance(prob, BilinearProblem):
+        raise ModelError(f"solve() needs a BilinearProblem, got {type(prob).__name__}")
+    if backend not in _BACKENDS:
+        raise ModelError(f"unknown backend {backend!r}; choose one of {_BACKENDS}")
+    if heuristic not in _HEURISTICS:
+        raise ModelError(f"unknown heuristic {heuristic!r}; choose one of {_HEURISTICS}")
+    if int(max_iter) < 1:
+        raise ModelError(f"max_iter must be ≥ 1, got {max_iter}")
+    if not (np.isfinite(tol) and tol > 0):
+        raise ModelError(f"tol must be finite and > 0, got {tol}")
+    lay = prob.layout
+    x_start = lay.pack(x0)
+    red = _presolve(prob, split=presolve, normalize=normalize)
+    t_pre = time.perf_counter() - t_start
+    info: dict[str, Any] = dict(red.info)
+    info["presolve_time"] = t_pre
+    if red.inconsistent > 1e-8:
+        return SCRSolution(lay.unpack(x_start), (), (), "infeasible", False,
+                           f"the linear equalities (given and split off the bilinear terms) are inconsistent: "
+                           f"residual {red.inconsistent:.3e}", 0, time.perf_counter() - t_start, backend,
+                           x_start, info)
+    groups = group_terms(red.terms)
+    lgroups = group_lmis(red.lmis)
+    info["groups"] = [dict(zip(("j", "k", "l", "m"), g.dims, strict=True)) | {"s": g.s, "u": g.idx.shape[1]}
+                      for g in groups]
+    z = x_start[red.free].copy()
+    t0 = time.perf_counter()
+    if backend == "admm":
+        be = ADMMBackend(red, groups, lgroups, admm or ADMMOptions())
+        info["rho"] = be.rho
+    else:
+        from symid.scr.backend_cvxpy import CvxpyBackend
+
+        be = CvxpyBackend(red, groups, lgroups, solver_options=solver_options)
+        info["is_dpp"] = bool(be.problem.is_dpp())
+    info["setup_time"] = time.perf_counter() - t0
+    Q = [-g.A(z) for g in groups]
+    R = [-g.B(z) for g in groups]
+    ranks = [np.linalg.matrix_rank(g.P) for g in groups]
+    Q_prev, R_prev = Q, R
+    x_prev = red.lift(z)
+    history: list[Iteration] = []
+    iterates: list[dict[str, Any]] = []
+    status, message = "max_iter", ""
+    last_res = np.inf
+    n_iter = max_iter if groups else 1
+    for k in range(n_iter):
+        t_it = time.perf_counter()
+        W = None
+        if heuristic == "truncated" and k >= max(truncate_after, 1) and groups:
+            W = _truncation(groups, ranks, Q_prev, R_prev, Q, R, z)
+        z_new, ok, msg, timing = be.step(Q, R, W, z)
+        if not ok:
+            status, message = "solver_error", msg
+            break
+        t_b = time.perf_counter()
+        built = [g.build(q, r) for g, q, r in zip(groups, Q, R, strict=True)]
+        relax = _relaxation(red, groups, built, W, z_new)
+        z = z_new
+        x = red.lift(z)
+        res_terms = tuple(float(v) for v in prob.residuals(x))
+        res = max((float(g.residual(z).max()) for g in groups), default=0.0)
+        step = float(np.max(np.abs(x - x_prev), initial=0.0))
+        Q_prev, R_prev = Q, R
+        Q = [-g.A(z) for g in groups]
+        R = [-g.B(z) for g in groups]
+        timing = dict(timing)
+        timing["bookkeeping"] = time.perf_counter() - t_b
+        history.append(Iteration(red.objective(z), relax, res_terms, res, step, time.perf_counter() - t_it, timing))
+        iterates.append(lay.unpack(x))
+        if msg:
+            message = msg
+        stol = (step_tol if step_tol is not None else max(10 * tol, 1e-8)) * max(1.0, float(np.abs(x).max(initial=0)))
+        if res <= tol and step <= stol:
+            status = "converged"
+            break
+        if not groups:
+            status = "converged"
+            break
+        if res >= 0.99 * last_res:
+            be.on_stall()
+        last_res = res
+        x_prev = x
+    if backend == "cvxpy":
+        info["compilations"] = be.compilations
+        info["compile_time"] = float(be.problem.compilation_time or 0.0)
+    else:
+        info["inner_iterations"] = list(be.iterations)
+    x_final = red.lift(z)
+    if status == "converged":
+        message = ("solved exactly: no bilinear term left after presolve" if not groups else
+                   f"bilinear residual {history[-1].residual:.3e} ≤ tol = {tol:g} after {len(history)} iterations")
+        if msg:
+            message += f" (last sub-problem: {msg})"
+    elif status == "max_iter":
+        message = (f"maximum number of iterations ({max_iter}) reached; bilinear residual "
+                   f"{history[-1].residual:.3e} > tol = {tol:g} or step {history[-1].step:.3e} too large")
+    return SCRSolution(lay.unpack(x_final), tuple(iterates), tuple(history), status, status == "converged", message,
+                       len(history), time.perf_counter() - t_start, backend, x_final, info)
