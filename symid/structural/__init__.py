@@ -1,0 +1,32 @@
+"""Structural identifiability of linear grey-box models (thesis §1-2, §6-6).
+
+``identifiability(model)`` answers, before any estimation, which parameters can be
+recovered from noise-free input-output data: per parameter "global", "local" or
+"none", the number of solutions, identifiable combinations and a reparameterisation.
+
+Modules: :mod:`~symid.structural.summary` (exhaustive summary),
+:mod:`~symid.structural.local` (exact Jacobian rank),
+:mod:`~symid.structural.global_` (Gröbner basis, solution count),
+:mod:`~symid.structural.combinations`, :mod:`~symid.structural.report`,
+:mod:`~symid.structural.deadline` (timeout without hangs).
+"""
+
+from symid.structural.analyse import (
+    DEFAULT_TIMEOUT,
+    check_local,
+    identifiability,
+    warn_if_not_identifiable,
+)
+from symid.structural.report import IdentifiabilityReport, NecessaryCondition
+from symid.structural.summary import ExhaustiveSummary, exhaustive_summary
+
+__all__ = [
+    "DEFAULT_TIMEOUT",
+    "ExhaustiveSummary",
+    "IdentifiabilityReport",
+    "NecessaryCondition",
+    "check_local",
+    "exhaustive_summary",
+    "identifiability",
+    "warn_if_not_identifiable",
+]

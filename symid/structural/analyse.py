@@ -1,0 +1,308 @@
+"""``identifiability(model)``: the full report, and the cheap local check used before estimation."""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Mapping
+
+import sympy as sp
+
+from symid.errors import IdentifiabilityWarning, ModelError
+from symid.structural.combinations import monomial_candidates, parameters_to_fix, select_combinations
+from symid.structural.deadline import run_with_deadline
+from symid.structural.global_ import GlobalResult, global_analysis
+from symid.structural.local import local_analysis
+from symid.structural.numeric import numeric_local_check
+from symid.structural.report import IdentifiabilityReport, NecessaryCondition
+from symid.structural.summary import free_parameters, model_kind, rational
+
+_EXACT_LIMIT = 400
+
+__all__ = ["DEFAULT_TIMEOUT", "check_local", "identifiability", "warn_if_not_identifiable"]
+
+DEFAULT_TIMEOUT = 30.0
+"""Default deadline (s) of the global step of :func:`identifiability`."""
+
+
+def _describe(model) -> str:
+    kind = type(model).__name__
+    name = f" {model.name!r}" if getattr(model, "name", None) else ""
+    return f"{kind}{name} ({model._shape_text()})"
+
+
+def _necessary(model, n_free: int, known: Mapping[str, object]) -> NecessaryCondition:
+    n, p, m = model.n_states, model.n_outputs, model.n_inputs
+    bound = n * (p + m)
+    if model_kind(model) == "state-space":
+        free = {q.name for q in free_parameters(model, known)}
+        if any(model.parameters[i].name in free for i in model.maps["D"].depends_on):
+            bound += p * m
+    elif model.output == "acceleration":
+        bound += p * m
+    return NecessaryCondition(n_free, n, m, p, bound, n_free <= bound)
+
+
+def _positive_flags(model, positive: bool | None, known) -> list[bool]:
+    free = free_parameters(model, known)
+    if positive is None:
+        return [bool(q.is_positive) for q in free]
+    return [bool(positive)] * len(free)
+
+
+def _complexity(expr: sp.Expr) -> tuple[int, int]:
+    terms = len(sp.Add.make_args(sp.expand(sp.numer(sp.together(expr)))))
+    return terms, sp.count_ops(expr)
+
+
+def identifiability(model, *, known: Mapping[str, float] | None = None, positive: bool | None = None,
+                    timeout: float | None = DEFAULT_TIMEOUT, seed: int = 0) -> IdentifiabilityReport:
+    """Structural identifiability of a model's parameters from its input-output map.
+
+    Local identifiability comes from the exact rank of the Jacobian of the Markov
+    parameters at two random rational points (cheap, always computed). Global
+    identifiability comes from solving summary(θ) = summary(θ*) exactly at a random
+    rational θ* with a Gröbner basis, where the summary is the normalised
+    transfer-function coefficients (Markov parameters for a non-minimal realisation).
+    One admissible solution → global; k > 1 → local (k reported); infinitely many →
+    not identifiable. For parameters that are not identifiable the report lists
+    identifiable combinations and a reparameterisation.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+        Parameters may appear in any matrix; any output kind.
+    known : dict of str to float, optional
+        Parameter values taken as known (substituted before anything else).
+    positive : bool, optional
+        Discard solutions with a non-positive value of a positive parameter. ``None``
+        (default) uses the declarations (``si.parameters(..., positive=True)``);
+        ``True`` treats every parameter as positive; ``False`` ignores positivity.
+        The report says when positivity changed a verdict.
+    timeout : float or None, optional
+        Deadline in seconds of the global step (default 30 s). When it passes, the
+        report carries the local verdicts and marks the global one undetermined;
+        ``None`` waits for ever.
+    seed : int, optional
+        Seed of the random rational points (the verdicts are generic; the seed only
+        matters on a measure-zero set).
+
+    Returns
+    -------
+    IdentifiabilityReport
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> a, b, c = si.parameters("a b c", positive=True)
+    >>> model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[c]])
+    >>> rep = si.identifiability(model)
+    >>> rep.verdict, rep.verdicts
+    ('none', {'a': 'global', 'b': 'none', 'c': 'none'})
+    >>> [c["expression"] for c in rep.combinations]
+    ['b*c']
+    """
+    t0 = time.perf_counter()
+    model_kind(model)
+    known = {str(k): float(v) for k, v in (known or {}).items()}
+    known_exact = {k: rational(v) for k, v in known.items()}
+    free = free_parameters(model, known)
+    names = tuple(q.name for q in free)
+    pos = _positive_flags(model, positive, known)
+    necessary = _necessary(model, len(free), known)
+    notes: list[str] = []
+
+    status_local, local = run_with_deadline(local_analysis, {"model": model, "known": known_exact, "seed": seed},
+                                            timeout)
+    t_local = time.perf_counter() - t0
+    if status_local != "ok":
+        return _numeric_report(model, names, known, necessary, pos, timeout, status_local, local, t0)
+    monos = monomial_candidates(local)
+
+    t1 = time.perf_counter()
+    status, glob = run_with_deadline(
+        global_analysis, {"model": model, "known": known_exact, "positive": pos, "seed": seed,
+                          "extra_candidates": monos}, timeout)
+    t_global = time.perf_counter() - t1
+    if status == "ok" and not isinstance(glob, GlobalResult):  # pragma: no cover - defensive
+        status, glob = "error", "unexpected result"
+    determined = status == "ok"
+    if status == "timeout":
+        global_status = f"undetermined (timeout after {timeout:g} s)"
+    elif status == "error":
+        global_status = f"undetermined (error: {str(glob).splitlines()[0]})"
+    else:
+        global_status = "determined"
+
+    loc = dict(zip(names, local.identifiable, strict=True))
+    full_rank = local.rank == len(free)
+    verdicts: dict[str, str] = {}
+    n_sol = n_real = n_complex = None
+    positivity_changed = False
+    solutions: tuple = ()
+    if not determined:
+        for nm in names:
+            verdicts[nm] = "local" if loc[nm] else "none"
+        verdict = "local" if full_rank else "none"
+        if status == "error":
+            notes.append(f"global step failed: {glob}")
+    else:
+        notes.extend(glob.notes)
+        n_sol, n_real, n_complex = glob.n_admissible, glob.n_real, glob.n_complex
+        solutions = glob.solutions
+        for nm in names:
+            if not loc[nm]:
+                verdicts[nm] = "none"
+            else:
+                verdicts[nm] = "global" if glob.global_admissible.get(nm, False) else "local"
+        if not full_rank:
+            verdict = "none"
+        elif not glob.zero_dimensional:
+            verdict = "local"
+            notes.append("the Jacobian has full rank but the solution set has a positive-dimensional part "
+                         "(non-generic points)")
+        else:
+            verdict = "global" if n_sol == 1 else "local"
+        if glob.zero_dimensional and full_rank:
+            real_verdict = "global" if n_real == 1 else "local"
+            real_params = {nm: ("global" if glob.global_real[nm] else "local") for nm in names if loc[nm]}
+            adm_params = {nm: verdicts[nm] for nm in names if loc[nm]}
+            if real_verdict != verdict or real_params != adm_params:
+                positivity_changed = True
+                pos_names = [nm for nm, f in zip(names, pos, strict=True) if f]
+                changed = [nm for nm in real_params if real_params[nm] != adm_params[nm]]
+                what = f"model verdict {real_verdict} → {verdict}" if real_verdict != verdict else \
+                    f"verdict of {', '.join(changed)} local → global"
+                notes.append(f"positivity ({', '.join(pos_names)} > 0) discarded {n_real - n_sol} of {n_real} real "
+                             f"solutions: {what}")
+            elif n_real is not None and n_sol is not None and n_real > n_sol:
+                notes.append(f"positivity discarded {n_real - n_sol} of {n_real} real solutions (verdict unchanged)")
+            if n_complex and n_real is not None and n_complex > n_real:
+                cplx_verdict = "global" if n_complex == 1 else "local"
+                msg = f"{n_complex - n_real} of {n_complex} complex solutions are not real and were discarded"
+                if cplx_verdict != real_verdict:
+                    msg += f" (over ℂ the verdict would be {cplx_verdict})"
+                notes.append(msg)
+            if verdict == "local":
+                notes.append("counts of real and positive solutions are at the random point θ*; elsewhere they "
+                             f"can differ (the complex count, {n_complex}, is generic)")
+
+    # -- combinations and reparameterisation -------------------------------------
+    combos, reparam, fix = [], {}, ()
+    if local.rank < len(free):
+        candidates = [(e, "scaling", (glob.membership[i] if determined else None)) for i, e in enumerate(monos)]
+        if determined:
+            gb = sorted(glob.candidates, key=_complexity)
+            candidates += [(e, "groebner", True) for e in gb]
+            sm = sorted(glob.summary_expressions, key=_complexity)
+            candidates += [(e, "summary", True) for e in sm]
+        chosen = select_combinations(local, candidates)
+        combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global} for c in chosen]
+        reparam = {f"phi{i + 1}": c["expression"] for i, c in enumerate(combos)}
+        fix_syms = parameters_to_fix(local)
+        fix = tuple(q.name for q in fix_syms)
+        if len(local.identifiable) - sum(local.identifiable) > 0 and \
+                sum(local.identifiable) + len(combos) < local.rank:
+            notes.append("the combinations found do not reach the Jacobian rank "
+                         f"({sum(local.identifiable) + len(combos)} of {local.rank}); the list is incomplete")
+        if fix:
+            check = local_analysis(model, {**known_exact, **{q: sp.Integer(1) for q in fix}}, seed=seed + 1)
+            if all(check.identifiable):
+                notes.append(f"with {', '.join(f'{q} = 1' for q in fix)} known, every other parameter is locally "
+                             "identifiable (checked)")
+    if not necessary.satisfied:
+        notes.append("the counting condition fails: the parameters cannot all be identifiable")
+    total = time.perf_counter() - t0
+    timing = {"local": round(t_local, 4), "global": round(t_global, 4), "total": round(total, 4)}
+    theta_star = {k: str(v) for k, v in glob.theta_star.items()} if determined else {}
+    return IdentifiabilityReport(
+        model=_describe(model), parameters=names, known=known, verdict=verdict, verdicts=verdicts,
+        locally_identifiable=loc, global_determined=determined, global_status=global_status,
+        n_solutions=n_sol, n_solutions_real=n_real, n_solutions_complex=n_complex,
+        jacobian_ranks=tuple(local.ranks),
+        summary_kind=glob.summary_kind if determined else None,
+        n_summary=len(glob.summary_labels) if determined else None,
+        necessary_condition=necessary, combinations=tuple(combos), reparameterisation=reparam, fix=fix,
+        positivity_changed=positivity_changed, notes=tuple(notes), theta_star=theta_star,
+        solutions=tuple(solutions), timing=timing)
+
+
+def _numeric_report(model, names, known, necessary, pos, timeout, status, err, t0) -> IdentifiabilityReport:
+    """Report from the floating-point Jacobian rank when the exact local step did not finish."""
+    sub = model
+    if known:
+        raise ModelError("the exact local step did not finish and the floating-point fallback does not take "
+                         f"known= values; raise timeout= (now {timeout} s)")
+    num = numeric_local_check(sub)
+    bad = set(num.not_identifiable)
+    verdicts = {nm: ("none" if nm in bad else "local") for nm in names}
+    why = (f"the exact local step exceeded the timeout ({timeout:g} s)" if status == "timeout"
+           else f"the exact local step failed ({str(err).splitlines()[0]})")
+    notes = (f"{why}: local verdicts come from the floating-point rank of the frequency-response Jacobian "
+             f"(rank {num.rank} of {num.n_parameters}), a screen rather than a proof",)
+    if not necessary.satisfied:
+        notes += ("the counting condition fails: the parameters cannot all be identifiable",)
+    total = time.perf_counter() - t0
+    return IdentifiabilityReport(
+        model=_describe(model), parameters=names, known=known, verdict="local" if not bad else "none",
+        verdicts=verdicts, locally_identifiable={nm: nm not in bad for nm in names}, global_determined=False,
+        global_status=f"undetermined ({why})", n_solutions=None, n_solutions_real=None, n_solutions_complex=None,
+        jacobian_ranks=(num.rank,), summary_kind=None, n_summary=None, necessary_condition=necessary,
+        combinations=(), reparameterisation={}, fix=(), positivity_changed=False, notes=notes, theta_star={},
+        solutions=(), timing={"local": round(total, 4), "global": 0.0, "total": round(total, 4)})
+
+
+def check_local(model, known: Mapping[str, float] | None = None, *, seed: int = 0) -> tuple[str, ...]:
+    """Names of the parameters that are not locally identifiable (cheap; no Gröbner basis).
+
+    Exact (rational Jacobian rank) for models with at most ``_EXACT_LIMIT`` = 400
+    parameters × states; above that, and without ``known`` values, the floating-point
+    rank of :func:`symid.structural.numeric.numeric_local_check` (a 108-parameter
+    truss takes minutes exactly and a fraction of a second in floating point).
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> a, b, c = si.parameters("a b c")
+    >>> from symid.structural import check_local
+    >>> check_local(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[c]]))
+    ('b', 'c')
+    """
+    if not known and model.n_parameters * model.n_states > _EXACT_LIMIT:
+        return numeric_local_check(model, seed=seed).not_identifiable
+    known_exact = {str(k): rational(v) for k, v in (known or {}).items()}
+    local = local_analysis(model, known_exact, seed=seed)
+    return tuple(q.name for q, ok in zip(local.parameters, local.identifiable, strict=True) if not ok)
+
+
+def warn_if_not_identifiable(model, known: Mapping[str, float] | None = None, *, stacklevel: int = 2
+                             ) -> tuple[str, ...]:
+    """Emit an :class:`~symid.IdentifiabilityWarning` naming the parameters that are not locally identifiable.
+
+    Called by estimators before they start. Returns the names (empty when all are
+    locally identifiable). A model the local test cannot handle is let through silently.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import symid as si
+    >>> from symid.structural import warn_if_not_identifiable
+    >>> a, b, c = si.parameters("a b c")
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter("always")
+    ...     warn_if_not_identifiable(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[c]]))
+    ('b', 'c')
+    >>> w[0].category.__name__
+    'IdentifiabilityWarning'
+    """
+    try:
+        bad = check_local(model, known)
+    except ModelError:
+        return ()
+    if bad:
+        warnings.warn(
+            f"parameter(s) {', '.join(bad)} are not locally identifiable from the input-output map: infinitely "
+            "many values fit the data equally well. Fix some of them (known values) or reparameterise; "
+            "si.identifiability(model) lists the identifiable combinations.",
+            IdentifiabilityWarning, stacklevel=stacklevel + 1)
+    return bad

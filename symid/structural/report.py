@@ -1,0 +1,201 @@
+"""The identifiability report: per-parameter verdicts, solution count, combinations, timing."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+__all__ = ["IdentifiabilityReport", "NecessaryCondition"]
+
+_VERDICT_TEXT = {
+    "global": "GLOBALLY IDENTIFIABLE",
+    "local": "LOCALLY IDENTIFIABLE (finitely many solutions)",
+    "none": "NOT IDENTIFIABLE",
+}
+
+
+@dataclass(frozen=True)
+class NecessaryCondition:
+    """The counting condition of thesis §1-2: at most n(p + m) free parameters.
+
+    The thesis states "fewer than n(p + m)"; the e-nose model (6-19) has exactly
+    n(p + m) = 6 parameters and is identifiable, so the bound that holds is
+    ``n_parameters ≤ n(p + m)`` (plus p·m when D carries parameters): an order-n
+    input-output map has n(p + m) (+ p·m) free coordinates.
+    """
+
+    n_parameters: int
+    n_states: int
+    n_inputs: int
+    n_outputs: int
+    bound: int
+    satisfied: bool
+
+    def __str__(self) -> str:
+        sign = "≤" if self.satisfied else ">"
+        mark = "satisfied" if self.satisfied else "VIOLATED: cannot be identifiable"
+        return (f"{self.n_parameters} free parameters {sign} n(p+m) = {self.n_states}·({self.n_outputs}+"
+                f"{self.n_inputs}) = {self.bound}: {mark}")
+
+
+@dataclass(frozen=True)
+class IdentifiabilityReport:
+    """Structural identifiability of a model's parameters from its input-output map.
+
+    Attributes
+    ----------
+    model : str
+        Short description of the model.
+    parameters : tuple of str
+        The free (unknown) parameters examined, in θ order.
+    known : dict of str to float
+        Parameters fixed by ``known=``.
+    verdict : str
+        Model verdict: ``"global"``, ``"local"`` or ``"none"``.
+    verdicts : dict of str to str
+        Per free parameter: ``"global"``, ``"local"`` or ``"none"``. When the global
+        step did not finish, locally identifiable parameters read ``"local"`` and
+        ``global_determined`` is False.
+    locally_identifiable : dict of str to bool
+        Per free parameter, from the Jacobian's null space.
+    global_determined : bool
+        Whether the global (Gröbner) step finished.
+    global_status : str
+        ``"determined"`` or ``"undetermined (...)"`` with the reason (timeout, error).
+    n_solutions : int or None
+        Admissible solutions of summary(θ) = summary(θ*) (real, positive where declared);
+        None when infinitely many or undetermined.
+    n_solutions_real, n_solutions_complex : int or None
+        Distinct real / complex solutions.
+    jacobian_ranks : tuple of int
+        Exact Jacobian rank at each random rational point (out of ``len(parameters)``).
+    summary_kind : str or None
+        The exhaustive summary used by the global step.
+    n_summary : int or None
+        Number of non-constant summary entries.
+    necessary_condition : NecessaryCondition
+    combinations : tuple of dict
+        Identifiable combinations (``expression``, ``source``, ``global``), for a model
+        with non-identifiable parameters.
+    reparameterisation : dict of str to str
+        Suggested new parameters (``phi1 = b*c``, ...).
+    fix : tuple of str
+        Parameters whose values, once known, make the others locally identifiable.
+    positivity_changed : bool
+        Discarding non-positive solutions changed a verdict.
+    notes : tuple of str
+        Everything worth knowing (positivity, realness, summary choice, limits).
+    theta_star : dict of str to str
+        The random rational point of the global step.
+    solutions : tuple of dict
+        The admissible solutions (floats), when finitely many.
+    timing : dict of str to float
+        Wall time (s) of ``local``, ``global`` and ``total``.
+    """
+
+    model: str
+    parameters: tuple[str, ...]
+    known: dict[str, float]
+    verdict: str
+    verdicts: dict[str, str]
+    locally_identifiable: dict[str, bool]
+    global_determined: bool
+    global_status: str
+    n_solutions: int | None
+    n_solutions_real: int | None
+    n_solutions_complex: int | None
+    jacobian_ranks: tuple[int, ...]
+    summary_kind: str | None
+    n_summary: int | None
+    necessary_condition: NecessaryCondition
+    combinations: tuple[dict[str, Any], ...] = ()
+    reparameterisation: dict[str, str] = field(default_factory=dict)
+    fix: tuple[str, ...] = ()
+    positivity_changed: bool = False
+    notes: tuple[str, ...] = ()
+    theta_star: dict[str, str] = field(default_factory=dict)
+    solutions: tuple[dict[str, float], ...] = ()
+    timing: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def identifiable(self) -> tuple[str, ...]:
+        """Parameters that are locally identifiable."""
+        return tuple(p for p in self.parameters if self.locally_identifiable[p])
+
+    @property
+    def non_identifiable(self) -> tuple[str, ...]:
+        """Parameters that are not locally identifiable."""
+        return tuple(p for p in self.parameters if not self.locally_identifiable[p])
+
+    def summary(self) -> str:
+        """The report as a readable table."""
+        L = []
+        L.append(f"Structural identifiability: {self.model}")
+        L.append("=" * min(max(len(L[0]), 40), 100))
+        verdict = _VERDICT_TEXT[self.verdict]
+        if self.verdict == "local" and self.n_solutions is not None:
+            verdict = f"LOCALLY IDENTIFIABLE ({self.n_solutions} solutions)"
+        if not self.global_determined and self.verdict == "local":
+            verdict = "LOCALLY IDENTIFIABLE (global verdict undetermined)"
+        L.append(f"verdict            : {verdict}")
+        if self.known:
+            L.append("known              : " + ", ".join(f"{k} = {v:g}" for k, v in self.known.items()))
+        L.append(f"necessary condition: {self.necessary_condition}")
+        npar = len(self.parameters)
+        ranks = ", ".join(f"{r}/{npar}" for r in self.jacobian_ranks)
+        if any("floating-point rank" in note for note in self.notes):
+            L.append(f"local  (float)     : Jacobian rank {ranks} of the frequency response at a random point")
+        else:
+            L.append(f"local  (exact)     : Jacobian rank {ranks} at {len(self.jacobian_ranks)} random rational "
+                     "points")
+        if self.global_determined:
+            if self.n_solutions_complex is None:
+                sol = "infinitely many (positive-dimensional solution set)"
+            else:
+                sol = (f"{self.n_solutions} admissible of {self.n_solutions_real} real, "
+                       f"{self.n_solutions_complex} complex")
+            L.append(f"global (Gröbner)   : summary(θ) = summary(θ*): {sol}")
+            L.append(f"summary            : {self.n_summary} {self.summary_kind}")
+        else:
+            L.append(f"global (Gröbner)   : {self.global_status}")
+        L.append("")
+        width = max([9, *(len(p) for p in self.parameters)])
+        L.append(f"  {'parameter':<{width}}  verdict")
+        L.append(f"  {'-' * width}  -------")
+        for p in self.parameters:
+            v = self.verdicts[p]
+            if v == "local" and not self.global_determined:
+                v = "local (global undetermined)"
+            L.append(f"  {p:<{width}}  {v}")
+        if self.combinations:
+            L.append("")
+            L.append("identifiable combinations:")
+            for c in self.combinations:
+                g = {True: "global", False: "local", None: "local"}[c["global"]]
+                L.append(f"  {c['expression']}   [{g}; from {c['source']}]")
+        if self.reparameterisation or self.fix:
+            L.append("")
+            L.append("suggested reparameterisation:")
+            for k, v in self.reparameterisation.items():
+                L.append(f"  {k} = {v}")
+            if self.fix:
+                fixes = ", ".join(f"'{p}': ..." for p in self.fix)
+                L.append(f"  or fix {', '.join(self.fix)} (known={{{fixes}}}): the rest become locally identifiable")
+        if self.notes:
+            L.append("")
+            L.append("notes:")
+            for n in self.notes:
+                L.append(f"  - {n}")
+        if self.timing:
+            L.append("")
+            L.append("time: " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timing.items()))
+        return "\n".join(L)
+
+    def __str__(self) -> str:
+        return self.summary()
+
+    def to_dict(self) -> dict[str, Any]:
+        """The report as plain data (JSON-serialisable)."""
+        out = asdict(self)
+        out["necessary_condition"] = asdict(self.necessary_condition)
+        return out

@@ -1,0 +1,403 @@
+"""Exhaustive summaries of the input-output map of a linear model, computed exactly.
+
+An *exhaustive summary* is a finite list of functions of θ that determines the
+input-output map: two parameter vectors give the same transfer function if and only
+if they give the same summary. Identifiability is then a property of the polynomial
+map θ ↦ summary(θ) (thesis §1-2, Definition 1.1).
+
+Two summaries are used:
+
+* **Transfer-function coefficients** (the default). ``H(s) = N(s) / d(s)`` with
+  ``d(s) = det(sI − A)`` for a state-space model and ``d(s) = det(s²M + sV + K)``
+  for a second-order model, and each numerator entry from the adjugate identity
+  ``c adj(P) b = det(P + b c) − det(P)`` (one determinant per input-output pair).
+  The coefficients are normalised by the leading coefficient of ``d`` (``1`` for a
+  state-space model, ``det M(θ)`` for a second-order model). They are an exhaustive
+  summary when the realisation is minimal at the point where identifiability is
+  examined, which is checked exactly (controllability and observability ranks).
+* **Markov parameters** ``C Aᵏ B`` (k < 2n) plus ``D``, used when the realisation is
+  not minimal. By Cayley-Hamilton the first 2n determine all of them, so they are an
+  exhaustive summary without any minimality assumption (but of higher degree).
+
+Every entry is kept as a pair of polynomials (numerator, denominator) over ℚ in the
+free parameters, computed with sympy's sparse polynomial rings and ``DomainMatrix``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+
+import sympy as sp
+from sympy import QQ
+from sympy.polys.matrices import DomainMatrix
+from sympy.polys.orderings import grevlex
+from sympy.polys.rings import PolyElement, PolyRing, ring
+
+from symid.errors import ModelError
+
+__all__ = ["ExhaustiveSummary", "exhaustive_summary", "free_parameters", "model_matrices", "rational"]
+
+KIND_TF = "transfer-function coefficients"
+KIND_MARKOV = "Markov parameters"
+
+
+def rational(value: object) -> sp.Rational:
+    """An exact rational from a number: floats through their shortest decimal (0.15 → 3/20)."""
+    if isinstance(value, sp.Rational):
+        return value
+    if isinstance(value, (int, Fraction)):
+        return sp.Rational(value)
+    if isinstance(value, sp.Float):
+        return sp.Rational(repr(float(value)))
+    if isinstance(value, float):
+        return sp.Rational(repr(value))
+    out = sp.sympify(value)
+    if out.is_Rational:
+        return out
+    if out.is_Float:
+        return sp.Rational(repr(float(out)))
+    raise ModelError(f"expected a real number, got {value!r}")
+
+
+def _rationalise(expr: sp.Expr) -> sp.Expr:
+    floats = expr.atoms(sp.Float)
+    if not floats:
+        return expr
+    return expr.xreplace({f: rational(f) for f in floats})
+
+
+def free_parameters(model, known: Mapping[str, object] | None) -> tuple[sp.Symbol, ...]:
+    """The parameters of ``model`` not fixed by ``known``, in θ order."""
+    known = dict(known or {})
+    unknown = sorted(set(known) - set(model.parameter_names))
+    if unknown:
+        raise ModelError(f"known= names unknown parameter(s) {', '.join(unknown)}; "
+                         f"the model's parameters are {', '.join(model.parameter_names)}")
+    return tuple(p for p in model.parameters if p.name not in known)
+
+
+def model_matrices(model, known: Mapping[str, object] | None) -> dict[str, sp.Matrix]:
+    """The model's symbolic matrices with known values substituted and floats made rational."""
+    known = dict(known or {})
+    subs = {p: rational(known[p.name]) for p in model.parameters if p.name in known}
+    out = {}
+    for name, mat in model.symbolic.items():
+        mat = mat.xreplace(subs) if subs else mat
+        out[name] = mat.applyfunc(_rationalise)
+    return out
+
+
+def model_kind(model) -> str:
+    """``"state-space"`` or ``"second-order"``; raises for anything else."""
+    if hasattr(model, "n_dof") and hasattr(model, "output"):
+        return "second-order"
+    if hasattr(model, "symbolic_state_space") and "A" in model.symbolic:
+        return "state-space"
+    raise ModelError(f"identifiability needs a StateSpaceModel or SecondOrderModel; got {type(model).__name__}")
+
+
+@dataclass(frozen=True, eq=False)
+class ExhaustiveSummary:
+    """An exhaustive summary: entries ``numerators[i] / denominators[i]``, polynomials over ℚ.
+
+    Attributes
+    ----------
+    kind : str
+        ``"transfer-function coefficients"`` or ``"Markov parameters"``.
+    ring : sympy.polys.rings.PolyRing
+        The polynomial ring ℚ[θ] (free parameters only, grevlex order).
+    parameters : tuple of sympy.Symbol
+        The free parameters, generators of ``ring``.
+    numerators, denominators : tuple of PolyElement
+        Entry i is ``numerators[i] / denominators[i]``; only non-constant entries are kept.
+    labels : tuple of str
+        What each entry is (``"d s^1"``, ``"N[0,0] s^2"``, ``"h2[0,0]"``, ...).
+    minimal : bool
+        Whether the realisation was found minimal at the check point (the
+        transfer-function summary is used only then).
+    n_constant : int
+        Number of entries dropped because they do not depend on θ.
+    normaliser : PolyElement or None
+        For the transfer-function summary, the common normalising polynomial (leading
+        coefficient of the denominator, ``det M`` for a second-order model): every
+        denominator divides it. None for Markov parameters.
+    """
+
+    kind: str
+    ring: PolyRing
+    parameters: tuple[sp.Symbol, ...]
+    numerators: tuple[PolyElement, ...]
+    denominators: tuple[PolyElement, ...]
+    labels: tuple[str, ...]
+    minimal: bool
+    n_constant: int
+    normaliser: PolyElement | None = None
+
+    def __len__(self) -> int:
+        return len(self.numerators)
+
+    def expressions(self) -> list[sp.Expr]:
+        """The entries as sympy expressions (rational functions of θ)."""
+        out = []
+        for num, den in zip(self.numerators, self.denominators, strict=True):
+            out.append(sp.cancel(num.as_expr() / den.as_expr()))
+        return out
+
+    def __repr__(self) -> str:
+        return f"<ExhaustiveSummary: {len(self)} {self.kind} in {', '.join(p.name for p in self.parameters)}>"
+
+
+def _poly_matrix(mat: sp.Matrix, R: PolyRing) -> DomainMatrix:
+    dom = R.to_domain()
+    try:
+        rows = [[dom.from_sympy(e) for e in mat.row(i)] for i in range(mat.rows)]
+    except (sp.CoercionFailed, sp.PolificationFailed) as exc:  # pragma: no cover - affine maps forbid this
+        raise ModelError(f"matrix entry is not polynomial in the parameters: {exc}") from None
+    return DomainMatrix(rows, mat.shape, dom)
+
+
+def first_order_polynomial(mats: dict[str, sp.Matrix], kind: str, output: str | None, R: PolyRing
+                           ) -> tuple[DomainMatrix, DomainMatrix, DomainMatrix, DomainMatrix, PolyElement]:
+    """Polynomial first-order form: ``A = Ã/d, B = B̃/d, C = C̃/d, D = D̃/d`` over ``R``.
+
+    For a state-space model ``d = 1``; for a second-order model ``d = det M`` and
+    ``M⁻¹ = adj(M)/d`` (thesis (7-2)).
+    """
+    dom = R.to_domain()
+    if kind == "state-space":
+        A, B, C, D = (_poly_matrix(mats[k], R) for k in "ABCD")
+        return A, B, C, D, R.one
+    M, V, K, B, C = (_poly_matrix(mats[k], R) for k in "MVKBC")
+    n = M.shape[0]
+    d = M.det()
+    if d == R.zero:
+        raise ModelError("det M(θ) is identically zero; the second-order model is degenerate")
+    adjM = M.adjugate()
+    Z = DomainMatrix.zeros((n, n), dom)
+    dI = DomainMatrix.eye(n, dom) * d
+    top = Z.hstack(dI)
+    bot = (-(adjM * K)).hstack(-(adjM * V))
+    At = top.vstack(bot)
+    Bt = DomainMatrix.zeros(B.shape, dom).vstack(adjM * B)
+    p, m = C.shape[0], B.shape[1]
+    if output == "position":
+        Ct = (C * d).hstack(DomainMatrix.zeros(C.shape, dom))
+        Dt = DomainMatrix.zeros((p, m), dom)
+    elif output == "velocity":
+        Ct = DomainMatrix.zeros(C.shape, dom).hstack(C * d)
+        Dt = DomainMatrix.zeros((p, m), dom)
+    else:
+        Ct = (-(C * adjM * K)).hstack(-(C * adjM * V))
+        Dt = C * adjM * B
+    return At, Bt, Ct, Dt, d
+
+
+def is_minimal_at(mats: dict[str, sp.Matrix], kind: str, output: str | None, params: Sequence[sp.Symbol],
+                  point: Sequence[object]) -> bool:
+    """Exact minimality (controllability and observability) of the first-order form at a rational point."""
+    subs = {p: sp.Rational(v) for p, v in zip(params, point, strict=True)}
+    if kind == "state-space":
+        A, B, C = (mats[k].xreplace(subs) for k in "ABC")
+    else:
+        M, V, K, B0, C0 = (mats[k].xreplace(subs) for k in "MVKBC")
+        n = M.rows
+        if M.det() == 0:
+            return False
+        Mi = M.inv()
+        A = sp.Matrix(sp.BlockMatrix([[sp.zeros(n), sp.eye(n)], [-Mi * K, -Mi * V]]))
+        B = sp.Matrix.vstack(sp.zeros(*B0.shape), Mi * B0)
+        if output == "position":
+            C = sp.Matrix.hstack(C0, sp.zeros(*C0.shape))
+        elif output == "velocity":
+            C = sp.Matrix.hstack(sp.zeros(*C0.shape), C0)
+        else:
+            C = sp.Matrix.hstack(-C0 * Mi * K, -C0 * Mi * V)
+    n = A.rows
+    Ad = DomainMatrix.from_Matrix(A).convert_to(QQ)
+    Bd = DomainMatrix.from_Matrix(B).convert_to(QQ)
+    Cd = DomainMatrix.from_Matrix(C).convert_to(QQ)
+    blocks, X = [], Bd
+    for _ in range(n):
+        blocks.append(X)
+        X = Ad * X
+    if DomainMatrix.hstack(*blocks).rank() < n:
+        return False
+    blocks, Y = [], Cd
+    for _ in range(n):
+        blocks.append(Y)
+        Y = Y * Ad
+    return DomainMatrix.vstack(*blocks).rank() == n
+
+
+def _coeffs_in_s(p: PolyElement, s_index: int, degree: int) -> list[PolyElement]:
+    """Coefficients of s⁰..s^degree of a polynomial of QQ[θ, s], as polynomials of the same ring."""
+    out = [p.ring.zero for _ in range(degree + 1)]
+    for monom, coeff in p.terms():
+        k = monom[s_index]
+        rest = (*monom[:s_index], 0, *monom[s_index + 1:])
+        out[k] += p.ring({rest: coeff})
+    return out
+
+
+def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
+                       check_point: Sequence[object] | None = None, kind: str | None = None
+                       ) -> ExhaustiveSummary:
+    """Compute an exhaustive summary of the input-output map of ``model``, exactly.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+        The symbolic model.
+    known : dict, optional
+        Parameter values substituted before anything else.
+    check_point : sequence of numbers, optional
+        Rational point (one value per free parameter) at which minimality is checked;
+        the transfer-function summary is used when the realisation is minimal there.
+        Default: a fixed pseudo-random point.
+    kind : {"transfer-function coefficients", "Markov parameters"}, optional
+        Force one summary.
+
+    Returns
+    -------
+    ExhaustiveSummary
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.summary import exhaustive_summary
+    >>> a, b = si.parameters("a b")
+    >>> model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])
+    >>> summ = exhaustive_summary(model)
+    >>> summ.kind, summ.expressions()
+    ('transfer-function coefficients', [a, b])
+    """
+    mkind = model_kind(model)
+    output = getattr(model, "output", None)
+    mats = model_matrices(model, known)
+    params = free_parameters(model, known)
+    names = list(params)
+    R = ring(names, QQ, grevlex)[0] if names else ring([sp.Dummy("_none")], QQ, grevlex)[0]
+    if check_point is None:
+        check_point = [sp.Rational(3 + 2 * i, 1 + (i % 3)) for i in range(len(params))]
+    minimal = is_minimal_at(mats, mkind, output, params, check_point)
+    if kind is None:
+        kind = KIND_TF if minimal else KIND_MARKOV
+    normaliser = None
+    if kind == KIND_TF:
+        nums, dens, labels = _tf_summary(mats, mkind, output, params)
+        if dens:
+            normaliser = _to_ring(dens[0], R, names)
+    elif kind == KIND_MARKOV:
+        nums, dens, labels = _markov_summary(mats, mkind, output, params)
+    else:
+        raise ModelError(f"unknown summary kind {kind!r}")
+    # Move every entry into ℚ[θ] and drop the constant ones.
+    keep_n, keep_d, keep_l, n_const = [], [], [], 0
+    for num, den, lab in zip(nums, dens, labels, strict=True):
+        num_r, den_r = _to_ring(num, R, names), _to_ring(den, R, names)
+        g = num_r.gcd(den_r)
+        if g != R.one:
+            num_r, den_r = num_r.exquo(g), den_r.exquo(g)
+        if num_r.is_ground and den_r.is_ground:
+            n_const += 1
+            continue
+        lc = den_r.LC
+        keep_n.append(num_r.quo_ground(lc))
+        keep_d.append(den_r.quo_ground(lc))
+        keep_l.append(lab)
+    if normaliser is not None:
+        normaliser = normaliser.quo_ground(normaliser.LC)
+    return ExhaustiveSummary(kind, R, tuple(params), tuple(keep_n), tuple(keep_d), tuple(keep_l), minimal, n_const,
+                             normaliser)
+
+
+def _to_ring(p: PolyElement, R: PolyRing, names: list[sp.Symbol]) -> PolyElement:
+    if p.ring == R:
+        return p
+    idx = [p.ring.symbols.index(x) for x in names]
+    out = R.zero
+    for monom, coeff in p.terms():
+        if any(monom[i] for i in range(len(monom)) if i not in idx):
+            raise ModelError("internal error: summary entry still depends on s")  # pragma: no cover
+        out += R({tuple(monom[i] for i in idx): coeff})
+    return out
+
+
+def _tf_summary(mats, mkind, output, params):
+    s = sp.Dummy("s")
+    Rs = ring([*params, s], QQ, grevlex)[0]
+    si = len(params)
+    entries_n, entries_d, labels = [], [], []
+    if mkind == "state-space":
+        A, B, C, D = (_poly_matrix(mats[k], Rs) for k in "ABCD")
+        n = A.shape[0]
+        den = A.charpoly()  # [1, c1, ..., cn] of det(sI − A)
+        lead = Rs.one
+        dcoef = list(reversed(den))  # s^0 .. s^n
+        nums = {}
+        Bl, Cl, Dl = B.to_list(), C.to_list(), D.to_list()
+        for i in range(C.shape[0]):
+            for j in range(B.shape[1]):
+                bc = DomainMatrix([[Bl[r][j] * Cl[i][c] for c in range(n)] for r in range(n)], (n, n), A.domain)
+                cp = (A - bc).charpoly()
+                coeffs = [x - y for x, y in zip(reversed(cp), dcoef, strict=True)]  # s^0..s^n, s^n is 0
+                coeffs = [x + Dl[i][j] * y for x, y in zip(coeffs, dcoef, strict=True)]
+                nums[i, j] = coeffs
+        degree = n
+    else:
+        M, V, K, B, C = (_poly_matrix(mats[k], Rs) for k in "MVKBC")
+        n = M.shape[0]
+        sv = Rs.gens[si]
+        P = M * (sv * sv) + V * sv + K
+        detP = P.det()
+        dcoef = _coeffs_in_s(detP, si, 2 * n)
+        lead = dcoef[2 * n]
+        if lead == Rs.zero:
+            raise ModelError("det M(θ) is identically zero; the second-order model is degenerate")
+        shift = {"position": 0, "velocity": 1, "acceleration": 2}[output]
+        nums = {}
+        Bl, Cl = B.to_list(), C.to_list()
+        for i in range(C.shape[0]):
+            for j in range(B.shape[1]):
+                bc = DomainMatrix([[Bl[r][j] * Cl[i][c] for c in range(n)] for r in range(n)], (n, n), P.domain)
+                num = ((P + bc).det() - detP) * sv**shift
+                nums[i, j] = _coeffs_in_s(num, si, 2 * n + shift)
+        degree = 2 * n
+    for k in range(degree):
+        entries_n.append(dcoef[k])
+        entries_d.append(lead)
+        labels.append(f"d s^{k}")
+    for (i, j), coeffs in nums.items():
+        for k, c in enumerate(coeffs):
+            if c == Rs.zero:
+                continue
+            entries_n.append(c)
+            entries_d.append(lead)
+            labels.append(f"N[{i},{j}] s^{k}")
+    return entries_n, entries_d, labels
+
+
+def _markov_summary(mats, mkind, output, params):
+    Rp = ring(list(params), QQ, grevlex)[0] if params else ring([sp.Dummy("_none")], QQ, grevlex)[0]
+    A, B, C, D, d = first_order_polynomial(mats, mkind, output, Rp)
+    n = A.shape[0]
+    entries_n, entries_d, labels = [], [], []
+    X = B
+    dpow = d * d  # C̃ Ãᵏ B̃ / d^(k+2)
+    for k in range(2 * n):
+        H = (C * X).to_list()
+        for i, row in enumerate(H):
+            for j, h in enumerate(row):
+                entries_n.append(h)
+                entries_d.append(dpow)
+                labels.append(f"h{k}[{i},{j}]")
+        X = A * X
+        dpow = dpow * d
+    for i, row in enumerate(D.to_list()):
+        for j, h in enumerate(row):
+            entries_n.append(h)
+            entries_d.append(d)
+            labels.append(f"D[{i},{j}]")
+    return entries_n, entries_d, labels
