@@ -1,0 +1,192 @@
+"""``si.compare``: several methods on the same model, data and starts, side by side."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from symid.errors import ModelError
+from symid.identification import prepare
+from symid.misfit import relative_parameter_error
+from symid.progress import progress_bar
+from symid.result import IdentificationResult, StartOutcome
+from symid.starts import make_starts
+from symid.statespace import StateSpaceModel
+
+__all__ = ["Comparison", "MethodStats", "compare"]
+
+
+@dataclass(frozen=True)
+class MethodStats:
+    """One method's figures in a comparison.
+
+    Attributes
+    ----------
+    method : str
+        The method asked for (``"scr"``, ``"ipopt"``, ...).
+    ran_as : str
+        The method that actually ran (``"ls"`` when SCR chose the linear special case).
+    n_starts, n_success : int
+        Starts run and starts that succeeded.
+    success_rate : float
+        ``n_success / n_starts``.
+    median_time : float
+        Median seconds per start (solver time, setup excluded).
+    setup_time : float
+        Seconds to build the method's problem once (shared by all starts).
+    time_to_solution : float
+        (setup + all starts) / successes; ``inf`` without a success.
+    best_cost : float
+        Lowest relative data misfit over the starts.
+    best_error : float or None
+        Relative parameter error of the best-cost start, when the truth is known.
+    result : IdentificationResult
+        Every start's outcome.
+    """
+
+    method: str
+    ran_as: str
+    n_starts: int
+    n_success: int
+    success_rate: float
+    median_time: float
+    setup_time: float
+    time_to_solution: float
+    best_cost: float
+    best_error: float | None
+    result: IdentificationResult = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form, suitable for JSON."""
+        return {"method": self.method, "ran_as": self.ran_as, "n_starts": self.n_starts,
+                "n_success": self.n_success, "success_rate": self.success_rate, "median_time": self.median_time,
+                "setup_time": self.setup_time, "time_to_solution": self.time_to_solution,
+                "best_cost": self.best_cost, "best_error": self.best_error,
+                "theta": self.result.theta, "starts": [s.to_dict() for s in self.result.starts]}
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """The outcome of :func:`compare`: per method, success rate and time figures.
+
+    ``success`` means a relative parameter error ‖θ − θ*‖₂/‖θ*‖₂ ≤ ``param_tol`` when the
+    truth is known, otherwise a relative data misfit ≤ ``cost_tol``.
+    """
+
+    stats: tuple[MethodStats, ...]
+    n_starts: int
+    seed: int | None
+    criterion: str
+    truth: dict[str, float] | None = None
+
+    def __getitem__(self, method: str) -> MethodStats:
+        for s in self.stats:
+            if s.method == method:
+                return s
+        raise KeyError(method)
+
+    def _rows(self) -> list[list[str]]:
+        rows = []
+        for s in self.stats:
+            name = s.method if s.ran_as == s.method else f"{s.method} (as {s.ran_as})"
+            rows.append([name, f"{s.n_success}/{s.n_starts}", f"{100 * s.success_rate:.0f}%",
+                         f"{1e3 * s.median_time:.1f}", f"{1e3 * s.setup_time:.1f}",
+                         "inf" if not np.isfinite(s.time_to_solution) else f"{s.time_to_solution:.3f}",
+                         f"{s.best_cost:.2e}", "—" if s.best_error is None else f"{s.best_error:.2e}"])
+        return rows
+
+    _HEAD: ClassVar[tuple[str, ...]] = ("method", "successes", "rate", "median ms/start", "setup ms",
+                                         "time to solution s", "best cost", "best rel. error")
+
+    def table(self) -> str:
+        """A plain-text table."""
+        rows = [list(self._HEAD), *self._rows()]
+        widths = [max(len(r[i]) for r in rows) for i in range(len(self._HEAD))]
+        lines = ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
+        lines.insert(1, "  ".join("-" * w for w in widths))
+        return "\n".join([f"{self.n_starts} identical starts (seed {self.seed}); success: {self.criterion}", *lines])
+
+    def to_markdown(self) -> str:
+        """A Markdown table."""
+        lines = ["| " + " | ".join(self._HEAD) + " |", "|" + "---|" * len(self._HEAD)]
+        lines += ["| " + " | ".join(r) + " |" for r in self._rows()]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form, suitable for JSON."""
+        return {"n_starts": self.n_starts, "seed": self.seed, "criterion": self.criterion, "truth": self.truth,
+                "methods": [s.to_dict() for s in self.stats]}
+
+    def __str__(self) -> str:
+        return self.table()
+
+
+def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *, starts: int = 10,
+            seed: int | None = 0, truth: Any = None, x0: Any = None, param_tol: float = 1e-3,
+            cost_tol: float = 1e-8, progress: bool | None = None,
+            options: dict[str, dict[str, Any]] | None = None) -> Comparison:
+    """Run several methods from identical starts and tabulate success and time.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+    data : FrequencyData
+    methods : sequence of str
+        Methods to compare (see :func:`symid.identify`).
+    starts : int
+        Number of starts; every method gets the same list (:func:`symid.starts.make_starts`).
+    seed : int, optional
+        Seed of the random starts.
+    truth : dict or sequence, optional
+        True parameters; success is then ‖θ − θ*‖₂/‖θ*‖₂ ≤ ``param_tol``.
+    x0 : dict or sequence, optional
+        A start put first in the list.
+    param_tol, cost_tol : float
+        Success thresholds (parameter error with a truth, data misfit without).
+    progress : bool, optional
+        Progress bar (default: on a terminal).
+    options : dict, optional
+        Per-method options, e.g. ``{"scr": {"backend": "admm"}}``.
+
+    Returns
+    -------
+    Comparison
+    """
+    if not methods:
+        raise ModelError("compare() needs at least one method")
+    options = dict(options or {})
+    unknown = set(options) - set(methods)
+    if unknown:
+        raise ModelError(f"options given for methods not compared: {', '.join(sorted(unknown))}")
+    truth_vec = None if truth is None else model.theta_vector(truth)
+    x0s = make_starts(model, starts, seed, x0, zero_first=isinstance(model, StateSpaceModel))
+    stats = []
+    for method in methods:
+        t0 = time.perf_counter()
+        solver = prepare(model, data, method, dict(options.get(method, {})))
+        setup = time.perf_counter() - t0
+        outcomes: list[StartOutcome] = []
+        for x in progress_bar(x0s, desc=f"{method}", enabled=progress):
+            outcomes.append(solver.run(x))
+        res = IdentificationResult.from_starts(solver.method, model.parameter_names, outcomes,
+                                               dict(getattr(solver, "options", {})))
+        if truth_vec is not None:
+            ok = [relative_parameter_error(o.theta, truth_vec) <= param_tol for o in outcomes]
+            best_err = relative_parameter_error(res.theta_vector, truth_vec)
+        else:
+            ok = [np.isfinite(o.cost) and o.cost <= cost_tol for o in outcomes]
+            best_err = None
+        n_ok = int(sum(ok))
+        total = setup + sum(o.wall_time for o in outcomes)
+        stats.append(MethodStats(method=method, ran_as=solver.method, n_starts=len(outcomes), n_success=n_ok,
+                                 success_rate=n_ok / len(outcomes),
+                                 median_time=float(np.median([o.wall_time for o in outcomes])), setup_time=setup,
+                                 time_to_solution=total / n_ok if n_ok else float("inf"),
+                                 best_cost=res.cost, best_error=best_err, result=res))
+    criterion = (f"relative parameter error <= {param_tol:g}" if truth_vec is not None
+                 else f"relative misfit <= {cost_tol:g}")
+    return Comparison(stats=tuple(stats), n_starts=len(x0s), seed=seed, criterion=criterion,
+                      truth=None if truth is None else model.theta_dict(truth))

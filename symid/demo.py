@@ -1,0 +1,72 @@
+"""``symid demo``: the belt drive of thesis §3-6, end to end, in well under a minute."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["run_demo"]
+
+
+def run_demo(out: str | Path = "symid-demo", *, starts: int = 20, seed: int = 0,
+             convergence_iterations: int = 150) -> int:
+    """Identify the belt drive (3-17) from its 10-point FRF with SCR and IPOPT, side by side.
+
+    Prints the model, its identifiability, the comparison table over ``starts``
+    identical starts and the best estimates against the truth (3-18); writes
+    ``bode.png`` and ``convergence.png`` to ``out``.
+
+    Returns
+    -------
+    int
+        0 when SCR recovered the truth to 1e-6, 1 otherwise (the exit code of the command).
+    """
+    from symid.comparison import compare
+    from symid.formulations.frf_scr import ScrFRF
+    from symid.plots import bode_plot, convergence_plot
+    from symid.structural import identifiability
+    from symid.zoo import load_model
+
+    t0 = time.perf_counter()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    entry = load_model("belt_drive")
+    model, truth = entry.model, entry.truth
+    truth_vec = model.theta_vector(truth)
+    print(f"symid demo: {entry.title} [{entry.source}]")
+    print(model.summary())
+    print()
+    rep = identifiability(model, timeout=20)
+    print(f"identifiability: {rep.verdict} ({', '.join(f'{k}: {v}' for k, v in rep.verdicts.items())})")
+    data = entry.data()
+    print(f"data: {entry.recipe}")
+    print()
+    cmp = compare(model, data, methods=("scr", "ipopt"), starts=starts, seed=seed, truth=truth, progress=True)
+    print(cmp.table())
+    print()
+    print(f"{'parameter':>10s} {'truth':>10s} {'SCR':>14s} {'IPOPT':>14s}")
+    scr_theta = cmp["scr"].result.theta_vector
+    ip_theta = cmp["ipopt"].result.theta_vector
+    for k, name in enumerate(model.parameter_names):
+        print(f"{name:>10s} {truth_vec[k]:>10.4g} {scr_theta[k]:>14.9f} {ip_theta[k]:>14.9f}")
+    err_scr = float(np.linalg.norm(scr_theta - truth_vec))
+    err_ip = float(np.linalg.norm(ip_theta - truth_vec))
+    print(f"{'‖θ̂ − θ*‖₂':>10s} {'':>10s} {err_scr:>14.2e} {err_ip:>14.2e}   (thesis (3-21): 3.5e-07)")
+    print()
+    bode = bode_plot(data, {"SCR": (model, scr_theta), "IPOPT (best start)": (model, ip_theta),
+                            "truth": (model, truth_vec)}, out / "bode.png",
+                     title="Belt drive (3-17): 10 FRF samples around the resonance")
+    # Figure 3-2 of the thesis: SCR on (3-15) as posed there, every equation relaxed (no
+    # presolve), from the all-zero start; with presolve symid solves it in one step.
+    raw = ScrFRF(model, data, backend="admm", presolve=False, gamma0="zero", max_iter=convergence_iterations)
+    sol = raw.solve(np.zeros(model.n_parameters))
+    conv = convergence_plot(raw.family_residuals(sol), out / "convergence.png",
+                            title=f"Belt drive: SCR on (3-15) without presolve, from θ = 0 "
+                                  f"({sol.iterations} iterations)")
+    print(f"SCR as the thesis posed it (every equation relaxed, no presolve): after {sol.iterations} iterations "
+          f"‖θ − θ*‖₂ = {np.linalg.norm(np.asarray(sol.x['theta']) - truth_vec):.2e}; with presolve the known rows "
+          "become linear equalities that fix every Γᵢ, and the problem is solved exactly in one step.")
+    print(f"wrote {bode} and {conv}   (total {time.perf_counter() - t0:.1f} s)")
+    return 0 if err_scr <= 1e-6 else 1

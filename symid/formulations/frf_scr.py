@@ -1,0 +1,249 @@
+"""SCR formulations for frequency responses: thesis Algorithm 3.1 (state space) and (4-8) (second order).
+
+State space, for every frequency ωᵢ (thesis (3-15)):
+
+- Γ substitution (3-10): A(θ) Γᵢ = jωᵢ Γᵢ − B(θ) and Hᵢ − D(θ) = C(θ) Γᵢ;
+- Ψ substitution (3-12): Ψᵢ A(θ) = jωᵢ Ψᵢ − C(θ) and Hᵢ − D(θ) = Ψᵢ B(θ).
+
+Second order (4-8): [M(θ) V(θ) K(θ)] Pᵢ Γᵢ = B(θ) with Pᵢ = [−ωᵢ² I; jωᵢ I; I] (the thesis
+prints −jωᵢ in (4-7)/(4-8); the sign must be + for Z = −ω²M + jωV + K of (4-5)), and
+Hᵢ = fᵢ C(θ) Γᵢ with fᵢ = 1, jωᵢ or −ωᵢ² for position, velocity or acceleration output
+(4-9); M, V, K ⪰ 0 as LMIs when they are symmetric.
+
+Every equation is posed as a bilinear term; the engine's presolve turns the rows that
+hold no product of unknowns into linear equalities and eliminates what they determine
+(scr-lessons 1 and 7), so only what is truly bilinear is relaxed.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from symid import scr
+from symid.errors import ModelError
+from symid.misfit import relative_misfit
+from symid.result import StartOutcome
+
+__all__ = ["ScrFRF"]
+
+
+def _theta_coef(amap: Any) -> np.ndarray:
+    """Coefficient array (r, c, l) of an affine model map, as scr.Affine wants it."""
+    return np.moveaxis(amap.Xi, 0, -1)
+
+
+def _identity(shape: tuple[int, int]) -> np.ndarray:
+    r, c = shape
+    return np.eye(r * c).reshape(r, c, r, c)
+
+
+def _symmetric(amap: Any) -> bool:
+    return bool(np.allclose(amap.X0, amap.X0.T) and np.allclose(amap.Xi, np.swapaxes(amap.Xi, 1, 2)))
+
+
+class ScrFRF:
+    """Sequential convex relaxation on a frequency response, built once, run per start.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+    data : FrequencyData
+    substitution : {"gamma", "psi", "both"}, optional
+        State-space models: which substitution of thesis (3-10)/(3-12) to use
+        (default ``"gamma"``; the thesis uses both, but with C known Ψ only slows
+        convergence, scr-lessons 7). Second-order models always use Γ.
+    weights : array_like, optional
+        Per-frequency weights λᵢ (3-15); default 1 for every frequency.
+    lmis : bool, optional
+        Second-order models: M, V, K ⪰ 0 (default True; thesis §5-7 and scr-lessons 2
+        show they are decisive).
+    backend : {"admm", "cvxpy"}
+        Engine back end (default ``"cvxpy"``: Clarabel).
+    max_iter : int
+        SCR iterations per start (default 500).
+    tol : float
+        Stopping tolerance on the normalised bilinear residual (default 1e-9).
+    gamma0 : {"model", "zero", "random"}
+        Initial Γᵢ (and Ψᵢ): computed from the start θ when that model is well defined
+        (default), zero (thesis ch. 3: "all matrices initialised as zero"), or seeded
+        N(0, 1) draws (scr-lessons 9: zero Γ makes the first 2-DOF sub-problem degenerate).
+    """
+
+    method = "scr"
+
+    def __init__(self, model: Any, data: Any, *, substitution: str = "gamma", weights: Any = None,
+                 lmis: bool = True, backend: str = "cvxpy", max_iter: int = 500, tol: float = 1e-9,
+                 gamma0: str = "model", seed: int = 0, presolve: bool = True, heuristic: str = "nuclear",
+                 admm: Any = None):
+        if substitution not in ("gamma", "psi", "both"):
+            raise ModelError(f"substitution must be 'gamma', 'psi' or 'both'; got {substitution!r}")
+        if gamma0 not in ("model", "zero", "random"):
+            raise ModelError(f"gamma0 must be 'model', 'zero' or 'random'; got {gamma0!r}")
+        self.model, self.data = model, data
+        self.second_order = "M" in model.maps
+        if self.second_order:
+            substitution = "gamma"
+        self.substitution = substitution
+        w = np.asarray(data.w, dtype=float)
+        self.w = w
+        s = w.size
+        lam = np.ones(s) if weights is None else np.asarray(weights, dtype=float).reshape(-1)
+        if lam.shape != (s,) or np.any(~np.isfinite(lam)) or np.any(lam <= 0):
+            raise ModelError(f"weights must be {s} positive finite numbers (one per frequency)")
+        self.options = {"substitution": substitution, "weights": "uniform" if weights is None else "given",
+                        "lmis": lmis, "backend": backend, "max_iter": max_iter, "tol": tol, "gamma0": gamma0,
+                        "presolve": presolve, "heuristic": heuristic}
+        self._solve_opts = {"backend": backend, "max_iter": int(max_iter), "tol": float(tol),
+                            "presolve": presolve, "heuristic": heuristic}
+        if admm is not None:
+            self._solve_opts["admm"] = admm
+        self._rng_seed = seed
+        self.gamma0 = gamma0
+        self.problem = self._build(lam, lmis)
+
+    # -- problem construction ---------------------------------------------------------------
+    def _build(self, lam: np.ndarray, lmis: bool) -> scr.BilinearProblem:
+        model, H = self.model, np.asarray(self.data.H, dtype=complex)
+        maps = model.maps
+        l = model.n_parameters
+        p, m = model.n_outputs, model.n_inputs
+        theta = scr.Variable("theta", (l,))
+        variables: list[scr.Variable] = [theta]
+        terms: list[scr.Bilinear] = []
+        lmi_list: list[Any] = []
+        self.families: dict[str, list[int]] = {}
+
+        def add(family: str, term: scr.Bilinear) -> None:
+            self.families.setdefault(family, []).append(len(terms))
+            terms.append(term)
+
+        def aff(amap: Any, sign: float = 1.0) -> scr.Affine:
+            return scr.Affine(sign * amap.X0, {theta: sign * _theta_coef(amap)})
+
+        if self.second_order:
+            n = model.n_dof
+            MVK0 = np.hstack([maps["M"].X0, maps["V"].X0, maps["K"].X0])
+            MVKc = np.concatenate([_theta_coef(maps["M"]), _theta_coef(maps["V"]), _theta_coef(maps["K"])], axis=1)
+            A_mvk = scr.Affine(MVK0, {theta: MVKc})
+            f = {"position": np.ones(self.w.size, dtype=complex), "velocity": 1j * self.w,
+                 "acceleration": -(self.w**2) + 0j}[model.output]
+            self.gamma_vars = []
+            for i, wi in enumerate(self.w):
+                G = scr.Variable(f"Gamma{i}", (n, m), complex=True)
+                variables.append(G)
+                self.gamma_vars.append(G)
+                Pi = np.vstack([-(wi**2) * np.eye(n), 1j * wi * np.eye(n), np.eye(n)])
+                Gi = scr.Affine(np.zeros((n, m)), {G: _identity((n, m))})
+                add("dynamics [M V K] P Γ = B", scr.Bilinear(A=A_mvk, P=Pi, B=Gi, C=aff(maps["B"]),
+                                                          weight=lam[i], name=f"dynamics[{i}]"))
+                # Hᵢ = fᵢ C(θ) Γᵢ
+                add("output H = C Γ", scr.Bilinear(A=aff(maps["C"]), P=f[i] * np.eye(n), B=Gi,
+                                                   C=scr.Affine(H[i]), weight=lam[i], name=f"output[{i}]"))
+            if lmis:
+                for name in "MVK":
+                    if maps[name].is_constant:
+                        continue
+                    if not _symmetric(maps[name]):
+                        self.options[f"lmi_{name}"] = "skipped: not symmetric"
+                        continue
+                    lmi_list.append(aff(maps[name]))
+        else:
+            n = model.n_states
+            eye = np.eye(n)
+            self.gamma_vars, self.psi_vars = [], []
+            for i, wi in enumerate(self.w):
+                Hi_minus_D = scr.Affine(H[i] - maps["D"].X0, {theta: -_theta_coef(maps["D"])})
+                if self.substitution in ("gamma", "both"):
+                    G = scr.Variable(f"Gamma{i}", (n, m), complex=True)
+                    variables.append(G)
+                    self.gamma_vars.append(G)
+                    Gi = scr.Affine(np.zeros((n, m)), {G: _identity((n, m))})
+                    rhs = scr.Affine(-maps["B"].X0, {G: 1j * wi * _identity((n, m)), theta: -_theta_coef(maps["B"])})
+                    add("Γ dynamics A Γ = jωΓ − B", scr.Bilinear(A=aff(maps["A"]), P=eye, B=Gi, C=rhs,
+                                                                 weight=lam[i], name=f"gamma_dynamics[{i}]"))
+                    add("Γ output H − D = C Γ", scr.Bilinear(A=aff(maps["C"]), P=eye, B=Gi, C=Hi_minus_D,
+                                                             weight=lam[i], name=f"gamma_output[{i}]"))
+                if self.substitution in ("psi", "both"):
+                    S = scr.Variable(f"Psi{i}", (p, n), complex=True)
+                    variables.append(S)
+                    self.psi_vars.append(S)
+                    Si = scr.Affine(np.zeros((p, n)), {S: _identity((p, n))})
+                    rhs = scr.Affine(-maps["C"].X0, {S: 1j * wi * _identity((p, n)), theta: -_theta_coef(maps["C"])})
+                    add("Ψ dynamics Ψ A = jωΨ − C", scr.Bilinear(A=Si, P=eye, B=aff(maps["A"]), C=rhs,
+                                                                 weight=lam[i], name=f"psi_dynamics[{i}]"))
+                    add("Ψ output H − D = Ψ B", scr.Bilinear(A=Si, P=eye, B=aff(maps["B"]), C=Hi_minus_D,
+                                                             weight=lam[i], name=f"psi_output[{i}]"))
+        # positivity declared on parameters: θk ≥ 0 as 1×1 LMIs
+        for k, pos in enumerate(model.positive):
+            if pos:
+                coef = np.zeros((1, 1, l))
+                coef[0, 0, k] = 1.0
+                lmi_list.append(scr.Affine(np.zeros((1, 1)), {theta: coef}))
+        self.theta_var = theta
+        return scr.BilinearProblem(variables=variables, bilinear=terms, lmis=lmi_list)
+
+    # -- one start ---------------------------------------------------------------------------
+    def _aux_start(self, x0: np.ndarray) -> dict[str, Any]:
+        model = self.model
+        start: dict[str, Any] = {"theta": x0}
+        mode = self.gamma0
+        gam = psi = None
+        if mode == "model":
+            try:
+                if self.second_order:
+                    mats = model.matrices(x0)
+                    M, V, K, B = (mats[k] for k in "MVKB")
+                    Z = -(self.w**2)[:, None, None] * M + 1j * self.w[:, None, None] * V + K
+                    gam = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (self.w.size, *B.shape)))
+                else:
+                    A, B, C, _ = model.state_space(x0)
+                    Z = 1j * self.w[:, None, None] * np.eye(A.shape[0]) - A
+                    gam = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (self.w.size, *B.shape)))
+                    psi = np.swapaxes(np.linalg.solve(np.swapaxes(Z, 1, 2),
+                                                      np.broadcast_to(C.T.astype(complex), (self.w.size, *C.T.shape))),
+                                      1, 2)
+                if not np.all(np.isfinite(gam)) or (psi is not None and not np.all(np.isfinite(psi))):
+                    gam = psi = None
+            except (np.linalg.LinAlgError, ModelError):
+                gam = psi = None
+            if gam is None:
+                mode = "random"
+        rng = np.random.default_rng([self._rng_seed, *np.abs(np.round(x0 * 1e6)).astype(np.int64).tolist()[:4]])
+        for i, G in enumerate(self.gamma_vars):
+            if mode == "model":
+                start[G.name] = gam[i]
+            elif mode == "random":
+                start[G.name] = rng.standard_normal(G.shape) + 1j * rng.standard_normal(G.shape)
+        for i, S in enumerate(getattr(self, "psi_vars", [])):
+            if mode == "model" and psi is not None:
+                start[S.name] = psi[i]
+            elif mode == "random":
+                start[S.name] = rng.standard_normal(S.shape) + 1j * rng.standard_normal(S.shape)
+        return start
+
+    def solve(self, x0: np.ndarray) -> scr.SCRSolution:
+        """The raw engine solution from the start ``x0`` (parameter vector)."""
+        return scr.solve(self.problem, self._aux_start(np.asarray(x0, dtype=float)), **self._solve_opts)
+
+    def family_residuals(self, sol: scr.SCRSolution) -> dict[str, list[float]]:
+        """Per iteration, the summed residual of each constraint family (thesis Figure 3-2)."""
+        out = {}
+        for fam, idx in self.families.items():
+            out[fam] = [float(np.sum(np.asarray(h.residuals)[idx])) for h in sol.history]
+        return out
+
+    def run(self, x0: np.ndarray) -> StartOutcome:
+        """Solve from the start ``x0``; never raises on solver failure."""
+        x0 = np.asarray(x0, dtype=float)
+        t0 = time.perf_counter()
+        sol = self.solve(x0)
+        elapsed = time.perf_counter() - t0
+        theta = np.asarray(sol.x["theta"], dtype=float).reshape(-1)
+        cost = relative_misfit(self.model, self.data, theta)
+        hist = tuple({"residual": h.residual, "objective": h.objective, "relaxation": h.relaxation,
+                      "time": h.time} for h in sol.history)
+        return StartOutcome(start=x0, theta=theta, cost=cost, converged=bool(sol.success and np.isfinite(cost)),
+                            iterations=sol.iterations, wall_time=elapsed, message=sol.message, history=hist)

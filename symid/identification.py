@@ -1,0 +1,149 @@
+"""``si.identify``: one entry point that picks the formulation from the model and data kinds."""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from symid.errors import DataError, ModelError
+from symid.formulations.frf_ls import LinearFRF, ls_applicable
+from symid.nlls.frf import IpoptFRF
+from symid.progress import progress_bar
+from symid.result import IdentificationResult, StartOutcome
+from symid.secondorder import SecondOrderModel
+from symid.starts import make_starts
+from symid.statespace import StateSpaceModel
+from symid.structural.analyse import warn_if_not_identifiable
+
+__all__ = ["METHODS", "identify", "prepare"]
+
+METHODS = ("scr", "ipopt", "ls")
+
+
+def _check_model(model: Any) -> None:
+    if not isinstance(model, (StateSpaceModel, SecondOrderModel)):
+        raise ModelError(f"model must be a StateSpaceModel or SecondOrderModel; got {type(model).__name__}")
+    if model.n_parameters == 0:
+        raise ModelError("the model has no free parameter: there is nothing to estimate")
+
+
+def _check_frf(model: Any, data: Any) -> None:
+    s, p, m = np.asarray(data.H).shape
+    if (p, m) != (model.n_outputs, model.n_inputs):
+        raise DataError(f"data H has {p} output(s) × {m} input(s) per frequency; the model has "
+                        f"{model.n_outputs} output(s) × {model.n_inputs} input(s)")
+    equations = 2 * s * p * m
+    if equations < model.n_parameters:
+        need = math.ceil(model.n_parameters / (2 * p * m))
+        raise DataError(f"{s} frequencies give {equations} real equations for {model.n_parameters} unknown "
+                        f"parameters: at least {need} frequencies are needed")
+
+
+def prepare(model: Any, data: Any, method: str, options: dict[str, Any]) -> Any:
+    """Build the method's solver for this model and data once; its ``run(x0)`` solves one start."""
+    from symid.data import FrequencyData
+
+    _check_model(model)
+    if not isinstance(data, FrequencyData):
+        raise DataError(f"identify() for {type(model).__name__} takes FrequencyData here; got {type(data).__name__} "
+                        "(spectra, black boxes and I/O series come with their own formulations)")
+    _check_frf(model, data)
+    if method == "ls":
+        return LinearFRF(model, data, **options)
+    if method == "ipopt":
+        return IpoptFRF(model, data, **options)
+    if method == "scr":
+        if isinstance(model, SecondOrderModel) and ls_applicable(model) and not options.get("force_scr", False):
+            return LinearFRF(model, data)
+        from symid.formulations.frf_scr import ScrFRF
+
+        opts = {k: v for k, v in options.items() if k != "force_scr"}
+        return ScrFRF(model, data, **opts)
+    raise ModelError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+
+
+def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, starts: int = 1,
+             seed: int | None = None, polish: bool = False, progress: bool | None = None,
+             identifiability_check: bool = True, **options: Any) -> IdentificationResult:
+    """Estimate the parameters of a symbolic model from data.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+        The grey-box model.
+    data : FrequencyData
+        The measurements.
+    method : {"scr", "ipopt", "ls"}
+        ``"scr"``: sequential convex relaxation (thesis Algorithm 3.1 / (4-8)); for a
+        second-order model whose C or B is known, square and invertible the linear
+        least squares (4-10)/(4-11) is exact and is used instead (reported as method
+        ``"ls"``; pass ``force_scr=True`` to run SCR anyway). ``"ipopt"``: nonlinear
+        least squares on the frequency response with CasADi/IPOPT. ``"ls"``: the linear
+        least squares; a clear error when it does not apply.
+    x0 : dict or sequence, optional
+        A start; it becomes the first of ``starts``.
+    starts : int
+        Number of starts. Default starts: for a state-space model the first is θ = 0
+        (thesis ch. 3), for a second-order model all are N(0, 1) draws (thesis ch. 4),
+        positive parameters drawn in absolute value. Every method gets the same starts
+        for the same ``seed``.
+    seed : int, optional
+        Seed of the random starts.
+    polish : bool
+        After SCR, refine the best estimate with IPOPT; reported in ``result.polished``,
+        never mixed into the SCR figures.
+    progress : bool, optional
+        Show a progress bar over the starts (default: when there is more than one start
+        and standard error is a terminal).
+    identifiability_check : bool
+        Before estimating, run the cheap local identifiability test and emit an
+        :class:`~symid.IdentifiabilityWarning` naming the parameters that no data of
+        this kind can determine (default True).
+    **options
+        Passed to the method (e.g. ``backend="admm"``, ``max_iter``, ``tol`` for SCR;
+        ``scale``, ``hessian`` for IPOPT).
+
+    Returns
+    -------
+    IdentificationResult
+        The best start by data misfit, and every start's outcome in ``result.starts``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> frf = si.simulate_frf(model, {"m": 2.0, "c": 0.5, "k": 3.0}, np.linspace(0.5, 2.0, 5))
+    >>> res = si.identify(model, frf, method="ls")
+    >>> [round(v, 6) for v in res.theta.values()]
+    [2.0, 0.5, 3.0]
+    """
+    solver = prepare(model, data, method, dict(options))
+    if identifiability_check:
+        warn_if_not_identifiable(model, stacklevel=2)
+    zero_first = isinstance(model, StateSpaceModel)
+    x0s = make_starts(model, starts, seed, x0, zero_first=zero_first)
+    if solver.method == "ls":
+        x0s = x0s[:1]
+    outcomes: list[StartOutcome] = []
+    label = f"{solver.method} starts"
+    for x in progress_bar(x0s, desc=label, enabled=progress):
+        outcomes.append(solver.run(x))
+    options_used = dict(getattr(solver, "options", {}))
+    if solver.method != method:
+        options_used["chosen_because"] = f"{method} → {solver.method}: linear special case ({solver.case})"
+    result = IdentificationResult.from_starts(solver.method, model.parameter_names, outcomes, options_used)
+    if polish and solver.method == "scr":
+        t0 = time.perf_counter()
+        polisher = IpoptFRF(model, data)
+        out = polisher.run(result.theta_vector)
+        out = StartOutcome(start=result.theta_vector, theta=out.theta, cost=out.cost, converged=out.converged,
+                           iterations=out.iterations, wall_time=time.perf_counter() - t0,
+                           message=f"IPOPT polish from the SCR estimate: {out.message}")
+        polished = IdentificationResult.from_starts("scr+polish", model.parameter_names, [out], {"polish": "ipopt"})
+        result = IdentificationResult(**{**result.__dict__, "polished": polished})
+    return result

@@ -1,0 +1,29 @@
+"""A progress bar for multi-start runs and studies (tqdm, to standard error)."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable, Iterator
+from typing import TypeVar
+
+from tqdm import tqdm
+
+__all__ = ["progress_bar"]
+
+T = TypeVar("T")
+
+
+def progress_bar(items: Iterable[T], *, desc: str, enabled: bool | None = None, total: int | None = None
+                 ) -> Iterator[T]:
+    """Iterate over ``items`` with a tqdm bar on standard error.
+
+    ``enabled=None`` shows the bar when there is more than one item and standard
+    error is a terminal; ``True`` always, ``False`` never.
+    """
+    seq = list(items)
+    if enabled is None:
+        enabled = len(seq) > 1 and sys.stderr.isatty()
+    if not enabled:
+        yield from seq
+        return
+    yield from tqdm(seq, desc=desc, total=total or len(seq), file=sys.stderr, leave=False, dynamic_ncols=True)
