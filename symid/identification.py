@@ -42,14 +42,8 @@ def _check_frf(model: Any, data: Any) -> None:
                         f"parameters: at least {need} frequencies are needed")
 
 
-def prepare(model: Any, data: Any, method: str, options: dict[str, Any]) -> Any:
-    """Build the method's solver for this model and data once; its ``run(x0)`` solves one start."""
-    from symid.data import FrequencyData
-
-    _check_model(model)
-    if not isinstance(data, FrequencyData):
-        raise DataError(f"identify() for {type(model).__name__} takes FrequencyData here; got {type(data).__name__} "
-                        "(spectra, black boxes and I/O series come with their own formulations)")
+def _prepare_frf(model: Any, data: Any, method: str, options: dict[str, Any]) -> Any:
+    """Solvers for a frequency response (thesis ch. 3 and 4)."""
     _check_frf(model, data)
     if method == "ls":
         return LinearFRF(model, data, **options)
@@ -62,7 +56,22 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any]) -> Any:
 
         opts = {k: v for k, v in options.items() if k != "force_scr"}
         return ScrFRF(model, data, **opts)
-    raise ModelError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    raise ModelError(f"unknown method {method!r} for frequency-response data; choose one of {', '.join(METHODS)}")
+
+
+def prepare(model: Any, data: Any, method: str, options: dict[str, Any]) -> Any:
+    """Build the method's solver for this model and data once; its ``run(x0)`` solves one start.
+
+    The formulation follows from the two kinds (the table of ``design.md``); each data
+    kind has its own ``_prepare_*`` function. A solver has ``method`` (the method that
+    actually runs), ``options`` and ``run(x0) -> StartOutcome``.
+    """
+    from symid.data import FrequencyData
+
+    _check_model(model)
+    if isinstance(data, FrequencyData):
+        return _prepare_frf(model, data, method, options)
+    raise DataError(f"identify() for {type(model).__name__} does not take {type(data).__name__} data here")
 
 
 def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, starts: int = 1,
