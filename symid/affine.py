@@ -81,14 +81,21 @@ class AffineMap:
         return out
 
 
+def _is_affine(expr: sp.Expr, symbols: Sequence[sp.Symbol]) -> bool:
+    """Whether ``expr`` is affine in ``symbols`` (every first derivative free of them)."""
+    return not any(sp.simplify(sp.diff(expr, s)).free_symbols & set(symbols) for s in symbols)
+
+
 def _hint(expr: sp.Expr, involved: Sequence[sp.Symbol]) -> str:
     names = [str(p) for p in involved]
     _, den = sp.fraction(sp.together(expr))
-    den_params = sorted(den.free_symbols & set(involved), key=sp.default_sort_key)
-    if den_params:
-        p = den_params[0]
-        return (f"introduce a new parameter such as `{p}inv = 1/{p}` (or one parameter for the whole ratio "
-                f"`{sp.sstr(expr)}`) and write the entry in it")
+    if den in set(involved):
+        inv = sp.Symbol(f"{den}inv")
+        if _is_affine(expr.subs(den, 1 / inv), [*(set(involved) - {den}), inv]):  # 1/m, 1 + 2/m
+            return f"introduce a new parameter such as `{inv} = 1/{den}` and write the entry in it"
+    if den.free_symbols & set(involved):  # c/m, 1/(a + b), k/(m1*m2)
+        return (f"introduce a new parameter for the whole ratio (for example `r = {sp.sstr(expr)}`) "
+                f"and write the entry in it")
     if len(involved) == 1:
         return f"introduce a new parameter for the nonlinear function of {names[0]} (for example `f = {sp.sstr(expr)}`)"
     return (f"introduce a new parameter for the nonlinear combination of {', '.join(names)} "

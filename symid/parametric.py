@@ -17,7 +17,21 @@ Theta = Mapping[str, float] | Mapping[sp.Symbol, float] | Sequence[float] | np.n
 
 
 class StateSpaceMatrices(NamedTuple):
-    """Numeric continuous-time state-space matrices (x' = A x + B u, y = C x + D u)."""
+    """Numeric continuous-time state-space matrices (x' = A x + B u, y = C x + D u).
+
+    A named tuple, so ``A, B, C, D = model.state_space(theta)`` unpacks it.
+
+    Attributes
+    ----------
+    A : numpy.ndarray
+        State matrix, shape (n, n).
+    B : numpy.ndarray
+        Input matrix, shape (n, m).
+    C : numpy.ndarray
+        Output matrix, shape (p, n).
+    D : numpy.ndarray
+        Feedthrough, shape (p, m).
+    """
 
     A: np.ndarray
     B: np.ndarray
@@ -60,6 +74,8 @@ class ParametricModel:
         if parameters is None:
             params = found
         else:
+            if isinstance(parameters, str):  # "b a" or "b, a", as si.parameters() takes names
+                parameters = parameters.replace(",", " ").split()
             params = []
             by_name = {s.name: s for s in found}
             for p in parameters:
@@ -115,10 +131,31 @@ class ParametricModel:
     def theta_vector(self, theta: Theta) -> np.ndarray:
         """Convert θ given as a dict (by name or symbol) or a sequence to a float vector.
 
+        Parameters
+        ----------
+        theta : dict or sequence of float
+            A dict keyed by parameter name (or sympy symbol) holding every parameter,
+            or a sequence of values in ``parameter_names`` order.
+
+        Returns
+        -------
+        numpy.ndarray
+            θ as floats, shape (n_parameters,), in ``parameter_names`` order.
+
         Raises
         ------
         ModelError
             On a missing or unknown name, a wrong length, or a non-finite value.
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> k, m = si.parameters("k m", positive=True)
+        >>> model = si.SecondOrderModel(M=[[m]], V=[[0.1]], K=[[k]], B=[[1]], C=[[1]])
+        >>> model.parameter_names
+        ('m', 'k')
+        >>> model.theta_vector({"k": 4.0, "m": 2.0})
+        array([2., 4.])
         """
         names = self.parameter_names
         if theta is None:
@@ -153,7 +190,19 @@ class ParametricModel:
         return dict(zip(self.parameter_names, self.theta_vector(theta).tolist(), strict=True))
 
     def matrices(self, theta: Theta) -> dict[str, np.ndarray]:
-        """Numeric value of every matrix at θ, by matrix name."""
+        """Numeric value of every matrix at θ, by matrix name.
+
+        Parameters
+        ----------
+        theta : dict or sequence of float
+            Parameter values (see :meth:`theta_vector`).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``{"A": ..., "B": ..., "C": ..., "D": ...}`` or ``{"M": ..., "V": ..., "K": ...,
+            "B": ..., "C": ...}``, each X(θ) = X0 + Σ θi Xi as floats.
+        """
         vec = self.theta_vector(theta)
         return {n: m(vec) for n, m in self._maps.items()}
 

@@ -29,17 +29,27 @@ class SecondOrderModel(ParametricModel):
     ----------
     M, V, K : array_like or sympy.Matrix
         Mass, damping and stiffness matrices, each (n, n), affine in the parameters.
+        Entries are numbers, sympy expressions or strings
+        (:func:`symid.symbols.parse_entry`).
     B : array_like or sympy.Matrix
         Input matrix (n, m).
     C : array_like or sympy.Matrix
         Output matrix (p, n).
     output : {"position", "velocity", "acceleration"}
-        What the sensors measure.
-    parameters : sequence of sympy.Symbol or str, optional
-        Fixes the order of θ; by default the order of first appearance, row by row,
-        through M, V, K, B, C.
+        What the sensors measure. Default ``"position"``.
+    parameters : sequence of sympy.Symbol or str, or str, optional
+        Fixes the order of θ (a string is split at spaces and commas); by default the
+        order of first appearance, row by row, through M, V, K, B, C (within one
+        entry, sympy's canonical order: alphabetical for plain names).
     name : str, optional
         A label used in reports.
+
+    Raises
+    ------
+    NonAffineError
+        If an entry is not affine in the parameters.
+    ModelError
+        On inconsistent shapes, unparsable entries or an unknown ``output``.
 
     Notes
     -----
@@ -108,7 +118,33 @@ class SecondOrderModel(ParametricModel):
         return Minv
 
     def state_space(self, theta: Theta) -> StateSpaceMatrices:
-        """First-order form (A, B, C, D) at θ (thesis (7-2); see the class notes)."""
+        """First-order form (A, B, C, D) at θ (thesis (7-2); see the class notes).
+
+        Parameters
+        ----------
+        theta : dict or sequence of float
+            Parameter values by name (or symbol), or in ``parameter_names`` order.
+
+        Returns
+        -------
+        StateSpaceMatrices
+            ``A`` (2n, 2n), ``B`` (2n, m), ``C`` (p, 2n) and ``D`` (p, m) for the state
+            ``x = [q; q']``; ``D = C M⁻¹ B`` for acceleration output, zero otherwise.
+
+        Raises
+        ------
+        ModelError
+            On bad θ, or if M(θ) is singular.
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> m, c, k = si.parameters("m c k", positive=True)
+        >>> acc = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]], output="acceleration")
+        >>> ss = acc.state_space({"m": 2.0, "c": 1.0, "k": 4.0})
+        >>> ss.C, ss.D                     # q'' = M⁻¹(B u − K q − V q')
+        (array([[-2. , -0.5]]), array([[0.5]]))
+        """
         vec = self.theta_vector(theta)
         mats = self.matrices(vec)
         M, V, K, B, C = (mats[k] for k in "MVKBC")
@@ -148,10 +184,35 @@ class SecondOrderModel(ParametricModel):
     def frequency_response(self, theta: Theta, w: Any) -> np.ndarray:
         """H(ω) = C (−ω²M + jωV + K)⁻¹ B, times jω (velocity) or −ω² (acceleration).
 
+        Computed directly from M, V, K (no first-order form, no M⁻¹); it equals the
+        response of :meth:`state_space` to rounding.
+
+        Parameters
+        ----------
+        theta : dict or sequence of float
+            Parameter values by name (or symbol), or in ``parameter_names`` order.
+        w : array_like
+            Real angular frequencies in rad/s (a scalar is one frequency).
+
         Returns
         -------
         numpy.ndarray
             Complex array of shape (len(w), p, m).
+
+        Raises
+        ------
+        ModelError
+            On bad θ, or if −ω²M + jωV + K is singular at one of the frequencies.
+        DataError
+            If ``w`` is missing, complex, not 1-D or not finite.
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> m, c, k = si.parameters("m c k", positive=True)
+        >>> vel = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]], output="velocity")
+        >>> vel.frequency_response([1.0, 2.0, 1.0], [1.0])[:, 0, 0]   # jω / (k − mω² + jcω)
+        array([0.5+0.j])
         """
         w = as_frequencies(w)
         mats = self.matrices(theta)

@@ -72,6 +72,16 @@ def _noise_level(noise: Any) -> float:
     return level
 
 
+def _generator(seed: Any) -> np.random.Generator:
+    """``numpy.random.default_rng(seed)`` for None, a non-negative int or a Generator; a DataError otherwise."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is not None and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer))
+                             or seed < 0):
+        raise DataError(f"seed must be None, an int >= 0 or a numpy.random.Generator; got {seed!r}")
+    return np.random.default_rng(seed)
+
+
 def _complex_normal(rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
     """Circular complex standard normal draws, E|z|² = 1."""
     g = rng.standard_normal((2, *shape))
@@ -125,10 +135,9 @@ def simulate_frf(model: Model, theta: Theta | None, w: Any, *, noise: float | No
     """
     sys, th = _system(model, theta)
     w_ = _checks.frequencies(w, "w")
-    level = _noise_level(noise)
+    level, rng = _noise_level(noise), _generator(seed)
     H = _response(sys, th, w_)
     if level > 0:
-        rng = np.random.default_rng(seed)
         H = H + level * np.abs(H) * _complex_normal(rng, H.shape)
     return FrequencyData(w_, H)
 
@@ -157,7 +166,7 @@ def _input_spectrum_array(Phi_uu: Any, w: np.ndarray, m: int) -> np.ndarray:
     s = w.size
     if callable(Phi_uu):
         fn: Callable[[float], Any] = Phi_uu
-        return np.stack([_spectrum_block(fn(float(wi)), m, f"Phi_uu({float(wi)!r})") for wi in w])
+        return np.stack([_spectrum_block(fn(float(wi)), m, f"Phi_uu({float(wi):.6g})") for wi in w])
     arr = _checks.as_array(Phi_uu, "Phi_uu", complex_ok=True)
     if arr.ndim == 0:
         return np.broadcast_to(arr * np.eye(m), (s, m, m)).copy()
@@ -231,13 +240,12 @@ def simulate_spectra(model: Model, theta: Theta | None, w: Any, Phi_uu: Any, *, 
     """
     sys, th = _system(model, theta)
     w_ = _checks.frequencies(w, "w")
-    level = _noise_level(noise)
+    level, rng = _noise_level(noise), _generator(seed)
     H = _response(sys, th, w_)
     Puu = _input_spectrum(Phi_uu, w_, H.shape[2])
     Pyy = H @ Puu @ np.conj(np.swapaxes(H, -1, -2))
     Pyy = 0.5 * (Pyy + np.conj(np.swapaxes(Pyy, -1, -2)))
     if level > 0:
-        rng = np.random.default_rng(seed)
         Pyy = Pyy + _hermitian_noise(rng, Pyy, level)
     return SpectralData(w_, Pyy, Puu)
 
@@ -338,7 +346,7 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
     n, m = B.shape
     u_ = _input_series(u, m)
     dt_ = _checks.check_positive_scalar(dt, "dt")
-    level = _noise_level(noise)
+    level, rng = _noise_level(noise), _generator(seed)
     if x0 is None:
         x = np.zeros(n)
     else:
@@ -362,6 +370,5 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
         raise DataError(f"the simulated output overflows at sample {k} (t = {k * dt_:g} s); "
                         f"is the system unstable? (max Re λ(A) = {np.linalg.eigvals(A).real.max():.3g})")
     if level > 0:
-        rng = np.random.default_rng(seed)
         y = y + level * np.std(y, axis=0) * rng.standard_normal(y.shape)
     return IOData(u_, y, dt_)

@@ -17,7 +17,12 @@ __all__ = ["StateSpaceModel", "as_frequencies"]
 
 def as_frequencies(w: Any, name: str = "w") -> np.ndarray:
     """Validate angular frequencies (rad/s): a finite, real 1-D array (a scalar becomes length 1)."""
-    arr = np.asarray(w)
+    if w is None:
+        raise DataError(f"{name} is missing (got None); give angular frequencies in rad/s")
+    try:
+        arr = np.asarray(w)
+    except (TypeError, ValueError):
+        raise DataError(f"{name} must be a 1-D sequence of numbers; got a ragged or non-numeric sequence") from None
     if np.iscomplexobj(arr):
         raise DataError(f"{name} must be real angular frequencies in rad/s; got complex values")
     try:
@@ -42,12 +47,15 @@ class StateSpaceModel(ParametricModel):
     ----------
     A, B, C : array_like or sympy.Matrix
         System matrices of shapes (n, n), (n, m), (p, n). Entries are numbers, sympy
-        expressions or strings parsed by sympy, each affine in the parameters.
+        expressions or strings (:func:`symid.symbols.parse_entry`: every bare name in
+        a string is a real parameter, ``pi`` excepted), each affine in the parameters.
+        A scalar is a 1 x 1 matrix; a 1-D sequence is refused as ambiguous.
     D : array_like or sympy.Matrix, optional
         Feedthrough of shape (p, m); zero when omitted.
-    parameters : sequence of sympy.Symbol or str, optional
-        Fixes the order of θ. By default it is the order of first appearance, row by
-        row, through A, B, C, D.
+    parameters : sequence of sympy.Symbol or str, or str, optional
+        Fixes the order of θ (a string is split at spaces and commas). By default it
+        is the order of first appearance, row by row, through A, B, C, D (within one
+        entry, sympy's canonical order: alphabetical for plain names).
     name : str, optional
         A label used in reports.
 
@@ -101,7 +109,30 @@ class StateSpaceModel(ParametricModel):
         return f"{self.n_states} states, {self.n_inputs} input(s), {self.n_outputs} output(s)"
 
     def state_space(self, theta: Theta) -> StateSpaceMatrices:
-        """Numeric matrices (A, B, C, D) at θ."""
+        """Numeric matrices (A, B, C, D) at θ.
+
+        Parameters
+        ----------
+        theta : dict or sequence of float
+            Parameter values by name (or symbol), or in ``parameter_names`` order.
+
+        Returns
+        -------
+        StateSpaceMatrices
+            Named tuple of float arrays ``A`` (n, n), ``B`` (n, m), ``C`` (p, n), ``D`` (p, m).
+
+        Raises
+        ------
+        ModelError
+            On a missing, unknown or non-finite parameter value.
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> a = si.parameters("a")
+        >>> si.StateSpaceModel(A=[[-a]], B=[[1]], C=[[2]]).state_space({"a": 3.0}).A
+        array([[-3.]])
+        """
         mats = self.matrices(theta)
         return StateSpaceMatrices(mats["A"], mats["B"], mats["C"], mats["D"])
 
@@ -113,10 +144,32 @@ class StateSpaceModel(ParametricModel):
     def frequency_response(self, theta: Theta, w: Any) -> np.ndarray:
         """Frequency response H(ω) = C (jωI − A)⁻¹ B + D at angular frequencies ``w`` (rad/s).
 
+        Parameters
+        ----------
+        theta : dict or sequence of float
+            Parameter values by name (or symbol), or in ``parameter_names`` order.
+        w : array_like
+            Real angular frequencies in rad/s (any order and sign; a scalar is one frequency).
+
         Returns
         -------
         numpy.ndarray
             Complex array of shape (len(w), p, m).
+
+        Raises
+        ------
+        ModelError
+            On bad θ, or if jωI − A is singular at one of the frequencies.
+        DataError
+            If ``w`` is missing, complex, not 1-D or not finite.
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> a = si.parameters("a")
+        >>> model = si.StateSpaceModel(A=[[-a]], B=[[1]], C=[[1]])
+        >>> model.frequency_response([1.0], [0.0, 1.0])[:, 0, 0]   # 1 / (jω + a)
+        array([1. +0.j , 0.5-0.5j])
         """
         ss = self.state_space(theta)
         return frequency_response_ss(ss, as_frequencies(w))

@@ -2,15 +2,21 @@
 
 from __future__ import annotations
 
+import io
+import keyword
+import tokenize
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
 import sympy as sp
+from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
 
 from symid.errors import ModelError
 
-__all__ = ["as_symbolic_matrix", "parameters"]
+__all__ = ["as_symbolic_matrix", "parameters", "parse_entry"]
+
+_TRANSFORMATIONS = (*standard_transformations, convert_xor)  # what sympy.sympify uses for strings
 
 
 def parameters(names: str | Sequence[str], *, positive: bool = False):
@@ -47,6 +53,8 @@ def parameters(names: str | Sequence[str], *, positive: bool = False):
     for p in parts:
         if not p.isidentifier():
             raise ModelError(f"parameter name {p!r} is not a valid identifier")
+        if keyword.iskeyword(p):
+            raise ModelError(f"parameter name {p!r} is a Python keyword; choose another (e.g. {p + '_'!r})")
     if len(set(parts)) != len(parts):
         dup = sorted({p for p in parts if parts.count(p) > 1})
         raise ModelError(f"parameter names are repeated: {', '.join(dup)}")
@@ -55,12 +63,69 @@ def parameters(names: str | Sequence[str], *, positive: bool = False):
     return symbols[0] if len(symbols) == 1 else symbols
 
 
+def _bare_names(text: str) -> set[str]:
+    """Names in ``text`` that are not called (not followed by ``(``); Python keywords are refused."""
+    tokens = [t for t in tokenize.generate_tokens(io.StringIO(text).readline)
+              if t.type not in (tokenize.NL, tokenize.NEWLINE, tokenize.ENDMARKER, tokenize.COMMENT)]
+    names = set()
+    for k, tok in enumerate(tokens):
+        if tok.type != tokenize.NAME:
+            continue
+        if keyword.iskeyword(tok.string):
+            raise SyntaxError(f"the Python keyword {tok.string!r} cannot appear in an entry")
+        if not (k + 1 < len(tokens) and tokens[k + 1].string == "("):
+            names.add(tok.string)
+    return names
+
+
+def parse_entry(text: str, where: str = "entry") -> sp.Expr:
+    """Parse a matrix entry written as a string, every bare name being a real parameter.
+
+    Unlike :func:`sympy.sympify`, a name that is not called as a function is always a
+    symbol, so ``"E*A/L"``, ``"I"``, ``"N"``, ``"S"``, ``"beta"`` or ``"gamma"`` are
+    parameters, not sympy's constants, singletons or special functions (a physical
+    model is more likely to mean Young's modulus than Euler's number by ``E``). The
+    one exception is ``pi`` (π); write ``exp(1)`` for e. Names followed by ``(`` are
+    functions (``sin(a)``, ``sqrt(2)``). ``^`` means a power, as in sympy.
+
+    Parameters
+    ----------
+    text : str
+        The entry, e.g. ``"c1 + c2"``.
+    where : str, optional
+        Where the entry sits, for error messages (``"A[1, 0]"``).
+
+    Returns
+    -------
+    sympy.Expr
+        The expression; its symbols are real (``real=True``).
+
+    Raises
+    ------
+    ModelError
+        If the text cannot be parsed or does not give an expression.
+
+    Examples
+    --------
+    >>> from symid.symbols import parse_entry
+    >>> expr = parse_entry("E*I/L**3 + pi")
+    >>> sorted(map(str, expr.free_symbols))
+    ['E', 'I', 'L']
+    """
+    try:
+        names = _bare_names(text)
+        local = {n: sp.Symbol(n, real=True) for n in names if n != "pi"}
+        out = parse_expr(text, local_dict=local, transformations=_TRANSFORMATIONS)
+    except (sp.SympifyError, SyntaxError, TypeError, ValueError, AttributeError, tokenize.TokenError) as exc:
+        raise ModelError(f"{where} = {text!r} cannot be parsed by sympy: {exc}") from None
+    if not isinstance(out, sp.Expr):
+        raise ModelError(f"{where} = {text!r} is not an expression (sympy reads it as {type(out).__name__})")
+    return out
+
+
 def _entry(value: Any, name: str, i: int, j: int) -> sp.Expr:
     if isinstance(value, str):
-        try:
-            return sp.sympify(value)
-        except (sp.SympifyError, SyntaxError, TypeError) as exc:
-            raise ModelError(f"{name}[{i}, {j}] = {value!r} cannot be parsed by sympy: {exc}") from None
+        return parse_entry(value, f"{name}[{i}, {j}]")
     if isinstance(value, (bool, np.bool_)):
         raise ModelError(f"{name}[{i}, {j}] is a boolean ({value}); expected a number or expression")
     if isinstance(value, (np.floating, np.integer, np.complexfloating)):
@@ -70,9 +135,12 @@ def _entry(value: Any, name: str, i: int, j: int) -> sp.Expr:
             raise ModelError(f"{name}[{i}, {j}] is {value}; entries must be finite")
         return sp.Float(value)
     try:
-        out = sp.sympify(value)
+        out = sp.sympify(value, strict=True)
     except (sp.SympifyError, SyntaxError, TypeError):
         raise ModelError(f"{name}[{i}, {j}] = {value!r} is neither a number nor a sympy expression") from None
+    if not isinstance(out, sp.Expr):
+        raise ModelError(f"{name}[{i}, {j}] = {value!r} is not a number or an expression "
+                         f"(sympy reads it as {type(out).__name__})")
     if out.has(sp.oo, -sp.oo, sp.zoo, sp.nan):
         raise ModelError(f"{name}[{i}, {j}] = {out} is not finite")
     return out

@@ -96,6 +96,8 @@ INVALID = [
     ("IO y 3-D", lambda: IOData(U, Y[:, :, None], 0.1), "y must have shape (N, p)"),
     ("IO one sample", lambda: IOData(U[:1], Y[:1], 0.1), "at least 2 samples"),
     ("IO row instead of column", lambda: IOData(np.ones((1, 50)), np.ones((1, 50)), 0.1), "got N = 1"),
+    ("IO transposed", lambda: IOData(U.T, Y.T[:2], 0.1), "u has shape (2, 50): 50 channels but only 2 samples"),
+    ("IO y transposed", lambda: IOData(U[:3], Y.T, 0.1), "y has shape (3, 50): 50 channels but only 3 samples"),
     ("IO complex u", lambda: IOData(U + 1j, Y, 0.1), "u must be real"),
     ("IO dt zero", lambda: IOData(U, Y, 0.0), "dt must be a finite number > 0"),
     ("IO dt negative", lambda: IOData(U, Y, -0.1), "dt must be a finite number > 0"),
@@ -123,6 +125,13 @@ def test_invalid_input_raises_data_error_naming_the_problem(label, make, phrase)
         make()
     assert phrase in str(info.value), str(info.value)
     assert isinstance(info.value, ValueError)
+
+
+def test_hermitian_check_does_not_overflow_on_huge_spectra():
+    skew = np.array([[1.0, 2.0], [0.0, 1.0]])
+    with pytest.raises(DataError, match=r"Phi_yy\[0\] is not Hermitian"):
+        SpectralData(W, 1e200 * np.broadcast_to(skew, (4, 2, 2)), np.ones(4))  # ||Φ||_F² would overflow
+    SpectralData(W, 1e300 * np.broadcast_to(skew + skew.T, (4, 2, 2)), np.ones(4))
 
 
 def test_hermitian_tolerance_is_relative_to_the_norm():
@@ -383,7 +392,7 @@ def _frequency_data(draw):
 
 @st.composite
 def _io_data(draw):
-    N, m, p = draw(st.integers(2, 8)), draw(st.integers(1, 3)), draw(st.integers(1, 3))
+    N, m, p = draw(st.integers(3, 8)), draw(st.integers(1, 3)), draw(st.integers(1, 3))  # N >= channels
     u = draw(hnp.arrays(np.float64, (N, m), elements=_finite))
     y = draw(hnp.arrays(np.float64, (N, p), elements=_finite))
     return IOData(u, y, draw(_positive))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -103,9 +105,32 @@ def test_non_affine_entry_is_named(entry, involved):
         assert p in msg
 
 
-def test_non_affine_hint_for_inverse_mass():
-    with pytest.raises(si.NonAffineError, match=r"minv = 1/m"):
-        si.SecondOrderModel(M=[[1]], V=[["c/m"]], K=[[1]], B=[[1]], C=[[1]])
+@pytest.mark.parametrize("entry, hint", [
+    ("1/m", "introduce a new parameter such as `minv = 1/m`"),  # issue 2's example
+    ("1 + 2/m", "introduce a new parameter such as `minv = 1/m`"),  # affine in minv
+    ("c/m", "introduce a new parameter for the whole ratio (for example `r = c/m`)"),  # c*minv is not affine
+    ("1/(a + b)", "introduce a new parameter for the whole ratio (for example `r = 1/(a + b)`)"),
+    ("k*c", "introduce a new parameter for the nonlinear combination of c, k (for example `ck = c*k`"),
+    ("sin(a)", "introduce a new parameter for the nonlinear function of a (for example `f = sin(a)`)"),
+])
+def test_non_affine_hint(entry, hint):
+    with pytest.raises(si.NonAffineError) as info:
+        si.SecondOrderModel(M=[[1]], V=[[entry]], K=[[1]], B=[[1]], C=[[1]])
+    assert info.value.matrix == "V" and info.value.entry == (0, 0)
+    assert f"Hint: {hint}" in str(info.value), str(info.value)
+
+
+@pytest.mark.parametrize("where", ["M", "V", "K", "B", "C"])
+def test_non_affine_entry_named_in_every_second_order_matrix(where):
+    k, c = si.parameters("k c", positive=True)
+    mats = {"M": [[1, 0], [0, 1]], "V": [[c, 0], [0, c]], "K": [[k, 0], [0, k]], "B": [[1], [0]], "C": [[1, 0]]}
+    rows, cols = len(mats[where]), len(mats[where][0])
+    mats[where] = [[0] * cols for _ in range(rows)]
+    mats[where][rows - 1][cols - 1] = k * c
+    with pytest.raises(si.NonAffineError) as info:
+        si.SecondOrderModel(**mats)
+    assert (info.value.matrix, info.value.entry, info.value.parameters) == (where, (rows - 1, cols - 1), ("c", "k"))
+    assert f"matrix {where}, entry ({rows - 1}, {cols - 1}) = c*k" in str(info.value)
 
 
 def test_non_affine_in_B_named():
@@ -155,6 +180,96 @@ def test_affine_maps_equal_substitution(case):
         assert sp.simplify(model.maps[name].symbolic() - X) == sp.zeros(*X.shape)
 
 
+_SYMS = sp.symbols("t0 t1 t2", real=True)
+
+
+@st.composite
+def _entry_affine_in_disguise(draw):
+    """An affine entry written the way people write them: factored, with cancelling nonlinear terms,
+    Float coefficients, constants such as pi; returned as a sympy expression or as its string."""
+    q = sp.Rational(draw(st.integers(-3, 3)), draw(st.integers(1, 3)))
+    s1, s2 = draw(st.sampled_from(_SYMS)), draw(st.sampled_from(_SYMS))
+    forms = [
+        q * (s1 + 2 * s2) - 2 * q * s2,  # q s1, unexpanded
+        (s1 + q) ** 2 - s1**2,  # 2 q s1 + q²: the square cancels
+        s1 * (s2 + 1) - s1 * s2 + sp.Float(draw(st.floats(-2, 2, allow_nan=False))) * s1,  # product cancels
+        sp.pi * s1 / 4 + sp.sqrt(2),
+        sp.sin(s2) ** 2 + sp.cos(s2) ** 2 + q * s1,  # constant 1 plus q s1, after simplification
+    ]
+    expr = draw(st.sampled_from(forms))
+    return str(expr) if draw(st.booleans()) else expr
+
+
+@settings(max_examples=60, deadline=None)
+@given(entries=st.lists(_entry_affine_in_disguise(), min_size=4, max_size=4),
+       theta=st.lists(st.floats(-5, 5, allow_nan=False), min_size=3, max_size=3))
+def test_affine_maps_of_disguised_affine_entries_equal_substitution(entries, theta):
+    """Property: maps of entries written unexpanded (or as strings) still equal substitution."""
+    model = si.StateSpaceModel(A=[entries[:2], entries[2:]], B=[[1], ["t0 + t1 + t2"]], C=[[1, 0]],
+                               parameters=["t0", "t1", "t2"])
+    values = dict(zip(model.parameters, theta, strict=True))
+    expected = np.array(model.symbolic["A"].subs(values).evalf(), dtype=float)
+    np.testing.assert_allclose(model.maps["A"](theta), expected, rtol=1e-12, atol=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(case=random_affine_model(), data=st.data())
+def test_non_affine_term_anywhere_is_refused_and_located(case, data):
+    """Property: adding one non-affine term to one entry of a random affine model raises NonAffineError
+    naming that matrix, that entry and the parameters of the term."""
+    A, B, C, D, syms, _ = case
+    mats = {"A": A.copy(), "B": B.copy(), "C": C.copy(), "D": D.copy()}
+    name = data.draw(st.sampled_from("ABCD"))
+    i = data.draw(st.integers(0, mats[name].rows - 1))
+    j = data.draw(st.integers(0, mats[name].cols - 1))
+    s1, s2 = data.draw(st.sampled_from(syms)), data.draw(st.sampled_from(syms))
+    term = data.draw(st.sampled_from([s1 * s2, 1 / s1, sp.sin(s1), sp.exp(s2)]))
+    mats[name][i, j] += data.draw(st.sampled_from([1, -2, sp.Rational(1, 3)])) * term
+    with pytest.raises(si.NonAffineError) as info:
+        si.StateSpaceModel(**mats)
+    err = info.value
+    assert (err.matrix, err.entry) == (name, (i, j))
+    assert set(err.parameters) == {str(s) for s in term.free_symbols}
+    assert "Hint: introduce a new parameter" in str(err)
+
+
+# -- string entries ------------------------------------------------------------------------------
+
+def test_string_entries_are_real_parameters_even_with_sympy_names():
+    # E (Young's modulus), I (second moment), N, S, beta, gamma: sympy would read constants or functions
+    model = si.StateSpaceModel(A=[["-E - 2*I - N"]], B=[["beta + S"]], C=[["gamma"]])
+    assert model.parameter_names == ("E", "I", "N", "S", "beta", "gamma")
+    assert all(p.is_real for p in model.parameters)
+    ss = model.state_space([2.0, 3.0, 1.0, 0.5, 0.25, 4.0])
+    np.testing.assert_array_equal(ss.A, [[-9.0]])  # −E − 2I − N, by hand
+    np.testing.assert_array_equal(ss.B, [[0.75]])
+    np.testing.assert_array_equal(ss.C, [[4.0]])
+
+
+def test_string_entries_keep_pi_functions_and_powers():
+    model = si.StateSpaceModel(A=[["-pi*a + sqrt(4) + exp(0) + 2^3"]], B=[[1]], C=[[1]])
+    assert model.parameter_names == ("a",)
+    np.testing.assert_allclose(model.state_space([1.0]).A, [[-np.pi + 2 + 1 + 8]], rtol=1e-15)
+
+
+@pytest.mark.parametrize("text, phrase", [
+    ("a if b else c", "Python keyword 'if'"), ("lambda", "Python keyword 'lambda'"), ("a +", "cannot be parsed"),
+    ("(a", "cannot be parsed"), ("", "cannot be parsed"), ("'a'", "is not an expression")])
+def test_bad_string_entries(text, phrase):
+    with pytest.raises(si.ModelError, match=re.escape(phrase)):
+        si.StateSpaceModel(A=[[text]], B=[[1]], C=[[1]])
+
+
+def test_keyword_parameter_name_is_refused():
+    with pytest.raises(si.ModelError, match="is a Python keyword"):
+        si.parameters("lambda mu")
+
+
+def test_parameter_order_given_as_a_string():
+    model = si.StateSpaceModel(A=[["-a"]], B=[["b"]], C=[["c"]], parameters="c, a b")
+    assert model.parameter_names == ("c", "a", "b")
+
+
 # -- theta handling --------------------------------------------------------------------------
 
 def test_theta_as_dict_or_sequence():
@@ -197,6 +312,48 @@ def test_second_order_response_matches_first_order(output):
     np.testing.assert_allclose(H_direct, H_ss, rtol=1e-10, atol=0)
 
 
+@pytest.mark.parametrize("output", ["position", "velocity", "acceleration"])
+def test_second_order_response_matches_first_order_mimo_nondiagonal_mass(output):
+    """The 3-DOF system of thesis (7-17): non-diagonal M, 2 inputs, 2 outputs."""
+    entry = si.load_model("msd3_similarity")
+    s = entry.model.symbolic
+    model = si.SecondOrderModel(s["M"], s["V"], s["K"], s["B"], s["C"], output=output,
+                                parameters=entry.model.parameters)
+    w = np.logspace(-1, 2, 170)  # the band of thesis §5-6 for the same M, V, K
+    H_direct = model.frequency_response(entry.truth, w)
+    H_ss = frequency_response_ss(model.state_space(entry.truth), w)
+    assert H_direct.shape == (170, 2, 2)
+    np.testing.assert_allclose(H_direct, H_ss, rtol=1e-10, atol=0)
+
+
+@st.composite
+def _second_order_system(draw):
+    n, m, p = draw(st.integers(1, 3)), draw(st.integers(1, 2)), draw(st.integers(1, 2))
+    unit = st.floats(-1, 1, allow_nan=False)
+
+    def mat(r, c):
+        return np.array(draw(st.lists(unit, min_size=r * c, max_size=r * c))).reshape(r, c)
+
+    def spd():
+        L = mat(n, n)
+        return L @ L.T + 0.5 * np.eye(n)  # symmetric positive definite, eigenvalues >= 0.5
+
+    return spd(), spd(), spd(), mat(n, m), mat(p, n), draw(st.sampled_from(["position", "velocity", "acceleration"]))
+
+
+@settings(max_examples=60, deadline=None)
+@given(_second_order_system())
+def test_second_order_response_matches_first_order_property(system):
+    """Property: C(−ω²M + jωV + K)⁻¹B (times jω or −ω²) equals C(jωI − A)⁻¹B + D of the form (7-2)."""
+    M, V, K, B, C, output = system
+    model = si.SecondOrderModel(M, V, K, B, C, output=output)
+    w = np.logspace(-1, 1, 25)
+    H_direct = model.frequency_response([], w)
+    H_ss = frequency_response_ss(model.state_space([]), w)
+    err = np.linalg.norm(H_direct - H_ss, axis=(1, 2))
+    assert np.all(err <= 1e-10 * np.linalg.norm(H_ss, axis=(1, 2))), err.max()
+
+
 def test_acceleration_output_has_feedthrough_and_factor():
     pos, acc = two_dof("position"), two_dof("acceleration")
     w = np.array([0.3, 1.0, 5.0])
@@ -237,7 +394,8 @@ def test_symbolic_state_space_agrees_with_numeric():
     (dict(A=[[float("nan")]], B=[[1]], C=[[1]]), "finite"),
     (dict(A=[["a +"]], B=[[1]], C=[[1]]), "cannot be parsed"),
     (dict(A=[[1]], B=[[1]], C=[[1]], D=[[1, 2]]), "D has shape"),
-    (dict(A=[["I*a"]], B=[[1]], C=[[1]]), "must be real"),
+    (dict(A=[[sp.I * sp.Symbol("a", real=True)]], B=[[1]], C=[[1]]), "must be real"),
+    (dict(A=[[2j]], B=[[1]], C=[[1]]), "must be real"),
 ])
 def test_malformed_state_space(kwargs, phrase):
     with pytest.raises(si.ModelError, match=phrase):
@@ -255,6 +413,8 @@ def test_bad_output_kind_and_singular_mass():
 
 def test_frequency_errors():
     model = two_dof()
+    with pytest.raises(si.DataError, match="w is missing"):
+        model.frequency_response(TRUTH_2DOF, None)
     with pytest.raises(si.DataError, match="NaN or inf"):
         model.frequency_response(TRUTH_2DOF, [1.0, np.nan])
     with pytest.raises(si.DataError, match="1-D"):

@@ -277,3 +277,20 @@ def test_io_noise_reproducible_and_sized(statespace):
     np.testing.assert_array_equal(a.u, exact.u)
     ratio = np.std(a.y - exact.y, axis=0) / np.std(exact.y, axis=0)
     np.testing.assert_allclose(ratio, [0.02, 0.02], rtol=0.1)
+
+
+@pytest.mark.parametrize("seed", ["a", 1.5, -1, True, [1, 2]])
+@pytest.mark.parametrize("noise", [0.0, 0.1])
+def test_bad_seed_is_a_data_error_even_without_noise(siso, seed, noise):
+    model, th = siso
+    for simulate in (lambda: si.simulate_frf(model, th, W, noise=noise, seed=seed),
+                     lambda: si.simulate_spectra(model, th, W, 1.0, noise=noise, seed=seed),
+                     lambda: si.simulate_io(model, th, np.ones(10), 0.1, noise=noise, seed=seed)):
+        with pytest.raises(DataError, match=r"seed must be None, an int >= 0 or a numpy\.random\.Generator"):
+            simulate()
+
+
+def test_numpy_integer_seed_is_accepted(siso):
+    model, th = siso
+    assert si.simulate_frf(model, th, W, noise=0.1, seed=np.int64(4)) == si.simulate_frf(model, th, W, noise=0.1,
+                                                                                          seed=4)

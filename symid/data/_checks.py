@@ -130,8 +130,15 @@ def frequencies(w: Any, name: str = "w") -> np.ndarray:
 
 def check_hermitian(Phi: np.ndarray, name: str, rtol: float = HERMITIAN_RTOL) -> None:
     """Raise unless every ``Phi[i]`` (shape (s, k, k)) is Hermitian to ``rtol`` relative to its norm."""
-    dev = np.abs(Phi - np.conj(np.swapaxes(Phi, -1, -2))).max(axis=(-1, -2))
-    scale = np.linalg.norm(Phi, axis=(-1, -2))
+    # each matrix is divided by its largest real or imaginary part first, so that |Φ − Φᴴ| and ||Φ||_F
+    # can neither overflow nor underflow; real and imaginary parts are divided separately (a complex
+    # division by a subnormal number overflows inside numpy)
+    big = np.maximum(np.abs(Phi.real), np.abs(Phi.imag)).max(axis=(-1, -2))
+    div = np.where(big > 0, big, 1.0)[..., None, None]
+    unit = np.empty(Phi.shape, dtype=np.complex128)
+    unit.real, unit.imag = Phi.real / div, Phi.imag / div
+    dev = np.abs(unit - np.conj(np.swapaxes(unit, -1, -2))).max(axis=(-1, -2)) * big
+    scale = np.linalg.norm(unit, axis=(-1, -2)) * big
     bad = np.flatnonzero(dev > rtol * scale)
     if bad.size:
         i = int(bad[0])

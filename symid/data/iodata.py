@@ -44,12 +44,13 @@ class IOData(DataContainer):
     ------
     DataError
         On NaN or inf, wrong shapes, ``u`` and ``y`` of different lengths, fewer than
-        two samples, or a ``dt`` that is not a finite positive number.
+        two samples, more channels than samples, or a ``dt`` that is not a finite
+        positive number.
 
     Notes
     -----
-    A 2-D array is always read as (samples, channels): an input of shape (1, N) is one
-    sample of N channels and is refused for being shorter than two samples, not
+    A 2-D array is always read as (samples, channels), never transposed silently: an
+    array with more channels than samples, such as (2, 5000), is refused as probably
     transposed.
 
     CSV layout (see :meth:`to_csv`)::
@@ -88,6 +89,11 @@ class IOData(DataContainer):
                             f"(shape {_checks.shape_text(y_.shape)})")
         if u_.shape[0] < 2:
             raise DataError(f"u and y must hold at least 2 samples (rows); got N = {u_.shape[0]}")
+        for label, arr in (("u", u_), ("y", y_)):
+            if arr.shape[1] > arr.shape[0]:
+                raise DataError(f"{label} has shape {_checks.shape_text(arr.shape)}: {arr.shape[1]} channels but only "
+                                f"{arr.shape[0]} samples; arrays are (samples, channels), one row per sample "
+                                f"(pass {label}.T if you have one row per channel)")
         dt_ = _checks.check_positive_scalar(dt, "dt")
         object.__setattr__(self, "u", _checks.frozen(u_))
         object.__setattr__(self, "y", _checks.frozen(y_))
