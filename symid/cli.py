@@ -184,8 +184,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "solutions, identifiable combinations and a reparameterisation.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     p.add_argument("--timeout", type=float, default=30.0, metavar="S",
-                   help="deadline of the global (Gröbner) step in seconds; after it the local verdict is "
-                        "reported and the global one marked undetermined (default: 30)")
+                   help="time budget of the analysis in seconds; if the global (Gröbner) step does not finish "
+                        "in it, the local verdict is reported and the global one marked undetermined (default: 30)")
     p.add_argument("--known", nargs="*", metavar="NAME=VALUE", help="parameters taken as known")
     p.add_argument("--positive", choices=("declared", "all", "ignore"), default="declared",
                    help="discard solutions with non-positive values of the parameters declared positive "

@@ -7,7 +7,10 @@ recovered from noise-free input-output data: per parameter "global", "local" or
 Modules: :mod:`~symid.structural.summary` (exhaustive summary),
 :mod:`~symid.structural.local` (exact Jacobian rank),
 :mod:`~symid.structural.global_` (Gröbner basis, solution count),
+:mod:`~symid.structural.witness` (numerical second solutions when the basis does not finish),
 :mod:`~symid.structural.combinations`, :mod:`~symid.structural.report`,
+:mod:`~symid.structural.numeric` (floating-point screen for large models),
+:mod:`~symid.structural.order` (memoised grevlex for sympy's Gröbner bases),
 :mod:`~symid.structural.deadline` (timeout without hangs).
 """
 

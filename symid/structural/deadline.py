@@ -43,6 +43,8 @@ def _run_signal(fn, kwargs, timeout):
         return "ok", fn(**kwargs)
     except DeadlineExceeded:
         return "timeout", None
+    except Exception as exc:
+        return "error", f"{type(exc).__name__}: {exc}"
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old_handler)
@@ -100,8 +102,8 @@ def run_with_deadline(fn: Callable[..., Any], kwargs: Mapping[str, Any], timeout
     Returns
     -------
     (status, value)
-        ``("ok", result)``, ``("timeout", None)`` or, for the process isolation,
-        ``("error", message)`` when the computation raised.
+        ``("ok", result)``, ``("timeout", None)`` or ``("error", message)`` when the
+        computation raised an exception (``"ExceptionName: message"``).
 
     Examples
     --------
@@ -110,7 +112,10 @@ def run_with_deadline(fn: Callable[..., Any], kwargs: Mapping[str, Any], timeout
     ('ok', {'a': 1})
     """
     if timeout is None:
-        return "ok", fn(**kwargs)
+        try:
+            return "ok", fn(**kwargs)
+        except Exception as exc:
+            return "error", f"{type(exc).__name__}: {exc}"
     if isolation == "auto":
         isolation = "signal" if _signal_available() else "process"
     if isolation == "signal":

@@ -39,10 +39,10 @@ import sympy as sp
 from sympy import QQ
 from sympy.polys.groebnertools import groebner
 from sympy.polys.matrices import DomainMatrix
-from sympy.polys.orderings import grevlex
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
 from symid.errors import ModelError
+from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
     KIND_TF,
     exhaustive_summary,
@@ -52,7 +52,7 @@ from symid.structural.summary import (
     model_matrices,
 )
 
-__all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "GlobalResult", "global_analysis"]
+__all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "GlobalResult", "global_analysis", "star_and_summary"]
 
 REAL_TOL = 1e-7
 """Relative tolerance on a parameter value when comparing numerical solutions to θ*."""
@@ -73,7 +73,7 @@ class GlobalResult:
     summary_labels : tuple of str
         Labels of the non-constant summary entries.
     summary_expressions : tuple of sympy.Expr
-        The summary entries (rational in θ).
+        The summary entries (rational in θ); empty unless ``expressions=True``.
     theta_star : dict of str to sympy.Rational
         The random point.
     zero_dimensional : bool
@@ -92,7 +92,7 @@ class GlobalResult:
         Per free parameter: a single value over the complex, real, admissible solutions.
     candidates : tuple of sympy.Expr
         Identifiable-function candidates read off the Gröbner basis (non-constant parts
-        of basis elements free of the saturation variable).
+        of basis elements free of the saturation variable); empty unless ``expressions=True``.
     membership : tuple of bool
         For each extra candidate passed in: f(θ) − f(θ*) lies in the ideal.
     groebner_size : int
@@ -134,6 +134,26 @@ def _pick_theta_star(model, mats, kind, output, params, rng: random.Random):
         if is_minimal_at(mats, kind, output, params, pt):
             return pt, True
     return pt, False
+
+
+def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: int = 0):
+    """The random point θ* of the global step and the exhaustive summary built for it.
+
+    Returns
+    -------
+    (params, star, minimal, summary, rng)
+        Free parameters, θ* (sympy Integers), whether the realisation is minimal there,
+        the :class:`~symid.structural.summary.ExhaustiveSummary` and the seeded
+        generator, advanced past θ* (for later random choices).
+    """
+    kind = model_kind(model)
+    output = getattr(model, "output", None)
+    mats = model_matrices(model, known)
+    params = free_parameters(model, known)
+    rng = random.Random(10_007 + seed)
+    star, minimal = _pick_theta_star(model, mats, kind, output, params, rng)
+    summ = exhaustive_summary(model, known, check_point=star)
+    return params, star, minimal, summ, rng
 
 
 def _lift(p: PolyElement, R: PolyRing) -> PolyElement:
@@ -211,13 +231,14 @@ def _in_radical(G, R: PolyRing, f: PolyElement) -> bool:
     if f.rem(G) == R.zero:
         return True
     y = sp.Dummy("y")
-    Ry = ring([*R.symbols, y], QQ, grevlex)[0]
+    Ry = ring([*R.symbols, y], QQ, grevlex_memo)[0]
     Gy = [g.set_ring(Ry) for g in G] + [Ry.one - Ry.gens[-1] * f.set_ring(Ry)]
     return groebner(Gy, Ry) == [Ry.one]
 
 
 def global_analysis(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
-                    seed: int = 0, extra_candidates: Sequence[sp.Expr] = ()) -> GlobalResult:
+                    seed: int = 0, extra_candidates: Sequence[sp.Expr] = (), expressions: bool = True
+                    ) -> GlobalResult:
     """Solve summary(θ) = summary(θ*) exactly at a random rational θ* and classify the solutions.
 
     Parameters
@@ -232,6 +253,10 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
         Seed of θ*.
     extra_candidates : sequence of sympy.Expr
         Functions of θ whose membership f(θ) − f(θ*) ∈ ideal is checked.
+    expressions : bool
+        Return the summary entries and the Gröbner-basis candidates as sympy
+        expressions (needed only for the combinations of a non-identifiable model;
+        building them is a noticeable part of the run on large models).
 
     Returns
     -------
@@ -249,16 +274,10 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     """
     times = {}
     t0 = time.perf_counter()
-    kind = model_kind(model)
-    output = getattr(model, "output", None)
-    mats = model_matrices(model, known)
-    params = free_parameters(model, known)
+    params, star, minimal, summ, rng = star_and_summary(model, known, seed=seed)
     names = [p.name for p in params]
     positive = list(positive) if positive is not None else [False] * len(params)
-    rng = random.Random(10_007 + seed)
-    star, minimal = _pick_theta_star(model, mats, kind, output, params, rng)
     theta_star = dict(zip(names, star, strict=True))
-    summ = exhaustive_summary(model, known, check_point=star)
     times["summary"] = time.perf_counter() - t0
     notes = []
     if not minimal:
@@ -273,23 +292,13 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     t1 = time.perf_counter()
     R0 = summ.ring
     tsym = sp.Dummy("t")
-    nonconst_den = [d for d in summ.denominators if not d.is_ground]
-    sat = None
-    if nonconst_den:
-        sat = nonconst_den[0]
-        for d in nonconst_den[1:]:
-            sat = sat.lcm(d)
-        sat = sat.sqf_part()
-        R = ring([*params, tsym], QQ, grevlex)[0]
-    else:
-        R = ring(list(params), QQ, grevlex)[0]
     pt = [QQ.from_sympy(v) for v in star]
     eqs = []
     L = summ.normaliser
     if L is not None and not L.is_ground:
         # common normaliser: N_i(θ) = λ N_i(θ*), L(θ) = λ L(θ*), t λ = 1 (fewer terms than cross-multiplying)
         lam = sp.Dummy("lam")
-        R = ring([*params, lam, tsym], QQ, grevlex)[0]
+        R = ring([*params, lam, tsym], QQ, grevlex_memo)[0]
         lamR, tR = R.gens[-2], R.gens[-1]
         for num, den in [*zip(summ.numerators, summ.denominators, strict=True), (L, L)]:
             raw = num * L.exquo(den)
@@ -297,6 +306,16 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
         eqs.append(tR * lamR - R.one)
         aux = 2
     else:
+        nonconst_den = [d for d in summ.denominators if not d.is_ground]
+        sat = None
+        if nonconst_den:
+            sat = nonconst_den[0]
+            for d in nonconst_den[1:]:
+                sat = sat.lcm(d)
+            sat = sat.sqf_part()
+            R = ring([*params, tsym], QQ, grevlex_memo)[0]
+        else:
+            R = ring(list(params), QQ, grevlex_memo)[0]
         aux = 1 if sat is not None else 0
         for num, den in zip(summ.numerators, summ.denominators, strict=True):
             e = num * den(*pt) - den * num(*pt)
@@ -314,7 +333,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
 
     # -- candidates for identifiable functions from the basis ---------------------
     cands = []
-    for g in G:
+    for g in G if expressions else ():
         if any(g.degree(R.gens[-1 - i]) > 0 for i in range(aux)):
             continue
         f = g - g.const()
@@ -390,7 +409,8 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
                 glob_r[name] = single(real_sols, name, i)
                 glob_a[name] = single(sols, name, i)
     times["solutions"] = time.perf_counter() - t2
-    return GlobalResult(summ.kind, summ.labels, tuple(summ.expressions()), theta_star, zero_dim, n_c, n_r, n_a,
+    summary_exprs = tuple(summ.expressions()) if expressions else ()
+    return GlobalResult(summ.kind, summ.labels, summary_exprs, theta_star, zero_dim, n_c, n_r, n_a,
                         tuple(sols), tuple(real_sols), glob_c, glob_r, glob_a, tuple(cands), membership, len(G),
                         times, tuple(notes))
 

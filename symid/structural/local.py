@@ -1,10 +1,23 @@
-"""Local identifiability: exact rank of the Jacobian of the Markov parameters at random rational points.
+"""Local identifiability: exact rank of the Jacobian of an exhaustive summary at random rational points.
 
-The Markov parameters ``h_k = C Aᵏ B`` (k < 2n) and ``D`` are an exhaustive summary of
-the input-output map. Their Jacobian with respect to θ is computed in forward mode,
-in exact rational arithmetic, at a rational point θ₀ — no symbolic expression is built,
-so the test is cheap enough to run before every estimation. For a second-order model
-the first-order form holds ``M⁻¹``, whose derivative is ``−M⁻¹ (∂M) M⁻¹``.
+The summary used here is the transfer matrix H(s, θ) evaluated at K = 2N + 1 + r
+distinct rational frequencies s₁ … s_K, where N is the order of the first-order form
+(n for a state-space model, 2n for a second-order one) and r the power of s in front of
+a second-order response (0, 1, 2 for position, velocity, acceleration output). It is
+exhaustive in the sense that matters for the Jacobian: a direction δθ leaves every
+H(s_i) unchanged to first order iff it leaves H(·, θ) unchanged, because the first-order
+change δH is a rational function whose numerator has degree at most 2N + r − 1 (state
+space with D: 2N) and vanishes at K points — so the null space, and hence the rank, is
+that of the Jacobian of the Markov parameters C Aᵏ B (k < 2n) and D, at every point.
+
+Evaluating at points avoids matrix powers and, for a second-order model, M⁻¹: with
+X = Z⁻¹B and Y = C Z⁻¹,
+
+- state space, Z = sI − A:  ∂H = ∂C X + Y ∂A X + Y ∂B + ∂D;
+- second order, Z = P(s) = Ms² + Vs + K:  ∂H = sʳ (∂C X − Y ∂P X + Y ∂B), ∂P = s²∂M + s∂V + ∂K,
+
+each ∂ a sparse coefficient matrix of the affine map, so a column costs a few scalar
+products. Everything is exact rational arithmetic at a rational θ₀.
 
 At a random point the rank equals the generic rank with probability one; the test is
 repeated at two independent points and the larger rank is kept (a lower rank can only
@@ -28,6 +41,8 @@ from symid.structural.summary import free_parameters, model_kind, rational
 
 __all__ = ["LocalResult", "jacobian_at", "local_analysis", "random_point"]
 
+_SHIFT = {"position": 0, "velocity": 1, "acceleration": 2}
+
 
 def random_point(rng: random.Random, n: int, *, numerators: tuple[int, int] = (2, 40),
                  denominators: tuple[int, int] = (1, 7)) -> list:
@@ -39,33 +54,60 @@ def _dm(mat: sp.Matrix) -> DomainMatrix:
     return DomainMatrix([[QQ.from_sympy(rational(e)) for e in mat.row(i)] for i in range(mat.rows)], mat.shape, QQ)
 
 
-def _affine_parts(model, known: Mapping[str, object] | None):
-    """Per matrix: exact constant part (known values folded in) and one coefficient per free parameter."""
+def _sparse(mat: sp.Matrix) -> tuple[tuple[int, int, object], ...]:
+    """Nonzero entries ``(row, column, value)`` of an exact matrix, values in QQ."""
+    return tuple((i, j, QQ.from_sympy(rational(mat[i, j]))) for i in range(mat.rows) for j in range(mat.cols)
+                 if mat[i, j] != 0)
+
+
+@dataclass(frozen=True)
+class _Parts:
+    """Per matrix: exact constant part (known values folded in) and sparse coefficients per free parameter."""
+
+    kind: str
+    output: str | None
+    n_order: int
+    constant: dict
+    coefficients: dict
+
+
+def _affine_parts(model, known: Mapping[str, object] | None) -> _Parts:
     known = dict(known or {})
+    kind = model_kind(model)
     free = free_parameters(model, known)
     free_idx = [model.parameters.index(p) for p in free]
-    parts = {}
+    const, coefs = {}, {}
     for name, amap in model.maps.items():
-        const = amap.constant.applyfunc(rational)
+        c = amap.constant.applyfunc(rational)
         for i, p in enumerate(model.parameters):
             if p.name in known:
-                const = const + rational(known[p.name]) * amap.coefficients[i].applyfunc(rational)
-        parts[name] = (_dm(const), [_dm(amap.coefficients[i]) for i in free_idx])
-    return free, parts
+                c = c + rational(known[p.name]) * amap.coefficients[i].applyfunc(rational)
+        const[name] = _dm(c)
+        coefs[name] = [_sparse(amap.coefficients[i]) for i in free_idx]
+    output = getattr(model, "output", None)
+    return _Parts(kind, output, model.n_states, const, coefs)
 
 
-def _at(parts, name, point):
-    X0, Xs = parts[name]
-    X = X0
-    for v, Xi in zip(point, Xs, strict=True):
+def _at(parts: _Parts, name: str, point: Sequence) -> DomainMatrix:
+    X = parts.constant[name].to_list()
+    for v, entries in zip(point, parts.coefficients[name], strict=True):
         if v:
-            X = X + Xi * v
-    return X, Xs
+            for i, j, c in entries:
+                X[i][j] += v * c
+    return DomainMatrix(X, parts.constant[name].shape, QQ)
 
 
-def jacobian_at(model, point: Sequence, known: Mapping[str, object] | None = None, *, _parts=None
-                ) -> DomainMatrix:
-    """Exact Jacobian (rows: entries of h_0..h_{2n−1} and D; columns: free parameters) at ``point``.
+def _frequencies(rng: random.Random, count: int) -> list:
+    """Distinct random rational frequencies (QQ)."""
+    out: set = set()
+    while len(out) < count:
+        out.add(QQ(rng.randint(1, 60), rng.randint(1, 9)))
+    return sorted(out)
+
+
+def jacobian_at(model, point: Sequence, known: Mapping[str, object] | None = None, *,
+                frequencies: Sequence | None = None, _parts: _Parts | None = None) -> DomainMatrix:
+    """Exact Jacobian of H(s_i, θ) (rows: entries at each frequency; columns: free parameters) at ``point``.
 
     Parameters
     ----------
@@ -74,81 +116,80 @@ def jacobian_at(model, point: Sequence, known: Mapping[str, object] | None = Non
         One rational value (``QQ``, int, ``Fraction`` or sympy Rational) per free parameter.
     known : dict, optional
         Fixed parameter values.
+    frequencies : sequence, optional
+        The rational frequencies s_i; default 2N + 1 + r fixed pseudo-random ones.
 
     Raises
     ------
     ModelError
-        If M(θ) is singular at the point (second-order models).
+        If a frequency is a pole at the point (then draw other frequencies).
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.local import jacobian_at
+    >>> a, b = si.parameters("a b")
+    >>> J = jacobian_at(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]]), [1, 2], frequencies=[0, 1, 2])
+    >>> J.to_Matrix()  # H = b / (s + a): ∂H/∂a = −b/(s + a)², ∂H/∂b = 1/(s + a)
+    Matrix([
+    [  -2,   1],
+    [-1/2, 1/2],
+    [-2/9, 1/3]])
     """
-    kind = model_kind(model)
-    if _parts is None:
-        _, parts = _affine_parts(model, known)
-    else:
-        parts = _parts
+    parts = _affine_parts(model, known) if _parts is None else _parts
     point = [QQ.convert(v) if not isinstance(v, sp.Basic) else QQ.from_sympy(v) for v in point]
     npar = len(point)
-    if kind == "state-space":
-        A, dA = _at(parts, "A", point)
-        B, dB = _at(parts, "B", point)
-        C, dC = _at(parts, "C", point)
-        D, dD = _at(parts, "D", point)
+    shift = _SHIFT.get(parts.output, 0)
+    if frequencies is None:
+        frequencies = _frequencies(random.Random(1), 2 * parts.n_order + 1 + shift)
+    if parts.kind == "state-space":
+        A, B, C = (_at(parts, k, point) for k in "ABC")
+        eye = DomainMatrix.eye(A.shape[0], QQ)
     else:
-        M, dM = _at(parts, "M", point)
-        V, dV = _at(parts, "V", point)
-        K, dK = _at(parts, "K", point)
-        B0, dB0 = _at(parts, "B", point)
-        C0, dC0 = _at(parts, "C", point)
-        n = M.shape[0]
+        M, V, K, B, C = (_at(parts, k, point) for k in "MVKBC")
+    co = parts.coefficients
+    p, m = C.shape[0], B.shape[1]
+    rows = []
+    for s in frequencies:
+        s = QQ.convert(s)
+        Z = eye * s - A if parts.kind == "state-space" else M * (s * s) + V * s + K
         try:
-            Mi = M.inv()
-        except Exception:
-            raise ModelError("M(θ) is singular at the test point") from None
-        Z = DomainMatrix.zeros((n, n), QQ)
-        I = DomainMatrix.eye(n, QQ)
-        MiK, MiV = Mi * K, Mi * V
-        A = Z.hstack(I).vstack((-MiK).hstack(-MiV))
-        B = DomainMatrix.zeros(B0.shape, QQ).vstack(Mi * B0)
-        zc = DomainMatrix.zeros(C0.shape, QQ)
-        out = model.output
-        if out == "position":
-            C = C0.hstack(zc)
-        elif out == "velocity":
-            C = zc.hstack(C0)
+            Zi = Z.inv()
+        except Exception:  # sympy raises DMNonInvertibleMatrixError
+            raise ModelError(f"s = {s} is a pole at the test point") from None
+        X, Y = (Zi * B).to_list(), (C * Zi).to_list()
+        if parts.kind == "state-space":
+            dZ = co["A"]
+            scale, sign = QQ(1), QQ(1)
         else:
-            C = (-(C0 * MiK)).hstack(-(C0 * MiV))
-        D = C0 * Mi * B0 if out == "acceleration" else DomainMatrix.zeros((C0.shape[0], B0.shape[1]), QQ)
-        dA, dB, dC, dD = [], [], [], []
-        zb = DomainMatrix.zeros(B0.shape, QQ)
-        for j in range(npar):
-            dMi = -(Mi * dM[j] * Mi)
-            dMiK = dMi * K + Mi * dK[j]
-            dMiV = dMi * V + Mi * dV[j]
-            dA.append(Z.hstack(Z).vstack((-dMiK).hstack(-dMiV)))
-            dB.append(zb.vstack(dMi * B0 + Mi * dB0[j]))
-            if out == "position":
-                dC.append(dC0[j].hstack(zc))
-                dD.append(DomainMatrix.zeros(D.shape, QQ))
-            elif out == "velocity":
-                dC.append(zc.hstack(dC0[j]))
-                dD.append(DomainMatrix.zeros(D.shape, QQ))
-            else:
-                dC.append((-(dC0[j] * MiK + C0 * dMiK)).hstack(-(dC0[j] * MiV + C0 * dMiV)))
-                dD.append(dC0[j] * Mi * B0 + C0 * dMi * B0 + C0 * Mi * dB0[j])
-    nstates = A.shape[0]
-    columns = []
-    for j in range(npar):
-        x, dx = B, dB[j]
-        col = []
-        for _ in range(2 * nstates):
-            dh = dC[j] * x + C * dx
-            col.extend(e for row in dh.to_list() for e in row)
-            dx = dA[j] * x + A * dx
-            x = A * x
-        col.extend(e for row in dD[j].to_list() for e in row)
-        columns.append(col)
-    nrows = len(columns[0]) if columns else 0
-    rows = [[columns[j][i] for j in range(npar)] for i in range(nrows)]
-    return DomainMatrix(rows, (nrows, npar), QQ)
+            dZ = [(*a, *b, *c) for a, b, c in
+                  zip(*[[tuple((i, j, v * f) for i, j, v in e) for e in co[k]] for k, f in
+                        (("M", s * s), ("V", s), ("K", QQ(1)))], strict=True)]
+            scale, sign = s**shift, QQ(-1)
+        block = [[QQ(0)] * npar for _ in range(p * m)]
+        for col in range(npar):
+            dH = [[QQ(0)] * m for _ in range(p)]
+            for i, j, v in co["C"][col]:  # ∂C X
+                for c in range(m):
+                    dH[i][c] += v * X[j][c]
+            for i, j, v in co["B"][col]:  # Y ∂B
+                for r in range(p):
+                    dH[r][j] += v * Y[r][i]
+            for i, j, v in dZ[col]:  # ± Y ∂Z X
+                v = v * sign
+                for r in range(p):
+                    yv = Y[r][i] * v
+                    if yv:
+                        for c in range(m):
+                            dH[r][c] += yv * X[j][c]
+            if parts.kind == "state-space":
+                for i, j, v in co["D"][col]:
+                    dH[i][j] += v
+            for r in range(p):
+                for c in range(m):
+                    block[r * m + c][col] = dH[r][c] * scale
+        rows.extend(block)
+    return DomainMatrix(rows, (len(rows), npar), QQ)
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,28 +249,27 @@ def local_analysis(model, known: Mapping[str, object] | None = None, *, seed: in
     >>> local_analysis(model).identifiable
     (True, True)
     """
-    free, parts = _affine_parts(model, known)
+    free = free_parameters(model, known)
+    parts = _affine_parts(model, known)
+    shift = _SHIFT.get(parts.output, 0)
     rng = random.Random(seed)
     points, ranks, nulls = [], [], []
     for _ in range(n_points):
         for _attempt in range(20):
             pt = random_point(rng, len(free))
+            freqs = _frequencies(rng, 2 * parts.n_order + 1 + shift)
             try:
-                J = jacobian_at(model, pt, known, _parts=parts)
-            except ModelError:
+                J = jacobian_at(model, pt, known, frequencies=freqs, _parts=parts)
+            except ModelError:  # a frequency hit a pole (or M(θ) is singular): draw again
                 continue
             break
         else:
-            raise ModelError("M(θ) is singular at every random test point; is the model degenerate?")
+            raise ModelError("the transfer function has a pole at every random test frequency; "
+                             "is M(θ) singular for every θ?")
         points.append(tuple(pt))
-        if len(free) == 0:
-            ranks.append(0)
-            nulls.append([])
-            continue
-        ranks.append(J.rank())
-        ns = J.nullspace().to_list() if J.shape[0] else [[QQ(int(i == j)) for j in range(len(free))]
-                                                          for i in range(len(free))]
-        nulls.append([list(v) for v in ns])
+        ns = [list(v) for v in J.nullspace().to_list()] if free else []
+        ranks.append(len(free) - len(ns))
+        nulls.append(ns)
     rank = max(ranks)
     best = ranks.index(rank)
     ident = tuple(all(vec[k] == 0 for vec in nulls[best]) for k in range(len(free)))

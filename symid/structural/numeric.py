@@ -16,6 +16,7 @@ singular-value threshold. θ_k is flagged when the null space has a component of
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -33,7 +34,7 @@ class NumericLocalResult:
     rank : int
         Numerical rank.
     n_parameters : int
-        Number of parameters (columns).
+        Number of free parameters (columns).
     not_identifiable : tuple of str
         Parameters with a component in the null space.
     singular_values : numpy.ndarray
@@ -77,12 +78,15 @@ def _jacobian(model: Any, theta: np.ndarray, w: np.ndarray) -> np.ndarray:
     return np.vstack([J.real, J.imag])
 
 
-def numeric_local_check(model: Any, *, w: Any = None, seed: int = 0, rtol: float = 1e-8) -> NumericLocalResult:
+def numeric_local_check(model: Any, *, known: Mapping[str, float] | None = None, w: Any = None, seed: int = 0,
+                        rtol: float = 1e-8) -> NumericLocalResult:
     """Screen a model for locally non-identifiable parameters in floating point.
 
     Parameters
     ----------
     model : StateSpaceModel or SecondOrderModel
+    known : dict of str to float, optional
+        Parameters fixed at these values: their columns are left out.
     w : array_like, optional
         Test frequencies (rad/s); default log-spaced in 0.05–20 rad/s, enough for three
         times as many real equations as parameters and at least 2n + 4 of them.
@@ -104,7 +108,9 @@ def numeric_local_check(model: Any, *, w: Any = None, seed: int = 0, rtol: float
     ('b', 'c')
     """
     l = model.n_parameters
-    if l == 0:
+    known = dict(known or {})
+    free = [k for k, name in enumerate(model.parameter_names) if name not in known]
+    if not free:
         return NumericLocalResult(0, 0, (), np.zeros(0))
     rng = np.random.default_rng(seed)
     if w is None:
@@ -113,24 +119,26 @@ def numeric_local_check(model: Any, *, w: Any = None, seed: int = 0, rtol: float
         freqs = np.logspace(np.log10(0.05), np.log10(20.0), count)
     else:
         freqs = np.asarray(w, dtype=float)
+    fixed = np.array([known.get(name, np.nan) for name in model.parameter_names], dtype=float)
     for _ in range(10):
         theta = rng.uniform(0.5, 2.0, l)
         signs = np.where(np.array(model.positive, dtype=bool), 1.0, rng.choice([-1.0, 1.0], l))
-        theta = theta * signs
+        theta = np.where(np.isnan(fixed), theta * signs, fixed)
         try:
-            J = _jacobian(model, theta, freqs)
+            J = _jacobian(model, theta, freqs)[:, free]
         except np.linalg.LinAlgError:
             continue
         if np.all(np.isfinite(J)):
             break
     else:  # pragma: no cover - degenerate models only
-        return NumericLocalResult(0, l, model.parameter_names, np.zeros(0))
+        return NumericLocalResult(0, len(free), tuple(model.parameter_names[k] for k in free), np.zeros(0))
+    nf = len(free)
     norms = np.linalg.norm(J, axis=0)
     zero_cols = norms == 0
     Js = J / np.where(zero_cols, 1.0, norms)
-    _, s, vt = np.linalg.svd(Js, full_matrices=Js.shape[0] < l)
+    _, s, vt = np.linalg.svd(Js, full_matrices=Js.shape[0] < nf)
     rank = int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
     null = vt[rank:]
     flagged = np.any(np.abs(null) > 1e-6, axis=0) | zero_cols if null.size else zero_cols
-    names = tuple(n for n, f in zip(model.parameter_names, flagged, strict=True) if f)
-    return NumericLocalResult(rank, l, names, s)
+    names = tuple(model.parameter_names[k] for k, f in zip(free, flagged, strict=True) if f)
+    return NumericLocalResult(rank, nf, names, s)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from fractions import Fraction
 from typing import Any
 
 __all__ = ["IdentifiabilityReport", "NecessaryCondition"]
@@ -34,8 +35,14 @@ class NecessaryCondition:
     def __str__(self) -> str:
         sign = "≤" if self.satisfied else ">"
         mark = "satisfied" if self.satisfied else "VIOLATED: cannot be identifiable"
-        return (f"{self.n_parameters} free parameters {sign} n(p+m) = {self.n_states}·({self.n_outputs}+"
-                f"{self.n_inputs}) = {self.bound}: {mark}")
+        if self.satisfied and self.n_parameters == self.bound:
+            mark = "satisfied with equality (the thesis's strict '<' is too strong: see (6-19))"
+        n, p, m = self.n_states, self.n_outputs, self.n_inputs
+        if self.bound == n * (p + m):
+            count = f"n(p+m) = {n}·({p}+{m})"
+        else:  # D carries parameters: p·m more coordinates
+            count = f"n(p+m) + pm = {n}·({p}+{m}) + {p}·{m}"
+        return f"{self.n_parameters} free parameters {sign} {count} = {self.bound}: {mark}"
 
 
 @dataclass(frozen=True)
@@ -89,6 +96,10 @@ class IdentifiabilityReport:
         The random rational point of the global step.
     solutions : tuple of dict
         The admissible solutions (floats), when finitely many.
+    witnesses : tuple of dict
+        When the Gröbner step did not finish: admissible solutions θ ≠ θ* found
+        numerically and verified at 60 digits. Any witness shows the model is not
+        globally identifiable (at least ``1 + len(witnesses)`` solutions).
     timing : dict of str to float
         Wall time (s) of ``local``, ``global`` and ``total``.
     """
@@ -115,6 +126,7 @@ class IdentifiabilityReport:
     notes: tuple[str, ...] = ()
     theta_star: dict[str, str] = field(default_factory=dict)
     solutions: tuple[dict[str, float], ...] = ()
+    witnesses: tuple[dict[str, float], ...] = ()
     timing: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -127,6 +139,16 @@ class IdentifiabilityReport:
         """Parameters that are not locally identifiable."""
         return tuple(p for p in self.parameters if not self.locally_identifiable[p])
 
+    @property
+    def shown_not_global(self) -> tuple[str, ...]:
+        """Parameters that take another value at some numerical witness (so are not globally identifiable)."""
+        out = []
+        for p in self.parameters:
+            ref = float(Fraction(self.theta_star[p])) if p in self.theta_star else None
+            if ref is not None and any(abs(w[p] - ref) > 1e-6 * max(1.0, abs(ref)) for w in self.witnesses):
+                out.append(p)
+        return tuple(out)
+
     def summary(self) -> str:
         """The report as a readable table."""
         L = []
@@ -137,6 +159,9 @@ class IdentifiabilityReport:
             verdict = f"LOCALLY IDENTIFIABLE ({self.n_solutions} solutions)"
         if not self.global_determined and self.verdict == "local":
             verdict = "LOCALLY IDENTIFIABLE (global verdict undetermined)"
+            if self.witnesses:
+                verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE (at least {1 + len(self.witnesses)} solutions; "
+                           "exact count undetermined)")
         L.append(f"verdict            : {verdict}")
         if self.known:
             L.append("known              : " + ", ".join(f"{k} = {v:g}" for k, v in self.known.items()))
@@ -162,10 +187,11 @@ class IdentifiabilityReport:
         width = max([9, *(len(p) for p in self.parameters)])
         L.append(f"  {'parameter':<{width}}  verdict")
         L.append(f"  {'-' * width}  -------")
+        not_global = set(self.shown_not_global)
         for p in self.parameters:
             v = self.verdicts[p]
             if v == "local" and not self.global_determined:
-                v = "local (global undetermined)"
+                v = "local (not global: differs at a witness)" if p in not_global else "local (global undetermined)"
             L.append(f"  {p:<{width}}  {v}")
         if self.combinations:
             L.append("")

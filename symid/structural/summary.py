@@ -32,10 +32,10 @@ from fractions import Fraction
 import sympy as sp
 from sympy import QQ
 from sympy.polys.matrices import DomainMatrix
-from sympy.polys.orderings import grevlex
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
 from symid.errors import ModelError
+from symid.structural.order import grevlex_memo
 
 __all__ = ["ExhaustiveSummary", "exhaustive_summary", "free_parameters", "model_matrices", "rational"]
 
@@ -139,11 +139,8 @@ class ExhaustiveSummary:
         return len(self.numerators)
 
     def expressions(self) -> list[sp.Expr]:
-        """The entries as sympy expressions (rational functions of θ)."""
-        out = []
-        for num, den in zip(self.numerators, self.denominators, strict=True):
-            out.append(sp.cancel(num.as_expr() / den.as_expr()))
-        return out
+        """The entries as sympy expressions (rational functions of θ, numerator and denominator coprime)."""
+        return [num.as_expr() / den.as_expr() for num, den in zip(self.numerators, self.denominators, strict=True)]
 
     def __repr__(self) -> str:
         return f"<ExhaustiveSummary: {len(self)} {self.kind} in {', '.join(p.name for p in self.parameters)}>"
@@ -171,7 +168,7 @@ def first_order_polynomial(mats: dict[str, sp.Matrix], kind: str, output: str | 
         return A, B, C, D, R.one
     M, V, K, B, C = (_poly_matrix(mats[k], R) for k in "MVKBC")
     n = M.shape[0]
-    d = M.det()
+    d = _det(M)
     if d == R.zero:
         raise ModelError("det M(θ) is identically zero; the second-order model is degenerate")
     adjM = M.adjugate()
@@ -231,6 +228,34 @@ def is_minimal_at(mats: dict[str, sp.Matrix], kind: str, output: str | None, par
     return DomainMatrix.vstack(*blocks).rank() == n
 
 
+def _det(mat: DomainMatrix) -> PolyElement:
+    """Determinant of a square polynomial matrix by expansion in minors (division-free).
+
+    Row by row, the minors on every set of columns are built from the previous row's
+    (n·2ⁿ⁻¹ products). sympy's fraction-free elimination divides polynomials exactly at
+    every step, which costs far more for the small matrices (n ≤ 6) of a model.
+    """
+    rows = mat.to_list()
+    n = len(rows)
+    if n == 0:
+        return mat.domain.one
+    minors = {(j,): rows[0][j] for j in range(n)}
+    for r in range(1, n):
+        nxt = {}
+        for cols, val in minors.items():
+            if not val:
+                continue
+            for j in range(n):
+                if j in cols:
+                    continue
+                sign = -1 if sum(1 for c in cols if c > j) % 2 else 1
+                key = tuple(sorted((*cols, j)))
+                term = val * rows[r][j]
+                nxt[key] = nxt.get(key, mat.domain.zero) + (term if sign > 0 else -term)
+        minors = nxt
+    return minors.get(tuple(range(n)), mat.domain.zero)
+
+
 def _coeffs_in_s(p: PolyElement, s_index: int, degree: int) -> list[PolyElement]:
     """Coefficients of s⁰..s^degree of a polynomial of QQ[θ, s], as polynomials of the same ring."""
     out = [p.ring.zero for _ in range(degree + 1)]
@@ -278,7 +303,7 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
     mats = model_matrices(model, known)
     params = free_parameters(model, known)
     names = list(params)
-    R = ring(names, QQ, grevlex)[0] if names else ring([sp.Dummy("_none")], QQ, grevlex)[0]
+    R = ring(names, QQ, grevlex_memo)[0] if names else ring([sp.Dummy("_none")], QQ, grevlex_memo)[0]
     if check_point is None:
         check_point = [sp.Rational(3 + 2 * i, 1 + (i % 3)) for i in range(len(params))]
     minimal = is_minimal_at(mats, mkind, output, params, check_point)
@@ -327,7 +352,7 @@ def _to_ring(p: PolyElement, R: PolyRing, names: list[sp.Symbol]) -> PolyElement
 
 def _tf_summary(mats, mkind, output, params):
     s = sp.Dummy("s")
-    Rs = ring([*params, s], QQ, grevlex)[0]
+    Rs = ring([*params, s], QQ, grevlex_memo)[0]
     si = len(params)
     entries_n, entries_d, labels = [], [], []
     if mkind == "state-space":
@@ -351,7 +376,7 @@ def _tf_summary(mats, mkind, output, params):
         n = M.shape[0]
         sv = Rs.gens[si]
         P = M * (sv * sv) + V * sv + K
-        detP = P.det()
+        detP = _det(P)
         dcoef = _coeffs_in_s(detP, si, 2 * n)
         lead = dcoef[2 * n]
         if lead == Rs.zero:
@@ -362,7 +387,7 @@ def _tf_summary(mats, mkind, output, params):
         for i in range(C.shape[0]):
             for j in range(B.shape[1]):
                 bc = DomainMatrix([[Bl[r][j] * Cl[i][c] for c in range(n)] for r in range(n)], (n, n), P.domain)
-                num = ((P + bc).det() - detP) * sv**shift
+                num = (_det(P + bc) - detP) * sv**shift
                 nums[i, j] = _coeffs_in_s(num, si, 2 * n + shift)
         degree = 2 * n
     for k in range(degree):
@@ -380,7 +405,7 @@ def _tf_summary(mats, mkind, output, params):
 
 
 def _markov_summary(mats, mkind, output, params):
-    Rp = ring(list(params), QQ, grevlex)[0] if params else ring([sp.Dummy("_none")], QQ, grevlex)[0]
+    Rp = ring(list(params), QQ, grevlex_memo)[0] if params else ring([sp.Dummy("_none")], QQ, grevlex_memo)[0]
     A, B, C, D, d = first_order_polynomial(mats, mkind, output, Rp)
     n = A.shape[0]
     entries_n, entries_d, labels = [], [], []

@@ -1,0 +1,262 @@
+"""Numerical witnesses against global identifiability, for when the Gröbner basis does not finish.
+
+When the exact global step exceeds its deadline, the model may still be shown *not*
+globally identifiable by exhibiting a second admissible solution θ ≠ θ* of
+summary(θ) = summary(θ*). The search:
+
+1. writes the equations ``F_i(θ) = n_i(θ) d_i(θ*) − d_i(θ) n_i(θ*)`` of the
+   exhaustive summary (the same θ* as the Gröbner step), each scaled to unit largest
+   coefficient, as exponent matrices for vectorised evaluation;
+2. runs Gauss–Newton from random starts around θ* (log-normal in magnitude, random
+   sign for parameters not declared positive), all starts at once in numpy;
+3. keeps converged points that differ from θ* and satisfy the declared positivity,
+   with every summary denominator away from zero (a true solution of
+   summary(θ) = summary(θ*), not of the cross-multiplied equations only);
+4. verifies each candidate by Newton's method at 60 significant digits with the exact
+   rational coefficients (mpmath): it is accepted when the residual falls below 1e-40
+   and the steps shrink quadratically, at a well-conditioned Jacobian (condition
+   number below 1e12). That is the numerical signature of a simple exact root within
+   the last step; a rigorous certificate (Smale's α-test, interval Newton) is not
+   computed.
+
+A witness shows the model is not globally identifiable at θ* (the solution count is
+at least 1 + the number of witnesses); finding none proves nothing.
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import mpmath
+import numpy as np
+from sympy import QQ
+
+from symid.structural.global_ import POSITIVE_TOL, star_and_summary
+
+__all__ = ["WitnessResult", "find_witnesses"]
+
+_DIGITS = 60
+_RESIDUAL_HP = 1e-40
+_MAX_WITNESSES = 8
+
+
+@dataclass(frozen=True)
+class WitnessResult:
+    """Other admissible solutions of summary(θ) = summary(θ*) found numerically.
+
+    Attributes
+    ----------
+    theta_star : dict of str to str
+        The point θ* (rational, as strings).
+    witnesses : tuple of dict
+        Verified solutions θ ≠ θ* (floats), at most eight.
+    n_starts : int
+        Starts tried.
+    seconds : float
+        Wall time of the search.
+    """
+
+    theta_star: dict
+    witnesses: tuple
+    n_starts: int
+    seconds: float
+
+
+def _compile(polys) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Exponent matrix and float coefficients (scaled to unit maximum) of each polynomial."""
+    out = []
+    for f in polys:
+        terms = f.terms()
+        E = np.array([m for m, _ in terms], dtype=np.int64)
+        c = np.array([float(v) for _, v in terms])
+        out.append((E, c / np.abs(c).max()))
+    return out
+
+
+def _exact(polys) -> list[list[tuple[tuple[int, ...], object]]]:
+    """Terms of each polynomial with exact rational coefficients, scaled like :func:`_compile`."""
+    out = []
+    for f in polys:
+        top = max(abs(c) for _, c in f.terms())
+        out.append([(m, c / top) for m, c in f.terms()])
+    return out
+
+
+def _eval(compiled, X: np.ndarray):
+    """Residuals (S, neq), Jacobians (S, neq, nv) and Σ|terms| (S, neq) at the rows of X (no zero entries).
+
+    Monomials as exp(log|X| Eᵀ) with the sign (−1)^(neg(X) Eᵀ): two matrix products per
+    polynomial instead of a power per term and variable.
+    """
+    S, nv = X.shape
+    F = np.empty((S, len(compiled)))
+    J = np.empty((S, len(compiled), nv))
+    size = np.empty((S, len(compiled)))
+    with np.errstate(all="ignore"):
+        logs = np.log(np.abs(X))
+        neg = (X < 0).astype(float)
+        for i, (E, c) in enumerate(compiled):
+            Ef = E.T.astype(float)
+            mon = np.exp(logs @ Ef) * (1.0 - 2.0 * np.mod(neg @ Ef, 2.0))  # (S, T)
+            cm = mon * c
+            F[:, i] = cm.sum(axis=1)
+            size[:, i] = np.abs(cm).sum(axis=1)
+            J[:, i, :] = (cm @ E) / X
+    return F, J, size
+
+
+def _newton(compiled, X: np.ndarray, iterations: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Newton from every row of X at once (steps capped); returns the points and max |F_i| / Σ|terms of F_i|."""
+    X = X.copy()
+    alive = np.ones(len(X), dtype=bool)
+    for _ in range(iterations):
+        F, J, _ = _eval(compiled, X[alive])
+        ok = np.isfinite(F).all(axis=1) & np.isfinite(J).all(axis=(1, 2))
+        idx = np.flatnonzero(alive)
+        alive[idx[~ok]] = False
+        if not ok.any():
+            break
+        F, J, Xa = F[ok], J[ok], X[idx[ok]]
+        with np.errstate(all="ignore"):
+            step = -np.einsum("sij,sj->si", np.linalg.pinv(J), F)
+            size = np.linalg.norm(step, axis=1, keepdims=True)
+            cap = 0.5 * (np.linalg.norm(Xa, axis=1, keepdims=True) + 1.0)
+            step = np.where(size > cap, step * cap / size, step)
+        X[idx[ok]] = Xa + step
+    X[~alive] = np.nan
+    F, _, size = _eval(compiled, X)
+    with np.errstate(all="ignore"):
+        return X, (np.abs(F) / np.maximum(size, 1e-300)).max(axis=1)
+
+
+def _nonzero(compiled, x: np.ndarray) -> bool:
+    """Every polynomial is away from zero at x, relative to the size of its terms."""
+    for E, c in compiled:
+        terms = c * np.prod(x[None, :] ** E, axis=1)
+        if abs(terms.sum()) <= 1e-9 * np.abs(terms).sum():
+            return False
+    return True
+
+
+def _verify(exact, x: np.ndarray) -> np.ndarray | None:
+    """Newton at 60 digits with exact coefficients; the refined point if it converges quadratically."""
+    nv = len(x)
+    with mpmath.workdps(_DIGITS):
+        X = [mpmath.mpf(float(v)) for v in x]
+        coefs = [[(mon, mpmath.mpf(c.numerator) / c.denominator) for mon, c in terms] for terms in exact]
+        last, floor = None, mpmath.mpf(10) ** (5 - _DIGITS)
+        for _ in range(12):
+            F = mpmath.matrix(len(exact), 1)
+            J = mpmath.matrix(len(exact), nv)
+            for i, terms in enumerate(coefs):
+                for mon, c in terms:
+                    val = c
+                    for v, e in enumerate(mon):
+                        if e:
+                            val *= X[v] ** e
+                    F[i] += val
+                    for v, e in enumerate(mon):
+                        if e:
+                            J[i, v] += val * e / X[v]
+            try:
+                step = mpmath.lu_solve(J.T * J, -(J.T * F))
+            except ZeroDivisionError:
+                return None
+            X = [X[v] + step[v] for v in range(nv)]
+            size = mpmath.norm(step)
+            quadratic = last is not None and size <= max(last**1.5, floor)
+            if mpmath.norm(F) < _RESIDUAL_HP and quadratic:
+                break
+            last = size
+        else:
+            return None
+        cond = np.linalg.cond(np.array(J.tolist(), dtype=float))
+    if not np.isfinite(cond) or cond > 1e12:
+        return None
+    return np.array([float(v) for v in X])
+
+
+def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
+                   seed: int = 0, max_time: float = 2.0, batch: int = 48) -> WitnessResult:
+    """Search for admissible solutions θ ≠ θ* of summary(θ) = summary(θ*), and verify them.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+    known : dict, optional
+        Fixed parameter values.
+    positive : sequence of bool, optional
+        Per free parameter, whether only positive values are admissible.
+    seed : int
+        Seed of θ* (the same as :func:`~symid.structural.global_.global_analysis`) and of the starts.
+    max_time : float
+        Seconds after which no new batch of starts is begun (one batch always runs).
+    batch : int
+        Starts per batch.
+
+    Returns
+    -------
+    WitnessResult
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.witness import find_witnesses
+    >>> th = si.parameters("th")
+    >>> model = si.StateSpaceModel(A=[[-1]], B=[[th]], C=[[th]])  # θ and −θ give the same H
+    >>> res = find_witnesses(model, max_time=0.5)
+    >>> [round(w["th"] / float(res.theta_star["th"]), 9) for w in res.witnesses]
+    [-1.0]
+    """
+    t0 = time.perf_counter()
+    params, star, _, summ, _ = star_and_summary(model, known, seed=seed)
+    names = [p.name for p in params]
+    theta_star = {n: str(v) for n, v in zip(names, star, strict=True)}
+    nv = len(params)
+    positive = list(positive) if positive is not None else [False] * nv
+    if nv == 0 or len(summ) == 0:
+        return WitnessResult(theta_star, (), 0, time.perf_counter() - t0)
+    pt = [QQ.from_sympy(v) for v in star]
+    polys = []
+    for num, den in zip(summ.numerators, summ.denominators, strict=True):
+        f = num * den(*pt) - den * num(*pt)
+        if f:
+            polys.append(f)
+    compiled, exact = _compile(polys), _exact(polys)
+    dens = _compile([d for d in summ.denominators if not d.is_ground])
+    xs = np.array([float(v) for v in star])
+    pos = np.array(positive, dtype=bool)
+    rng = np.random.default_rng(random.Random(seed).randrange(2**32))
+    found: list[np.ndarray] = []
+    n_starts = 0
+    while (n_starts == 0 or time.perf_counter() - t0 < max_time) and len(found) < _MAX_WITNESSES:
+        mag = xs * np.exp(rng.normal(0.0, 1.5, (batch, nv)))
+        sign = np.where(pos, 1.0, rng.choice([-1.0, 1.0], (batch, nv)))
+        X, res = _newton(compiled, mag * sign, 40)
+        n_starts += batch
+        for x, r in zip(X, res, strict=True):
+            if not np.isfinite(r) or r > 1e-9 or not np.all(np.isfinite(x)):
+                continue
+            if np.all(np.abs(x - xs) <= 1e-6 * np.maximum(1.0, np.abs(xs))):
+                continue  # θ* itself
+            if np.any(x[pos] <= POSITIVE_TOL):
+                continue
+            if any(np.all(np.abs(x - f) <= 1e-6 * np.maximum(1.0, np.abs(f))) for f in found):
+                continue
+            if found and time.perf_counter() - t0 > max_time:
+                break
+            sol = _verify(exact, x)
+            if sol is None or np.any(sol[pos] <= POSITIVE_TOL) or not _nonzero(dens, sol):
+                continue
+            if np.all(np.abs(sol - xs) <= 1e-9 * np.maximum(1.0, np.abs(xs))):
+                continue
+            if any(np.all(np.abs(sol - f) <= 1e-9 * np.maximum(1.0, np.abs(f))) for f in found):
+                continue
+            found.append(sol)
+            if len(found) >= _MAX_WITNESSES:
+                break
+    witnesses = tuple({n: float(v) for n, v in zip(names, sol, strict=True)} for sol in found)
+    return WitnessResult(theta_star, witnesses, n_starts, time.perf_counter() - t0)
