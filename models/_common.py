@@ -6,7 +6,6 @@ Private to the zoo (the leading underscore keeps it out of ``symid.list_models()
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 import sympy as sp
 
 import symid as si
@@ -79,6 +78,8 @@ def balanced_realisation(A, B, C) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     order. The sign of each balanced state is fixed so that the first nonzero entry of
     its row of ``T B`` is positive (balreal's sign choice is not documented).
     """
+    import scipy.linalg as sla  # imported here: loading any zoo model should not pay for scipy (cold CLI)
+
     A, B, C = (np.asarray(X, dtype=float) for X in (A, B, C))
     Wc = sla.solve_continuous_lyapunov(A, -B @ B.T)
     Wo = sla.solve_continuous_lyapunov(A.T, -C.T @ C)
