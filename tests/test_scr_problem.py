@@ -139,18 +139,52 @@ def test_result_object():
 
 
 def test_truncated_nuclear_norm_option():
-    sol = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, backend="admm", max_iter=30, tol=1e-8,
-                    heuristic="truncated", truncate_after=1)
-    assert sol.success, sol.message
-    np.testing.assert_allclose([sol.x["x"], sol.x["y"]], [1, 1], atol=1e-5)
+    # thesis §6-7-1 (Hu et al. 2012): ||M||_* − <U_r V_rᵀ, M>; Rosenbrock's minimum (1, 1), thesis §2-5-2
+    for backend in ("admm", "cvxpy"):
+        sol = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, backend=backend, max_iter=30, tol=1e-8,
+                        heuristic="truncated", truncate_after=1)
+        assert sol.success, (backend, sol.message)
+        np.testing.assert_allclose([sol.x["x"], sol.x["y"]], [1, 1], atol=1e-5)
+        plain = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, backend=backend, max_iter=2)
+        # iteration 2 differs: the relaxation subtracts the linear term (its value drops below the plain one)
+        assert sol.history[1].relaxation < plain.history[1].relaxation - 1e-6
     with pytest.raises(ModelError, match="heuristic"):
         scr.solve(rosenbrock(), heuristic="logdet")
 
 
-def test_cvxpy_backend_is_dpp_and_compiles_once():
-    sol = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, backend="cvxpy", max_iter=4, tol=1e-12)
-    assert sol.iterations == 4
+def test_cvxpy_backend_is_dpp_and_compiles_once(monkeypatch):
+    import cvxpy as cp
+    from cvxpy.reductions.chain import Chain
+
+    from symid.scr.backend_cvxpy import CvxpyBackend
+
+    problems: list[cp.Problem] = []
+    init = CvxpyBackend.__init__
+
+    def spy_init(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        problems.append(self.problem)
+
+    applied = []
+    apply = Chain.apply
+
+    def spy_apply(self, problem, verbose=False):  # the reduction chain: cvxpy's compilation
+        applied.append(problem)
+        return apply(self, problem, verbose)
+
+    monkeypatch.setattr(CvxpyBackend, "__init__", spy_init)
+    monkeypatch.setattr(Chain, "apply", spy_apply)
+    # two bilinear terms of different shapes, an LMI and an equality: every kind of parameter
+    prob = scr.BilinearProblem(
+        variables=[x, y, a],
+        bilinear=[scr.Bilinear(A=[[x]], P=[[1]], B=[[x]], C=[[y - a]], weight=0.1),
+                  scr.Bilinear(A=[[x, y]], P=np.eye(2), B=[[y], [a]], C=[[1]], weight=0.5)],
+        objective=100 * a**2 + (1 - x) ** 2, equalities=[x + y + a - 1], lmis=[sp.Matrix([[x, 0], [0, 1 - y]])])
+    sol = scr.solve(prob, x0={x: -1.9, y: 2}, backend="cvxpy", max_iter=4, tol=1e-12)
+    assert sol.iterations == 4, sol.message
+    assert len(problems) == 1 and problems[0].is_dpp()
     assert sol.info["is_dpp"] is True
+    assert len(applied) == 1  # compiled at the first iteration only; the other three re-used it
     assert sol.info["compilations"] == 1
 
 
@@ -161,3 +195,136 @@ def test_solver_failure_is_reported_not_hidden():
     sol = scr.solve(prob, x0={x: 1, y: 1}, backend="cvxpy", max_iter=3)
     assert not sol.success and sol.status == "solver_error"
     assert "infeasible" in sol.message
+
+
+def test_normalisation_makes_weight_independent_of_equation_scale():
+    # issue 3 notes: one λ behaves the same across problems. Multiplying the equation x·x = y − a by
+    # 1000 and P by 5 (C with them) leaves the solution set unchanged; after presolve's equilibration
+    # the iterates must be identical, while without it λ effectively changes.
+    scaled = scr.BilinearProblem(
+        variables=[x, y, a],
+        bilinear=[scr.Bilinear(A=[[1000 * x]], P=[[5]], B=[[x]], C=[[5000 * (y - a)]], weight=0.1)],
+        objective=100 * a**2 + (1 - x) ** 2)
+    for backend in ("admm", "cvxpy"):
+        ref = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, backend=backend, max_iter=3)
+        got = scr.solve(scaled, x0={x: -1.9, y: 2}, backend=backend, max_iter=3)
+        for i1, i2 in zip(ref.iterates, got.iterates, strict=True):
+            np.testing.assert_allclose([i2["x"], i2["y"]], [i1["x"], i1["y"]], rtol=1e-6, atol=1e-6)
+    raw = scr.solve(scaled, x0={x: -1.9, y: 2}, backend="cvxpy", max_iter=1, normalize=False)
+    assert abs(raw.iterates[0]["y"] - (-6.03)) > 1  # thesis §2-5-2 first iterate only with λ = 0.1 as meant
+
+
+def test_matrix_block_variable_through_sympy():
+    # X² = S² for a 2×2 real block X, posed with the variable's sympy matrix; from near S, SCR finds S
+    X = scr.Variable("X", (2, 2))
+    S = np.array([[2.0, 0.5], [0.3, 1.5]])
+    prob = scr.BilinearProblem(variables=[X], bilinear=[scr.Bilinear(A=X.sym, P=np.eye(2), B=X.sym, C=S @ S)])
+    x0 = {"X": S + 0.1 * np.array([[1.0, -1.0], [0.5, 0.2]])}
+    for backend in ("admm", "cvxpy"):
+        sol = scr.solve(prob, x0=x0, backend=backend, max_iter=200, tol=1e-9)
+        assert sol.success, sol.message
+        assert sol.x["X"].shape == (2, 2)
+        np.testing.assert_allclose(sol.x["X"], S, atol=1e-6)
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"backend": "scs"}, "unknown backend 'scs'"),
+    ({"max_iter": 0}, "max_iter must be ≥ 1"),
+    ({"tol": -1.0}, "tol must be finite and > 0"),
+    ({"step_tol": -1.0}, "step_tol must be finite"),
+    ({"heuristic": "truncated", "truncate_after": -1}, "truncate_after must be ≥ 0"),
+    ({"admm": {"rho": 1.0}}, "admm must be an scr.ADMMOptions"),
+    ({"backend": "cvxpy", "solver_options": {"no_such_setting": 1}}, "refused by CLARABEL"),
+])
+def test_bad_solve_arguments_are_named(kwargs, match):
+    with pytest.raises(ModelError, match=match):
+        scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, **({"max_iter": 2} | kwargs))
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"rho": -1.0}, "rho must be finite and > 0"),
+    ({"alpha": 2.0}, "alpha must lie in"),
+    ({"inner": 0}, "inner must be ≥ 1"),
+    ({"eps_abs": -1e-3}, "eps_abs must be ≥ 0"),
+])
+def test_bad_admm_options_are_named(kwargs, match):
+    with pytest.raises(ModelError, match=match):
+        scr.ADMMOptions(**kwargs)
+
+
+def test_bad_problem_input_is_named():
+    G = scr.Variable("G", (2, 1))
+    with pytest.raises(ModelError, match=r"bilinear\[0\]\.A: the coefficient of G has shape \(1, 2, 3\)"):
+        scr.BilinearProblem(variables=[G], bilinear=[scr.Bilinear(
+            A=scr.Affine(np.zeros((1, 2)), {G: np.ones((1, 2, 3))}), P=np.eye(2), B=G.sym, C=[[1]])])
+    with pytest.raises(ModelError, match=r"x0\['G'\] has shape \(3,\)"):
+        prob = scr.BilinearProblem(variables=[G], bilinear=[scr.Bilinear(A=G.sym.T, P=np.eye(2), B=G.sym, C=[[1]])])
+        scr.solve(prob, x0={"G": [1.0, 2.0, 3.0]})
+    with pytest.raises(ModelError, match=r"lmis\[0\] must be square"):
+        scr.BilinearProblem(variables=[x], lmis=[sp.Matrix([[x, 1]])])
+    with pytest.raises(ModelError, match=r"lmis\[0\] is not symmetric"):
+        scr.BilinearProblem(variables=[x], lmis=[np.array([[1.0, 2.0], [0.0, 1.0]])])
+    with pytest.raises(ModelError, match=r"bilinear\[0\]\.P must be constant"):
+        scr.BilinearProblem(variables=[x], bilinear=[scr.Bilinear(A=[[x]], P=[[x]], B=[[x]], C=[[1]])])
+    with pytest.raises(NonAffineError, match=r"lmis\[0\], entry \(0, 0\)"):
+        scr.BilinearProblem(variables=[x, y], lmis=[sp.Matrix([[x * y]])])
+
+
+def test_admm_kkt_sparse_and_dense_factorisations_agree():
+    # the z-update of appendix B (B-9): [[N, Dᵀ], [D, 0]] [z; ν] = [b; d], with an arrow-shaped N
+    from symid.scr.backend_admm import _KKT
+
+    rng = np.random.default_rng(3)
+    n_shared, blocks, size = 3, 40, 4
+    n = n_shared + blocks * size
+    rows, cols, vals = [], [], []
+    for t in range(blocks):
+        idx = np.r_[np.arange(n_shared), n_shared + t * size + np.arange(size)]
+        F = rng.standard_normal((2 * idx.size, idx.size))
+        ii, jj = np.meshgrid(idx, idx, indexing="ij")
+        rows.append(ii.ravel())
+        cols.append(jj.ravel())
+        vals.append((F.T @ F).ravel())
+    import scipy.sparse as sps
+
+    N = sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
+    D = sps.csr_matrix(rng.standard_normal((5, n)))
+    rhs = rng.standard_normal(n + 5)
+    K = np.block([[N.toarray(), D.T.toarray()], [D.toarray(), np.zeros((5, 5))]])
+    ref = np.linalg.solve(K, rhs)[:n]
+    assert _KKT(N, D).sparse is None and _KKT(N, D, dense_max=10).sparse is not None
+    np.testing.assert_allclose(_KKT(N, D).solve(rhs), ref, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(_KKT(N, D, dense_max=10).solve(rhs), ref, rtol=1e-9, atol=1e-12)
+
+
+def test_admm_backend_runs_without_cvxpy():
+    # issue 3 item 4: the ADMM back end is pure numpy/scipy; cvxpy is never imported
+    import subprocess
+    import sys
+
+    code = ("import sys, sympy as sp\nfrom symid import scr\nx, y, a = sp.symbols('x y a')\n"
+            "p = scr.BilinearProblem(variables=[x, y, a], bilinear=[scr.Bilinear(A=[[x]], P=[[1]], B=[[x]], "
+            "C=[[y - a]], weight=0.1)], objective=100 * a**2 + (1 - x)**2, lmis=[sp.Matrix([[1 - a]])])\n"
+            "sol = scr.solve(p, x0={x: -1.9, y: 2}, backend='admm', max_iter=3)\n"
+            "print(len(sol.history), 'cvxpy' in sys.modules, 'clarabel' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["3", "False", "False"]
+
+
+def test_admm_warm_start_and_tightening():
+    # belt drive (3-17), whole 3×3 blocks relaxed (presolve=False): 10 blocks of 12×8 in the real representation
+    prob, th = belt_drive()
+    x0 = {"theta": th + 0.1 * np.random.default_rng(1).standard_normal(4)}
+    opts = {"backend": "admm", "max_iter": 60, "tol": 1e-5, "step_tol": 1e9, "presolve": False}
+    sol = scr.solve(prob, x0=x0, admm=scr.ADMMOptions(eps_rel=1e-5, eps_abs=1e-6), **opts)
+    assert sol.success, sol.message
+    inner = sol.info["inner_iterations"]
+    # warm start across SCR iterations: the cold first sub-problem costs far more ADMM steps than the next ones
+    assert inner[0] > 10 * np.median(inner[1:10])
+    # with loose ADMM tolerances the reachable bilinear residual is capped near them, unless the
+    # tolerances are tightened to the residual as SCR converges (ADMMOptions.tighten, scr-lessons 8)
+    loose = {"eps_rel": 1e-4, "eps_abs": 1e-5}
+    capped = scr.solve(prob, x0=x0, admm=scr.ADMMOptions(tighten=None, **loose), **opts)
+    tightened = scr.solve(prob, x0=x0, admm=scr.ADMMOptions(**loose), **opts)
+    assert not capped.success and capped.residual > 1e-4
+    assert tightened.success and tightened.residual <= 1e-5

@@ -17,6 +17,17 @@ Two ways to pose a problem:
 
 Back ends: ``"admm"`` (numpy, vectorised over blocks, LMIs by PSD projection) and
 ``"cvxpy"`` (Clarabel, compiled once per solve thanks to DPP parameters).
+
+Scaling, so that one weight λ means the same in every problem (``solve(normalize=True)``,
+the default; details in :mod:`symid.scr.presolve`): every bilinear equation is
+equilibrated without changing its solutions — P divided by its spectral norm (C with it),
+each row of the equation divided by the largest coefficient of that row of A(x) and C(x),
+each column by the largest coefficient of that column of B(x) and C(x) — and a complex
+term, which enters through the real representation (2-8) whose singular values are those
+of the complex matrix twice over, gets half the weight, so that λ weighs the nuclear norm
+of the complex M. Multiplying an equation, or P, by a constant therefore leaves the
+iterates unchanged. LMIs are divided by their largest coefficient. The stopping residual
+is that of the equilibrated terms; ``sol.history[k].residuals`` are the user's, unscaled.
 """
 
 from symid.scr.backend_admm import ADMMOptions

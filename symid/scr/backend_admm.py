@@ -5,20 +5,31 @@ One SCR sub-problem, for fixed Q, R, is
     min_z  f(z) + Σ_t w_t (||Y_t||_* − <W_t, Y_t>)
     s.t.   Y_t = M_t(z),  S_e = E_e(z),  S_e ⪰ 0,  D z = d
 
-(W_t = 0 for the plain nuclear norm). Scaled-form ADMM with one shared ρ:
+(W_t = 0 for the plain nuclear norm). All blocks Y_t and S_e are stacked in one vector
+y = 𝒜 z + c, with 𝒜 a sparse matrix assembled once per SCR iteration from the batched
+blocks of :mod:`symid.scr.blocks`. Scaled-form ADMM with one shared ρ and
+over-relaxation α (Boyd et al. 2011, §3.4.3):
 
-* z-update: the equality-constrained least squares of appendix B, solved from one
-  factorisation of the KKT matrix [[2H + ρ(GᵀG + LᵀL) + δI, Dᵀ], [D, 0]] per SCR
-  iteration (δ is a tiny proximal term keeping it nonsingular);
-* Y-update: singular value thresholding (2-12), batched with one ``np.linalg.svd`` call
+* z-update: the equality-constrained least squares of appendix B (B-9), solved from one
+  factorisation of the KKT matrix [[2H + ρ𝒜ᵀ𝒜 + δI, Dᵀ], [D, 0]] per SCR iteration
+  (δ is a tiny proximal term keeping it nonsingular; dense LU when small, SuperLU
+  otherwise); one sparse product with 𝒜ᵀ and one with 𝒜 per inner iteration;
+* Y-update: singular value thresholding (2-12), batched with one ``np.linalg.eigh`` call
   per group of equal-shape blocks;
 * S-update: projection onto the PSD cone by eigenvalue clipping, batched likewise, so
   LMI problems need no interior-point solver;
-* stop on the primal and dual residuals (Boyd et al. 2011, §3.3.1).
+* stop on the primal and dual residuals (Boyd et al. 2011, §3.3.1), checked every
+  ``check_every`` inner iterations. The relative part of the dual tolerance is scaled by
+  ρ‖u‖ times the RMS column norm of 𝒜 rather than by ‖𝒜ᵀΛ‖, which vanishes at the
+  optimum of a feasibility problem;
+* the tolerances shrink with the last bilinear residual (``tighten``), so the reachable
+  SCR residual is not capped by the ADMM tolerance (scr-lessons 8);
+* ρ is rebalanced from the ratio of the normalised residuals (residual balancing, as in
+  OSQP) when they differ by more than a factor 5; the KKT matrix is then refactorised.
 
-The state (z, Y, S and the scaled duals) is kept between SCR iterations (warm start);
-the inner-iteration budget is raised by the SCR loop when the residual stalls
-(scr-lessons 8).
+No Python loop runs over blocks: only over the few groups of equal-shape blocks. The state
+(z, the scaled duals) is kept between SCR iterations (warm start); the inner-iteration
+budget is raised by the SCR loop when the residual stalls (scr-lessons 8).
 """
 
 from __future__ import annotations
@@ -27,10 +38,11 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
+import scipy.linalg.lapack as lapack
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
+from symid.errors import ModelError
 from symid.scr.blocks import LMIGroup, TermGroup
 from symid.scr.presolve import Reduced
 
@@ -45,6 +57,8 @@ class ADMMOptions:
     ----------
     rho : float or None
         Penalty ρ shared by all blocks; ``None`` uses 2 × the median term weight.
+    alpha : float
+        Over-relaxation factor in (0, 2) (Boyd et al. 2011, §3.4.3); 1 is plain ADMM.
     inner : int
         Initial cap on ADMM iterations per SCR iteration (raised ×2 on stalls).
     inner_first : int
@@ -53,40 +67,91 @@ class ADMMOptions:
         Largest cap.
     eps_abs, eps_rel : float
         Absolute and relative tolerances on the primal and dual residuals.
+    check_every : int
+        Inner iterations between two evaluations of the stopping rule.
+    adaptive_rho : bool
+        Rebalance ρ from the ratio of the normalised primal and dual residuals (as OSQP
+        does; Boyd et al. 2011, §3.4.1) when they differ by more than a factor 5, at most
+        every ``adapt_every`` inner iterations; the KKT matrix is then refactorised.
+        The adapted ρ carries over to the next SCR iteration.
+    adapt_every : int
+        Smallest number of inner iterations between two changes of ρ.
+    tighten : float or None
+        Inexact SCR: the primal tolerance of a sub-problem is lowered to ``tighten`` × the
+        last bilinear residual when that is smaller (the dual one in proportion), so the
+        sub-problems get more accurate as SCR converges instead of capping the reachable
+        residual at the ADMM tolerance. ``None`` keeps the fixed tolerances.
+
+    Examples
+    --------
+    >>> from symid import scr
+    >>> scr.ADMMOptions(rho=1.0, inner=100).alpha
+    1.6
     """
 
     rho: float | None = None
+    alpha: float = 1.6
     inner: int = 50
     inner_first: int = 2000
     inner_max: int = 1000
     eps_abs: float = 1e-7
     eps_rel: float = 1e-6
+    check_every: int = 5
+    adaptive_rho: bool = True
+    adapt_every: int = 25
+    tighten: float | None = 1.0
+
+    def __post_init__(self) -> None:
+        if self.rho is not None and not (np.isfinite(self.rho) and self.rho > 0):
+            raise ModelError(f"ADMMOptions.rho must be finite and > 0, got {self.rho}")
+        if not 0 < self.alpha < 2:
+            raise ModelError(f"ADMMOptions.alpha must lie in (0, 2), got {self.alpha}")
+        for name in ("inner", "inner_first", "inner_max", "check_every", "adapt_every"):
+            if int(getattr(self, name)) < 1:
+                raise ModelError(f"ADMMOptions.{name} must be ≥ 1, got {getattr(self, name)}")
+        if self.tighten is not None and not (np.isfinite(self.tighten) and self.tighten > 0):
+            raise ModelError(f"ADMMOptions.tighten must be finite and > 0 or None, got {self.tighten}")
+        for name in ("eps_abs", "eps_rel"):
+            if not getattr(self, name) >= 0:
+                raise ModelError(f"ADMMOptions.{name} must be ≥ 0, got {getattr(self, name)}")
+
+
+_DENSE_MAX = 200  # KKT size up to which a dense LU beats SuperLU here
+_DENSE_OPERATOR = 250_000  # entries of 𝒜 up to which dense products beat sparse ones
 
 
 class _KKT:
-    """Factorisation of the KKT matrix; dense LU when small, SuperLU otherwise."""
+    """Factorisation of the KKT matrix [[N, Dᵀ], [D, 0]]; dense LAPACK LU when small, SuperLU otherwise.
 
-    def __init__(self, N: sps.spmatrix, D: sps.spmatrix):
-        nz, m = N.shape[0], D.shape[0]
-        self.nz = nz
+    The sparse factorisation orders the symmetric pattern (minimum degree on K + Kᵀ) and
+    prefers diagonal pivots: with SuperLU's default column ordering and partial pivoting
+    the arrow-shaped matrices of SCR (shared parameters coupling many private blocks)
+    filled in ~100× more.
+    """
+
+    def __init__(self, N: sps.spmatrix, D: sps.spmatrix, dense_max: int = _DENSE_MAX):
+        m = D.shape[0]
         K = sps.bmat([[N, D.T], [D, None]], format="csc") if m else sps.csc_matrix(N)
-        if K.shape[0] <= 400:
-            self.lu = sla.lu_factor(K.toarray(), check_finite=False)
+        self.nz = N.shape[0]
+        self.empty = K.shape[0] == 0
+        if self.empty:
+            self.sparse = None
+        elif K.shape[0] <= dense_max:
+            self.lu, self.piv, info = lapack.dgetrf(K.toarray())
+            if info != 0:
+                raise np.linalg.LinAlgError(f"singular KKT matrix (LAPACK getrf info={info})")
             self.sparse = None
         else:
-            self.lu = None
-            self.sparse = spla.splu(K)
+            self.sparse = spla.splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        if self.lu is not None:
-            return sla.lu_solve(self.lu, rhs, check_finite=False)
-        return self.sparse.solve(rhs)
-
-
-def _scatter(idx: np.ndarray, vals: np.ndarray, n: int) -> np.ndarray:
-    """Sum vals (s, u) into a length-n vector at idx (s, u); padding (-1) is dropped."""
-    m = idx >= 0
-    return np.bincount(idx[m], weights=vals[m], minlength=n)
+        if self.empty:
+            return np.zeros(0)
+        if self.sparse is None:
+            x, _ = lapack.dgetrs(self.lu, self.piv, rhs)
+        else:
+            x = self.sparse.solve(rhs)
+        return x[: self.nz]
 
 
 def _svt(X: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -101,13 +166,24 @@ def _svt(X: np.ndarray, tau: np.ndarray) -> np.ndarray:
     lam, V = np.linalg.eigh(Xt.transpose(0, 2, 1) @ Xt)
     sig = np.sqrt(np.maximum(lam, 0.0))
     f = np.where(sig > tau[:, None], 1.0 - tau[:, None] / np.where(sig > 0, sig, 1.0), 0.0)
-    Y = (Xt @ (V * f[:, None, :])) @ V.transpose(0, 2, 1)
+    Y = Xt @ ((V * f[:, None, :]) @ V.transpose(0, 2, 1))
     return Y.transpose(0, 2, 1) if transpose else Y
 
 
 def _psd(X: np.ndarray) -> np.ndarray:
+    """Projection of a stack of square matrices onto the PSD cone (eigenvalue clipping)."""
     ev, V = np.linalg.eigh(0.5 * (X + X.transpose(0, 2, 1)))
     return (V * np.maximum(ev, 0.0)[:, None, :]) @ V.transpose(0, 2, 1)
+
+
+def _block_rows(offset: int, idx: np.ndarray, coef: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """COO triplets of the rows ``offset + t*P + r`` of a batched local map coef (s, P, u) on z[idx (s, u)]."""
+    s, P, u = coef.shape
+    rows = offset + np.arange(s * P).reshape(s, P, 1)
+    rows = np.broadcast_to(rows, (s, P, u))
+    cols = np.broadcast_to(idx[:, None, :], (s, P, u))
+    keep = (cols >= 0) & (coef != 0)
+    return rows[keep], cols[keep], coef[keep]
 
 
 class ADMMBackend:
@@ -120,127 +196,167 @@ class ADMMBackend:
         ws = np.concatenate([g.weight for g in groups]) if groups else np.ones(1)
         self.rho = float(options.rho) if options.rho is not None else 2.0 * float(np.median(ws))
         self.inner = int(options.inner)
-        self.z: np.ndarray | None = None
-        self.U = [np.zeros((g.s, *g.pq)) for g in groups]
-        self.S = [g.E0.copy() for g in lmis]
-        self.V = [np.zeros_like(g.E0) for g in lmis]
         self.iterations: list[int] = []
         self.hit_cap = False
-        self.LG = [g.G() for g in lmis]
-        nz = red.nz
-        rho = self.rho
-        NL = sps.csr_matrix((nz, nz))
-        for g, L in zip(lmis, self.LG, strict=True):
-            NL = NL + self._normal(g.idx, L, nz)
-        self.N_fixed = 2 * red.H + rho * NL
-
-    @staticmethod
-    def _normal(idx: np.ndarray, G: np.ndarray, nz: int) -> sps.csr_matrix:
-        loc = np.einsum("spu,spv->suv", G, G)
-        ii = np.broadcast_to(idx[:, :, None], loc.shape)
-        jj = np.broadcast_to(idx[:, None, :], loc.shape)
-        m = (ii >= 0) & (jj >= 0)
-        return sps.csr_matrix((loc[m], (ii[m], jj[m])), shape=(nz, nz))
+        # layout of the stacked vector y: term groups first, then LMI groups
+        sizes = [g.s * int(np.prod(g.pq)) for g in groups] + [g.E0.size for g in lmis]
+        self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+        self.m = int(self.offsets[-1])
+        trip = [_block_rows(int(self.offsets[len(groups) + k]), g.idx, g.G()) for k, g in enumerate(lmis)]
+        self._lmi_rows = tuple(np.concatenate([t[i] for t in trip]) if trip else np.zeros(0) for i in range(3))
+        self._lmi_c = np.concatenate([g.E0.reshape(-1) for g in lmis]) if lmis else np.zeros(0)
+        self.z = np.zeros(red.nz)
+        self.u = np.zeros(self.m)
+        self.started = False
+        self.taus = [g.weight / self.rho for g in groups]
 
     def on_stall(self) -> None:
         """Double the inner-iteration cap if the last sub-problem hit it (scr-lessons 8)."""
         if self.hit_cap:
             self.inner = min(2 * self.inner, self.opt.inner_max)
 
-    def step(self, Q: list[np.ndarray], R: list[np.ndarray], W: list[np.ndarray] | None,
-             z0: np.ndarray) -> tuple[np.ndarray, bool, str, dict]:
-        red, rho, opt = self.red, self.rho, self.opt
-        nz = red.nz
+    def _assemble(self, built: list[tuple[np.ndarray, np.ndarray]]) -> tuple[sps.csr_matrix, np.ndarray]:
+        """The stacked affine map y = 𝒜 z + c of every block, from the groups' M = m0 + G z."""
+        rows, cols, vals, cs = [], [], [], []
+        for k, (g, (m0, G)) in enumerate(zip(self.groups, built, strict=True)):
+            t = _block_rows(int(self.offsets[k]), g.idx, G)
+            rows.append(t[0])
+            cols.append(t[1])
+            vals.append(t[2])
+            cs.append(m0.reshape(-1))
+        rows.append(self._lmi_rows[0])
+        cols.append(self._lmi_rows[1])
+        vals.append(self._lmi_rows[2])
+        cs.append(self._lmi_c)
+        A = sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows).astype(np.int64),
+                                                    np.concatenate(cols).astype(np.int64))),
+                           shape=(self.m, self.red.nz))
+        return A, np.concatenate(cs)
+
+    def _prox(self, x: np.ndarray, shifts: list[np.ndarray | None]) -> np.ndarray:
+        """Y-update (SVT) and S-update (PSD projection) on the stacked vector x."""
+        y = np.empty_like(x)
+        off = self.offsets
+        for k, g in enumerate(self.groups):
+            X = x[off[k]:off[k + 1]].reshape(g.s, *g.pq)
+            if shifts[k] is not None:
+                X = X + shifts[k]
+            y[off[k]:off[k + 1]] = _svt(X, self.taus[k]).reshape(-1)
+        return y
+
+    def _project(self, x: np.ndarray, y: np.ndarray) -> None:
+        off, ng = self.offsets, len(self.groups)
+        for k, g in enumerate(self.lgroups):
+            e = g.E0.shape[1]
+            sl = slice(off[ng + k], off[ng + k + 1])
+            y[sl] = _psd(x[sl].reshape(g.s, e, e)).reshape(-1)
+
+    def _factor(self, AtA: sps.csr_matrix) -> tuple[_KKT, float]:
+        """Factorise the KKT matrix of the z-update for the current ρ; returns it and δ."""
+        nz = self.red.nz
+        N = sps.csr_matrix(2 * self.red.H + self.rho * AtA)
+        delta = 1e-10 * max(1.0, float(N.diagonal().max(initial=0.0)))
+        return _KKT(N + delta * sps.identity(nz, format="csr"), self.red.D), delta
+
+    def _set_rho(self, rho: float) -> None:
+        self.u *= self.rho / rho  # the scaled dual u = Λ/ρ
+        self.rho = rho
+        self.taus = [g.weight / rho for g in self.groups]
+
+    def step(self, built: list[tuple[np.ndarray, np.ndarray]], W: list[np.ndarray] | None,
+             z0: np.ndarray, residual: float = np.inf) -> tuple[np.ndarray, bool, str, dict]:
+        """One SCR sub-problem for the blocks M = m0 + G z of ``built``; returns (z, ok, message, timing).
+
+        ``residual`` is the last bilinear residual; with ``tighten`` the tolerances shrink with it.
+        """
+        red, opt = self.red, self.opt
+        nz, m = red.nz, self.m
         tm = {"build": 0.0, "factor": 0.0, "solve": 0.0, "svd": 0.0, "projection": 0.0}
         t = time.perf_counter()
-        built = [g.build(q, r) for g, q, r in zip(self.groups, Q, R, strict=True)]
-        m0s = [b[0] for b in built]
-        Gs = [b[1] for b in built]
-        N = self.N_fixed
-        for g, G in zip(self.groups, Gs, strict=True):
-            N = N + rho * self._normal(g.idx, G, nz)
-        N = sps.csr_matrix(N)
-        diag = N.diagonal()
-        delta = 1e-10 * max(1.0, float(diag.max(initial=0.0)))
-        N = N + delta * sps.identity(nz, format="csr")
+        A, c = self._assemble(built)
+        AT = A.T.tocsr()
+        AtA = AT @ A
+        if m * nz <= _DENSE_OPERATOR:  # small problems: dense products have less overhead
+            A, AT = A.toarray(), AT.toarray()
+        a_rms = np.sqrt(float(AtA.diagonal().sum()) / max(nz, 1))  # RMS column norm of 𝒜
         tm["build"] += time.perf_counter() - t
         t = time.perf_counter()
         try:
-            kkt = _KKT(N, red.D)
+            kkt, delta = self._factor(AtA)
         except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
             return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
         tm["factor"] += time.perf_counter() - t
-        z = (self.z if self.z is not None else z0).copy()
-        taus = [g.weight / rho for g in self.groups]
-        shifts = [None if W is None else (g.weight / rho)[:, None, None] * w
-                  for g, w in zip(self.groups, W or [None] * len(self.groups), strict=True)]
-
-        def Mz(k: int, zz: np.ndarray) -> np.ndarray:
-            g = self.groups[k]
-            return m0s[k] + np.einsum("spu,su->sp", Gs[k], g.gather(zz)).reshape(m0s[k].shape)
-
-        Y = [Mz(k, z) for k in range(len(self.groups))]
-        U, S, V = self.U, self.S, self.V
+        if not self.started:
+            self.z = z0.copy()
+        z = self.z
+        y = A @ z + c
         neq = red.D.shape[0]
         rhs = np.zeros(nz + neq)
         rhs[nz:] = red.d
-        m_tot = sum(y.size for y in Y) + sum(s_.size for s_ in S)
+        alpha = opt.alpha
+        sqm, sqn = np.sqrt(max(m, 1)), np.sqrt(max(nz, 1))
         ok = False
         it = 0
         rp = rd = np.inf
-        cap = self.inner if self.z is not None else max(self.inner, self.opt.inner_first)
-        for it in range(1, cap + 1):  # noqa: B007
+        cap = self.inner if self.started else max(self.inner, opt.inner_first)
+        check = max(1, int(opt.check_every))
+        accuracy = opt.tighten * residual if opt.tighten is not None else np.inf
+        last_change = 0
+        shifts: list[np.ndarray | None] = [None] * len(self.groups)
+        for it in range(1, cap + 1):
+            rho, u = self.rho, self.u
+            if W is not None and it == last_change + 1:
+                shifts = [(g.weight / rho)[:, None, None] * w for g, w in zip(self.groups, W, strict=True)]
             t = time.perf_counter()
-            b = -red.g + delta * z
-            for k, g in enumerate(self.groups):
-                b += rho * _scatter(g.idx, np.einsum("spu,sp->su", Gs[k], (Y[k] - U[k] - m0s[k]).reshape(g.s, -1)), nz)
-            for k, g in enumerate(self.lgroups):
-                b += rho * _scatter(g.idx, np.einsum("spu,sp->su", self.LG[k], (S[k] - V[k] - g.E0).reshape(g.s, -1)),
-                                    nz)
-            rhs[:nz] = b
-            z = kkt.solve(rhs)[:nz]
-            tm["solve"] += time.perf_counter() - t
-            t = time.perf_counter()
-            rp2 = 0.0
-            dual = np.zeros(nz)
-            nm = ny = nu = 0.0
-            for k, g in enumerate(self.groups):
-                M = Mz(k, z)
-                X = M + U[k] if shifts[k] is None else M + U[k] + shifts[k]
-                Ynew = _svt(X, taus[k])
-                dual += _scatter(g.idx, np.einsum("spu,sp->su", Gs[k], (Ynew - Y[k]).reshape(g.s, -1)), nz)
-                Y[k] = Ynew
-                U[k] += M - Ynew
-                rp2 += float(np.sum((M - Ynew) ** 2))
-                nm += float(np.sum(M**2))
-                ny += float(np.sum(Ynew**2))
-                nu += float(np.sum(U[k] ** 2))
-            tm["svd"] += time.perf_counter() - t
-            t = time.perf_counter()
-            for k, g in enumerate(self.lgroups):
-                E = g.E(z)
-                Snew = _psd(E + V[k])
-                dual += _scatter(g.idx, np.einsum("spu,sp->su", self.LG[k], (Snew - S[k]).reshape(g.s, -1)), nz)
-                S[k] = Snew
-                V[k] += E - Snew
-                rp2 += float(np.sum((E - Snew) ** 2))
-                nm += float(np.sum(E**2))
-                ny += float(np.sum(Snew**2))
-                nu += float(np.sum(V[k] ** 2))
-            tm["projection"] += time.perf_counter() - t
-            rp = np.sqrt(rp2)
-            rd = rho * float(np.linalg.norm(dual))
-            eps_p = np.sqrt(m_tot) * opt.eps_abs + opt.eps_rel * np.sqrt(max(nm, ny))
-            eps_d = np.sqrt(nz) * opt.eps_abs + opt.eps_rel * rho * np.sqrt(nu)
-            if rp <= eps_p and rd <= eps_d:
-                ok = True
-                break
+            rhs[:nz] = rho * (AT @ (y - u - c)) - red.g + delta * z
+            z = kkt.solve(rhs)
+            az = A @ z + c
+            ah = alpha * az + (1 - alpha) * y if alpha != 1 else az
+            x = ah + u
+            t2 = time.perf_counter()
+            tm["solve"] += t2 - t
+            y_new = self._prox(x, shifts)
+            t3 = time.perf_counter()
+            tm["svd"] += t3 - t2
+            self._project(x, y_new)
+            tm["projection"] += time.perf_counter() - t3
+            self.u = u = x - y_new
+            if it % check == 0 or it == cap or m == 0:
+                t = time.perf_counter()
+                rp = float(np.linalg.norm(az - y_new))
+                rd = rho * float(np.linalg.norm(AT @ (y_new - y)))
+                scale_p = max(float(np.linalg.norm(az)), float(np.linalg.norm(y_new)))
+                # ||𝒜ᵀΛ|| of Boyd et al. vanishes at the optimum of a feasibility problem; ||Λ|| times the
+                # RMS column norm of 𝒜 is the scale of the terms whose difference the dual residual is
+                scale_d = rho * float(np.linalg.norm(u)) * a_rms
+                tm["solve"] += time.perf_counter() - t
+                eps_p = sqm * opt.eps_abs + opt.eps_rel * scale_p
+                eps_d = sqn * opt.eps_abs + opt.eps_rel * scale_d
+                if accuracy < eps_p:  # inexact SCR: the sub-problem no sloppier than the bilinear residual
+                    eps_p, eps_d = accuracy, eps_d * max(accuracy / eps_p, 1e-6)
+                if rp <= eps_p and rd <= eps_d:
+                    ok = True
+                    break
+                if opt.adaptive_rho and it - last_change >= opt.adapt_every and rp > 0 and rd > 0:
+                    ratio = np.sqrt((rp / max(scale_p, 1e-300)) / (rd / max(scale_d, 1e-300)))
+                    if not 0.2 <= ratio <= 5.0:
+                        t = time.perf_counter()
+                        self._set_rho(float(np.clip(rho * ratio, 1e-6, 1e6)))
+                        try:
+                            kkt, delta = self._factor(AtA)
+                        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
+                            return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
+                        tm["factor"] += time.perf_counter() - t
+                        last_change = it
+            y = y_new
+        self.started = True
         self.z = z
         self.hit_cap = not ok
         self.iterations.append(it)
         tm["inner_iterations"] = it
         tm["primal_residual"] = float(rp)
         tm["dual_residual"] = float(rd)
+        tm["rho"] = self.rho
         if not np.all(np.isfinite(z)):
             return z0, False, "ADMM diverged (non-finite iterate)", tm
         msg = "" if ok else f"ADMM stopped at its cap of {cap} inner iterations (primal {rp:.2e}, dual {rd:.2e})"

@@ -1,11 +1,12 @@
 """cvxpy + Clarabel back end: the SDP (2-9) of every SCR sub-problem, compiled once.
 
 M_t(z) = m0_t + G_t z[idx_t] (2-6) depends on Q, R only through the numbers m0_t and
-G_t, which are cvxpy ``Parameter``s (per group of equal-shape terms: one vector for m0
-and one per local variable slot u, multiplied elementwise with a constant selection of
-z). Parameter × variable is DPP, and no product of two parameters appears (scr-lessons
-10), so cvxpy compiles the problem once per ``solve`` and every SCR iteration only
-refreshes the parameter values and re-solves.
+G_t, which are cvxpy ``Parameter``s, one pair per block, multiplying the block's own
+entries of z. Parameter × variable is DPP, and no product of two parameters appears
+(scr-lessons 10), so cvxpy compiles the problem once per ``solve`` and every SCR
+iteration only refreshes the parameter values and re-solves. Per-block parameters keep
+the compiled parameter tensor linear in the number of blocks (slicing one long
+parameter vector per block made compilation quadratic).
 """
 
 from __future__ import annotations
@@ -14,21 +15,18 @@ import time
 
 import cvxpy as cp
 import numpy as np
-import scipy.sparse as sps
 
+from symid.errors import ModelError
 from symid.scr.blocks import LMIGroup, TermGroup
 from symid.scr.presolve import Reduced
 
 __all__ = ["CvxpyBackend"]
 
 
-def _selection(idx: np.ndarray, pq: int, u: int, nz: int) -> sps.csr_matrix:
-    """Rows t*pq + r pick z[idx[t, u]] (zero rows at padding)."""
-    s = idx.shape[0]
-    col = np.repeat(idx[:, u], pq)
-    row = np.arange(s * pq)
-    m = col >= 0
-    return sps.csr_matrix((np.ones(int(m.sum())), (row[m], col[m])), shape=(s * pq, nz))
+def _local(z: cp.Variable, idx: np.ndarray) -> tuple[cp.Expression | None, int]:
+    """The entries z[idx] of one block (padding −1 dropped) and how many there are."""
+    live = idx[idx >= 0]
+    return (z[live] if live.size else None), int(live.size)
 
 
 class CvxpyBackend:
@@ -45,24 +43,26 @@ class CvxpyBackend:
         z = cp.Variable(nz, name="z")
         self.z = z
         nucs: list[cp.Expression] = []
-        self.m0p: list[cp.Parameter] = []
-        self.Gp: list[list[cp.Parameter]] = []
+        self.m0p: list[list[cp.Parameter]] = []
+        self.Gp: list[list[tuple[cp.Parameter, int] | None]] = []
         t0 = time.perf_counter()
         for g in groups:
             p, q = g.pq
-            pq = p * q
-            m0 = cp.Parameter(g.s * pq, name=f"m0_{len(self.m0p)}")
-            vec = m0
-            gps = []
-            for u in range(g.idx.shape[1]):
-                Gu = cp.Parameter(g.s * pq, name=f"G_{len(self.m0p)}_{u}")
-                gps.append(Gu)
-                vec = vec + cp.multiply(Gu, _selection(g.idx, pq, u, nz) @ z)
-            self.m0p.append(m0)
-            self.Gp.append(gps)
+            m0s, gps = [], []
             for t in range(g.s):
-                Mt = cp.reshape(vec[t * pq:(t + 1) * pq], (p, q), order="C")
+                m0 = cp.Parameter((p, q), name=f"m0_{len(self.m0p)}_{t}")
+                zt, u = _local(z, g.idx[t])
+                Mt: cp.Expression = m0
+                if u:
+                    Gt = cp.Parameter((p * q, u), name=f"G_{len(self.m0p)}_{t}")
+                    Mt = m0 + cp.reshape(Gt @ zt, (p, q), order="C")
+                    gps.append((Gt, u))
+                else:
+                    gps.append(None)
+                m0s.append(m0)
                 nucs.append(float(g.weight[t]) * cp.normNuc(Mt))
+            self.m0p.append(m0s)
+            self.Gp.append(gps)
         obj = cp.sum(cp.hstack(nucs)) if nucs else 0
         self.glin = cp.Parameter(nz, name="glin")
         self.glin.value = np.zeros(nz)
@@ -75,52 +75,63 @@ class CvxpyBackend:
         if red.D.shape[0]:
             cons.append(red.D @ z == red.d)
         for g in lmis:
-            s, e, _, u = g.Ec.shape
-            L = sps.csr_matrix((e * e * s, nz))
-            for uu in range(u):
-                L = L + sps.diags(g.Ec[:, :, :, uu].reshape(-1)) @ _selection(g.idx, e * e, uu, nz)
-            vecE = g.E0.reshape(-1) + L @ z
+            s, e, _, _ = g.Ec.shape
             for t in range(s):
-                Et = cp.reshape(vecE[t * e * e:(t + 1) * e * e], (e, e), order="C")
+                zt, u = _local(z, g.idx[t])
+                Et: cp.Expression = cp.Constant(g.E0[t])
+                if u:
+                    Et = Et + cp.reshape(g.Ec[t].reshape(e * e, -1)[:, :u] @ zt, (e, e), order="C")
                 cons.append(0.5 * (Et + Et.T) >> 0)
         self.problem = cp.Problem(cp.Minimize(obj), cons)
         self.build_time = time.perf_counter() - t0
         self.compilations = 0
-        self._prog = None
+        self.compile_time = 0.0
 
     def on_stall(self) -> None:
         """Nothing to adapt: the interior-point solve is exact."""
 
-    def step(self, Q: list[np.ndarray], R: list[np.ndarray], W: list[np.ndarray] | None,
-             z0: np.ndarray) -> tuple[np.ndarray, bool, str, dict]:
+    def step(self, built: list[tuple[np.ndarray, np.ndarray]], W: list[np.ndarray] | None,
+             z0: np.ndarray, residual: float = np.inf) -> tuple[np.ndarray, bool, str, dict]:
+        """One SCR sub-problem for the blocks M = m0 + G z of ``built``; returns (z, ok, message, timing).
+
+        ``residual`` (the last bilinear residual) is not needed: the interior-point solve is exact.
+        """
         tm = {"build": 0.0, "solve": 0.0}
         t = time.perf_counter()
         glin = np.zeros(self.red.nz)
         for k, g in enumerate(self.groups):
-            m0, G = g.build(Q[k], R[k])
-            self.m0p[k].value = m0.reshape(-1)
-            for u, Gu in enumerate(self.Gp[k]):
-                Gu.value = G[:, :, u].reshape(-1)
+            m0, G = built[k]
+            for t_, (mp, gp) in enumerate(zip(self.m0p[k], self.Gp[k], strict=True)):
+                mp.value = m0[t_]
+                if gp is not None:
+                    gp[0].value = G[t_, :, : gp[1]]
             if W is not None:
                 gl = np.einsum("spu,sp->su", G, (g.weight[:, None, None] * W[k]).reshape(g.s, -1))
                 m = g.idx >= 0
                 glin -= np.bincount(g.idx[m], weights=gl[m], minlength=self.red.nz)
         self.glin.value = glin
         tm["build"] = time.perf_counter() - t
+        cache = getattr(self.problem, "_cache", None)
+        prog_before = getattr(cache, "param_prog", None)
         t = time.perf_counter()
         try:
             self.problem.solve(solver=self.solver, **self.solver_options)
         except cp.error.SolverError as exc:
             tm["solve"] = time.perf_counter() - t
             return z0, False, f"cvxpy/{self.solver} failed: {exc}", tm
+        except (TypeError, ValueError) as exc:
+            if not self.solver_options:
+                raise
+            raise ModelError(f"solver_options {self.solver_options} were refused by {self.solver}: {exc}") from None
         tm["solve"] = time.perf_counter() - t
-        cache = getattr(self.problem, "_cache", None)
-        prog = getattr(cache, "param_prog", None)
-        if prog is not self._prog:
-            self.compilations += 1
-            self._prog = prog
-        st = self.problem.status
+        # a solve compiles unless it reused the cached parametrised program (DPP fast path)
+        prog_after = getattr(getattr(self.problem, "_cache", None), "param_prog", None)
+        compiled = prog_before is None or prog_after is not prog_before
         tm["compilation"] = float(self.problem.compilation_time or 0.0)
+        if compiled:
+            self.compilations += 1
+            self.compile_time += tm["compilation"]
+        st = self.problem.status
         if st not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or self.z.value is None:
             return z0, False, f"cvxpy/{self.solver} returned status {st!r}", tm
         msg = "" if st == cp.OPTIMAL else f"cvxpy/{self.solver}: {st}"

@@ -9,34 +9,14 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from symid.scr.maps import LocalMap
+from symid.scr.maps import LocalMap, stack_index, stack_maps
 from symid.scr.presolve import RealTerm
 
 __all__ = ["LMIGroup", "TermGroup", "group_lmis", "group_terms"]
-
-
-def _stack(maps: list[LocalMap], idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    s, u = idx.shape
-    r, c = maps[0].shape
-    const = np.stack([m.const.real for m in maps])
-    coef = np.zeros((s, r, c, u))
-    for t, m in enumerate(maps):
-        if m.idx.size:
-            pos = np.searchsorted(idx[t, : np.count_nonzero(idx[t] >= 0)], m.idx)
-            coef[t][:, :, pos] = m.coef.real
-    return const, coef
-
-
-def _index(maps_per_term: list[list[LocalMap]]) -> np.ndarray:
-    sets = [np.unique(np.concatenate([m.idx for m in ms])).astype(np.int64) for ms in maps_per_term]
-    u = max((x.size for x in sets), default=0)
-    idx = np.full((len(sets), u), -1, dtype=np.int64)
-    for t, x in enumerate(sets):
-        idx[t, : x.size] = x
-    return idx
 
 
 @dataclass(eq=False)
@@ -70,6 +50,16 @@ class TermGroup:
     def pq(self) -> tuple[int, int]:
         j, k, l, m = self.dims
         return j + k, m + l
+
+    @cached_property
+    def _slots(self) -> tuple[slice | np.ndarray, slice | np.ndarray, np.ndarray, np.ndarray]:
+        """Local slots u with a nonzero coefficient in some A (resp. B) of the group, and those coefficients."""
+        out: list[slice | np.ndarray] = []
+        for c in (self.Ac, self.Bc):
+            used = np.flatnonzero(np.any(c != 0, axis=(0, 1, 2)))
+            contiguous = used.size and used[-1] - used[0] + 1 == used.size
+            out.append(slice(int(used[0]), int(used[-1]) + 1) if contiguous else used)
+        return out[0], out[1], np.ascontiguousarray(self.Ac[..., out[0]]), np.ascontiguousarray(self.Bc[..., out[1]])
 
     def gather(self, z: np.ndarray) -> np.ndarray:
         """z at the term's indices, (s, u), zero at padding."""
@@ -105,10 +95,12 @@ class TermGroup:
         m0[:, j:, :m] = P @ (self.B0 + R)
         m0[:, j:, m:] = P
         G = np.zeros((s, j + k, m + l, u))
-        G[:, :j, :m] = (self.Cc + np.einsum("sjku,skm->sjmu", self.Ac, PR)
-                        + np.einsum("sjl,slmu->sjmu", QP, self.Bc))
-        G[:, :j, m:] = np.einsum("sjku,skl->sjlu", self.Ac, P)
-        G[:, j:, :m] = np.einsum("skl,slmu->skmu", P, self.Bc)
+        G[:, :j, :m] = self.Cc
+        a, b, Ac, Bc = self._slots  # only the slots A (resp. B) depends on: typically a few shared parameters
+        G[:, :j, :m, a] += np.einsum("sjku,skm->sjmu", Ac, PR)
+        G[:, :j, :m, b] += np.einsum("sjl,slmu->sjmu", QP, Bc)
+        G[:, :j, m:, a] = np.einsum("sjku,skl->sjlu", Ac, P)
+        G[:, j:, :m, b] = np.einsum("skl,slmu->skmu", P, Bc)
         return m0, G.reshape(s, (j + k) * (m + l), u)
 
 
@@ -143,10 +135,10 @@ def group_terms(terms: list[RealTerm]) -> list[TermGroup]:
     out = []
     for members in by.values():
         ts = [terms[i] for i in members]
-        idx = _index([[t.A, t.B, t.C] for t in ts])
-        A0, Ac = _stack([t.A for t in ts], idx)
-        B0, Bc = _stack([t.B for t in ts], idx)
-        C0, Cc = _stack([t.C for t in ts], idx)
+        idx = stack_index([[t.A, t.B, t.C] for t in ts])
+        A0, Ac = stack_maps([t.A for t in ts], idx)
+        B0, Bc = stack_maps([t.B for t in ts], idx)
+        C0, Cc = stack_maps([t.C for t in ts], idx)
         P = np.stack([t.P for t in ts])
         out.append(TermGroup(np.asarray(members), np.asarray([t.source for t in ts]), idx, A0, Ac, P, B0, Bc, C0, Cc,
                              np.asarray([t.weight for t in ts]),
@@ -162,7 +154,7 @@ def group_lmis(lmis: list[LocalMap]) -> list[LMIGroup]:
     out = []
     for members in by.values():
         ms = [lmis[i] for i in members]
-        idx = _index([[m] for m in ms])
-        E0, Ec = _stack(ms, idx)
+        idx = stack_index([[m] for m in ms])
+        E0, Ec = stack_maps(ms, idx)
         out.append(LMIGroup(idx, E0, Ec))
     return out

@@ -18,7 +18,7 @@ import sympy as sp
 from symid.errors import ModelError, NonAffineError
 from symid.scr.variables import Layout
 
-__all__ = ["Affine", "LocalMap", "as_map", "compile_sympy"]
+__all__ = ["Affine", "LocalMap", "as_map", "compile_sympy", "stack_index", "stack_maps"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,6 +59,33 @@ class LocalMap:
         for u, i in enumerate(self.idx):
             out[:, :, pos[int(i)]] += self.coef[:, :, u]
         return out
+
+
+def stack_index(maps_per_term: list[list[LocalMap]]) -> np.ndarray:
+    """Per term, the sorted union of the indices its maps touch, padded with −1 to a common width."""
+    sets = [np.unique(np.concatenate([m.idx for m in ms])).astype(np.int64) for ms in maps_per_term]
+    u = max((x.size for x in sets), default=0)
+    idx = np.full((len(sets), u), -1, dtype=np.int64)
+    for t, x in enumerate(sets):
+        idx[t, : x.size] = x
+    return idx
+
+
+def stack_maps(maps: list[LocalMap], idx: np.ndarray, real: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Equal-shape maps stacked on the padded index ``idx`` of :func:`stack_index`.
+
+    Returns the constants (s, r, c) and coefficients (s, r, c, u), zero at padding; real
+    parts only when ``real``.
+    """
+    s, u = idx.shape
+    r, c = maps[0].shape
+    const = np.stack([m.const for m in maps])
+    coef = np.zeros((s, r, c, u), dtype=complex)
+    for t, m in enumerate(maps):
+        if m.idx.size:
+            pos = np.searchsorted(idx[t, : np.count_nonzero(idx[t] >= 0)], m.idx)
+            coef[t][:, :, pos] = m.coef
+    return (const.real.copy(), coef.real.copy()) if real else (const, coef)
 
 
 def _clean(idx: np.ndarray, coef: np.ndarray, const: np.ndarray) -> LocalMap:
@@ -225,7 +252,7 @@ def as_map(value: Any, layout: Layout, name: str) -> LocalMap:
         arr = np.asarray(value)
     except (TypeError, ValueError):
         arr = np.asarray([], dtype=object)
-    if arr.dtype != object and arr.size:
+    if arr.size and (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool):
         if arr.ndim > 2:
             raise ModelError(f"{name} must be a matrix, got an array of shape {arr.shape}")
         a = arr.astype(complex).reshape((1, 1) if arr.ndim == 0 else ((-1, 1) if arr.ndim == 1 else arr.shape))

@@ -11,7 +11,7 @@ import scipy.sparse as sps
 import sympy as sp
 
 from symid.errors import ModelError
-from symid.scr.maps import LocalMap, as_map
+from symid.scr.maps import LocalMap, as_map, stack_index, stack_maps
 from symid.scr.variables import Layout, Variable
 
 __all__ = ["Bilinear", "BilinearProblem", "SumSquares"]
@@ -75,9 +75,6 @@ class CompiledTerm:
     B: LocalMap
     C: LocalMap
     weight: float
-
-    def residual(self, x: np.ndarray) -> np.ndarray:
-        return self.A(x) @ self.P @ self.B(x) - self.C(x)
 
 
 def _quadratic_from_sympy(expr: Any, layout: Layout) -> tuple[sps.csr_matrix, np.ndarray, float]:
@@ -143,6 +140,21 @@ def _quadratic_from_sumsquares(term: SumSquares, layout: Layout, name: str) -> t
     g = np.zeros(layout.n)
     np.add.at(g, m.idx, gl)
     return H, g, w * float(np.vdot(f0, f0).real)
+
+
+def _residual_groups(terms: list[CompiledTerm]) -> list[tuple[np.ndarray, ...]]:
+    """The user's bilinear terms stacked by shape (complex), for batched residuals."""
+    by: dict[tuple[tuple[int, int], ...], list[int]] = {}
+    for i, t in enumerate(terms):
+        by.setdefault((t.A.shape, t.P.shape, t.B.shape), []).append(i)
+    out = []
+    for members in by.values():
+        ts = [terms[i] for i in members]
+        idx = stack_index([[t.A, t.B, t.C] for t in ts])
+        stacked = [stack_maps([getattr(t, k) for t in ts], idx, real=False) for k in "ABC"]
+        P = np.stack([t.P for t in ts])
+        out.append((np.asarray(members), idx, *stacked[0], P, *stacked[1], *stacked[2]))
+    return out
 
 
 def _as_list(value: Any) -> list[Any]:
@@ -251,6 +263,7 @@ class BilinearProblem:
             else:
                 Hk, gk, ck = _quadratic_from_sympy(o, lay)
             H, g, c = H + Hk, g + gk, c + ck
+        self._residual_groups: list[tuple[np.ndarray, ...]] | None = None
         self.H: sps.csr_matrix = sps.csr_matrix(H)
         self.g: np.ndarray = g
         self.c: float = c
@@ -269,8 +282,19 @@ class BilinearProblem:
         return float(x @ (self.H @ x) + self.g @ x + self.c)
 
     def residuals(self, x: np.ndarray) -> np.ndarray:
-        """Frobenius norm of A(x) P B(x) − C(x) for every bilinear term."""
-        return np.array([np.linalg.norm(t.residual(x)) for t in self.terms])
+        """Frobenius norm of A(x) P B(x) − C(x) for every bilinear term (batched over equal shapes)."""
+        if self._residual_groups is None:
+            self._residual_groups = _residual_groups(self.terms)
+        x = np.asarray(x, dtype=float)
+        out = np.zeros(len(self.terms))
+        for members, idx, A0, Ac, P, B0, Bc, C0, Cc in self._residual_groups:
+            xl = np.where(idx >= 0, x[np.maximum(idx, 0)], 0.0)
+            A = A0 + np.einsum("sjku,su->sjk", Ac, xl)
+            B = B0 + np.einsum("slmu,su->slm", Bc, xl)
+            C = C0 + np.einsum("sjmu,su->sjm", Cc, xl)
+            r = A @ P @ B - C
+            out[members] = np.sqrt(np.einsum("sij,sij->s", r.conj(), r).real)
+        return out
 
     def __repr__(self) -> str:
         return (f"BilinearProblem(n={self.n}, variables={list(self.layout.names)}, bilinear={len(self.terms)}, "

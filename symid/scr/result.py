@@ -30,7 +30,9 @@ class Iteration:
     time : float
         Wall time of the iteration in seconds.
     timing : dict
-        Where the time went (back-end specific: build, factor, solve, svd, projection).
+        Where the wall time went (back-end specific: build, factor, solve, svd, projection,
+        bookkeeping), ADMM facts (inner_iterations, residuals, rho) and the process CPU
+        time of the iteration (``cpu``; less disturbed than wall time by other jobs).
     """
 
     objective: float

@@ -99,7 +99,10 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         Move the affine rows/columns of the bilinear terms to linear equalities and
         eliminate variables they determine (default ``True``); see :mod:`symid.scr.presolve`.
     normalize : bool
-        Equilibrate each term so one λ means the same across problems (default ``True``).
+        Equilibrate each term so one λ means the same across problems (default ``True``):
+        P scaled to unit spectral norm, each row of the equation by its largest coefficient
+        in A and C, each column by its largest coefficient in B and C; complex terms get
+        half the weight in the real representation (2-8). See :mod:`symid.scr`.
     admm : ADMMOptions, optional
         Options of the ADMM back end.
     solver_options : dict, optional
@@ -139,6 +142,14 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         raise ModelError(f"max_iter must be ≥ 1, got {max_iter}")
     if not (np.isfinite(tol) and tol > 0):
         raise ModelError(f"tol must be finite and > 0, got {tol}")
+    if step_tol is not None and not (np.isfinite(step_tol) and step_tol >= 0):
+        raise ModelError(f"step_tol must be finite and ≥ 0, got {step_tol}")
+    if int(truncate_after) < 0:
+        raise ModelError(f"truncate_after must be ≥ 0, got {truncate_after}")
+    if admm is not None and not isinstance(admm, ADMMOptions):
+        raise ModelError(f"admm must be an scr.ADMMOptions, got {type(admm).__name__}")
+    if solver_options is not None and not isinstance(solver_options, Mapping):
+        raise ModelError(f"solver_options must be a dict, got {type(solver_options).__name__}")
     lay = prob.layout
     x_start = lay.pack(x0)
     red = _presolve(prob, split=presolve, normalize=normalize)
@@ -171,21 +182,23 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
     Q_prev, R_prev = Q, R
     x_prev = red.lift(z)
     history: list[Iteration] = []
-    iterates: list[dict[str, Any]] = []
+    xs: list[np.ndarray] = []
     status, message = "max_iter", ""
     last_res = np.inf
     n_iter = max_iter if groups else 1
     for k in range(n_iter):
-        t_it = time.perf_counter()
+        t_it, c_it = time.perf_counter(), time.process_time()
         W = None
         if heuristic == "truncated" and k >= max(truncate_after, 1) and groups:
             W = _truncation(groups, ranks, Q_prev, R_prev, Q, R, z)
-        z_new, ok, msg, timing = be.step(Q, R, W, z)
+        t_b = time.perf_counter()
+        built = [g.build(q, r) for g, q, r in zip(groups, Q, R, strict=True)]
+        t_build = time.perf_counter() - t_b
+        z_new, ok, msg, timing = be.step(built, W, z, last_res)
         if not ok:
             status, message = "solver_error", msg
             break
         t_b = time.perf_counter()
-        built = [g.build(q, r) for g, q, r in zip(groups, Q, R, strict=True)]
         relax = _relaxation(red, groups, built, W, z_new)
         z = z_new
         x = red.lift(z)
@@ -196,17 +209,19 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         Q = [-g.A(z) for g in groups]
         R = [-g.B(z) for g in groups]
         timing = dict(timing)
+        timing["build"] = timing.get("build", 0.0) + t_build
         timing["bookkeeping"] = time.perf_counter() - t_b
+        timing["cpu"] = time.process_time() - c_it
         history.append(Iteration(red.objective(z), relax, res_terms, res, step, time.perf_counter() - t_it, timing))
-        iterates.append(lay.unpack(x))
+        xs.append(x)
         if msg:
             message = msg
         stol = (step_tol if step_tol is not None else max(10 * tol, 1e-8)) * max(1.0, float(np.abs(x).max(initial=0)))
         if res <= tol and step <= stol:
             status = "converged"
             break
-        if not groups:
-            status = "converged"
+        if not groups:  # convex after presolve: one exact (or capped ADMM) solve
+            status = "max_iter" if msg and backend == "admm" else "converged"
             break
         if res >= 0.99 * last_res:
             be.on_stall()
@@ -214,17 +229,21 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         x_prev = x
     if backend == "cvxpy":
         info["compilations"] = be.compilations
-        info["compile_time"] = float(be.problem.compilation_time or 0.0)
+        info["compile_time"] = be.compile_time
     else:
         info["inner_iterations"] = list(be.iterations)
+        info["rho_final"] = be.rho
     x_final = red.lift(z)
+    iterates = tuple(lay.unpack(xk) for xk in xs)
     if status == "converged":
         message = ("solved exactly: no bilinear term left after presolve" if not groups else
                    f"bilinear residual {history[-1].residual:.3e} ≤ tol = {tol:g} after {len(history)} iterations")
         if msg:
             message += f" (last sub-problem: {msg})"
+    elif status == "max_iter" and not groups:
+        message = f"the convex problem left after presolve was not solved to tolerance: {msg}"
     elif status == "max_iter":
         message = (f"maximum number of iterations ({max_iter}) reached; bilinear residual "
                    f"{history[-1].residual:.3e} > tol = {tol:g} or step {history[-1].step:.3e} too large")
-    return SCRSolution(lay.unpack(x_final), tuple(iterates), tuple(history), status, status == "converged", message,
+    return SCRSolution(lay.unpack(x_final), iterates, tuple(history), status, status == "converged", message,
                        len(history), time.perf_counter() - t_start, backend, x_final, info)
