@@ -2,9 +2,15 @@
 
 Run: python examples/belt_drive_ipopt.py
 
-Prints, for IPOPT (CasADi, exact Hessian, relative objective) on the zoo's 10-point FRF:
-the all-zero start, 10 seeded N(0, 1) starts, and θ0 = (−0.5, −0.5, −0.2, −0.1); and SCR
-from the same starts. Success: ‖θ − θ*‖₂/‖θ*‖₂ ≤ 1e-3.
+IPOPT (CasADi ``nlpsol``, exact Hessian, objective Σ‖Hᵢ − H(ωᵢ, θ)‖² / Σ‖Hᵢ‖², real and
+imaginary parts) on the zoo's 10-point FRF, from: the all-zero start; 10 draws
+θ0 ~ N(0, 1) (``numpy.random.default_rng(0)``); and θ0 = (−0.5, −0.5, −0.2, −0.1).
+SCR (default options) from the same starts. Success: ‖θ − θ*‖₂/‖θ*‖₂ ≤ 1e-3.
+
+Prints per start the final θ, the relative misfit and the solver status. Asserts what
+the README states about SCR: it succeeds from every one of these starts. IPOPT's
+outcome is reported, not asserted (the thesis's PEM failed in all three cases: fit
+−8.5% from zeros, best fit 68.5% over 10 random starts, and a miss from the close start).
 """
 
 from __future__ import annotations
@@ -18,19 +24,24 @@ from symid.misfit import relative_parameter_error
 def main() -> None:
     entry = si.load_model("belt_drive")
     model, data = entry.model, entry.data()
-    truth = model.theta_vector(entry.truth)
+    truth = model.theta_vector(entry.truth)  # thesis (3-18)
     rng = np.random.default_rng(0)
     cases = {"zeros": [np.zeros(4)], "10 x N(0,1), seed 0": [rng.standard_normal(4) for _ in range(10)],
              "(-0.5, -0.5, -0.2, -0.1)": [np.array([-0.5, -0.5, -0.2, -0.1])]}
-    print(f"{'start':>26s} {'method':>6s} {'successes':>10s}  final θ of the first start")
     for label, starts in cases.items():
+        print(f"\nstart: {label}")
         for method in ("ipopt", "scr"):
-            ok, first = 0, None
+            ok = 0
             for x0 in starts:
                 res = si.identify(model, data, method=method, x0=x0, identifiability_check=False)
-                ok += relative_parameter_error(res.theta_vector, truth) <= 1e-3
-                first = res.theta_vector if first is None else first
-            print(f"{label:>26s} {method:>6s} {ok:>6d}/{len(starts):<3d}  {np.array2string(first, precision=4)}")
+                err = relative_parameter_error(res.theta_vector, truth)
+                ok += err <= 1e-3
+                print(f"  {method:>5s}  θ0 = {np.array2string(x0, precision=2):>28s}  "
+                      f"θ̂ = {np.array2string(res.theta_vector, precision=4, max_line_width=200):>48s}  "
+                      f"rel. error {err:8.1e}  misfit {res.cost:8.1e}  {res.message[:60]}")
+            print(f"  {method}: {ok}/{len(starts)} succeed")
+            if method == "scr":
+                assert ok == len(starts), (label, ok)
 
 
 if __name__ == "__main__":

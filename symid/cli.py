@@ -61,7 +61,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from symid.identification import identify
-    from symid.plots import bode_plot
+    from symid.plots import bode_plot, start_convergence_plot
 
     entry, data, source = _entry_and_data(args.model, args.data)
     print(f"model: {entry.name}   data: {source}")
@@ -81,8 +81,14 @@ def _cmd_identify(args: argparse.Namespace) -> int:
             if res.polished is not None:
                 curves["after polish"] = (entry.model, res.polished.theta_vector)
             written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate"))
+        best = res.best_start
+        if best.history and "families" in best.history[0]:  # SCR: thesis Figure 3-2 for the reported start
+            written.append(start_convergence_plot(
+                best, out / "convergence.png", truth=None if truth is None else entry.model.theta_vector(truth),
+                title=f"{entry.name}: SCR convergence of the reported start"))
         print("wrote " + ", ".join(str(p) for p in written))
-    return 0 if res.success else 1
+    final = res.polished if res.polished is not None else res
+    return 0 if final.success else 1
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
@@ -97,7 +103,8 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     print(f"model: {entry.name}   data: {source}")
     scr_opts = _method_options(args)
     cmp = compare(entry.model, data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
-                  progress=True, options={"scr": scr_opts} if scr_opts and "scr" in methods else None)
+                  progress=True,
+                  options={"scr": scr_opts} if scr_opts and {"scr", "scr+polish"} & set(methods) else None)
     print(cmp.table())
     if args.out:
         out = Path(args.out)
@@ -156,7 +163,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
     p.add_argument("--max-iter", type=int, dest="max_iter", metavar="K", help="SCR iterations per start")
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
-    p.add_argument("--out", metavar="DIR", help="write result.json, summary.txt and bode.png here")
+    p.add_argument("--out", metavar="DIR",
+                   help="write result.json, summary.txt, bode.png and (SCR) convergence.png here")
     p.set_defaults(func=_cmd_identify)
 
     p = sub.add_parser("compare", help="compare estimators on the same data and starts",
@@ -164,7 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
                                    "median time per start, time to solution and best cost.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     p.add_argument("--data", metavar="FILE", help="data file; default: simulate the zoo recipe (truth known)")
-    p.add_argument("--methods", default="scr,ipopt", help="comma-separated methods (default: scr,ipopt)")
+    p.add_argument("--methods", default="scr,ipopt",
+                   help="comma-separated methods among scr, scr+polish (SCR then IPOPT from its estimate, "
+                        "reported apart), ipopt, ls (default: scr,ipopt)")
     p.add_argument("--starts", type=int, default=10, metavar="N", help="number of starts (default: 10)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the random starts (default: 0)")
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")

@@ -11,6 +11,7 @@ import numpy as np
 from symid.errors import ModelError
 from symid.identification import prepare
 from symid.misfit import relative_parameter_error
+from symid.polish import polish_outcome
 from symid.progress import progress_bar
 from symid.result import IdentificationResult, StartOutcome
 from symid.starts import make_starts
@@ -124,6 +125,16 @@ class Comparison:
         return self.table()
 
 
+def _polisher(model: Any, data: Any, solver: Any) -> Any:
+    """The local refinement for ``"<method>+polish"``: the solver's own, else IPOPT on the FRF."""
+    own = getattr(solver, "polisher", None)
+    if own is not None:
+        return own
+    from symid.nlls.frf import IpoptFRF
+
+    return IpoptFRF(model, data)
+
+
 def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *, starts: int = 10,
             seed: int | None = 0, truth: Any = None, x0: Any = None, param_tol: float = 1e-3,
             cost_tol: float = 1e-8, progress: bool | None = None,
@@ -135,7 +146,12 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     model : StateSpaceModel or SecondOrderModel
     data : FrequencyData
     methods : sequence of str
-        Methods to compare (see :func:`symid.identify`).
+        Methods to compare (see :func:`symid.identify`). ``"scr+polish"`` is SCR followed,
+        from every start, by a local IPOPT refinement of its estimate (kept only when it
+        lowers the misfit, :func:`symid.polish.polish_outcome`); its time per start is the
+        SCR time plus the polish time. When ``"scr"`` is compared too, the SCR runs are
+        shared, so the two rows report SCR alone and SCR + polish on the same SCR
+        estimates, never mixed.
     starts : int
         Number of starts; every method gets the same list (:func:`symid.starts.make_starts`).
     seed : int, optional
@@ -149,30 +165,64 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     progress : bool, optional
         Progress bar (default: on a terminal).
     options : dict, optional
-        Per-method options, e.g. ``{"scr": {"backend": "admm"}}``.
+        Per-method options, e.g. ``{"scr": {"backend": "admm"}}``; ``"scr+polish"``
+        uses the options of ``"scr"``.
 
     Returns
     -------
     Comparison
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> truth = {"m": 2.0, "c": 0.5, "k": 3.0}
+    >>> frf = si.simulate_frf(model, truth, np.linspace(0.5, 2.0, 5))
+    >>> cmp = si.compare(model, frf, methods=("ls", "ipopt"), starts=3, seed=0, truth=truth)
+    >>> cmp["ls"].n_success, cmp["ls"].n_starts
+    (3, 3)
     """
     if not methods:
         raise ModelError("compare() needs at least one method")
+    methods = tuple(methods)
+    if len(set(methods)) != len(methods):
+        raise ModelError(f"a method is listed twice in {methods}")
     options = dict(options or {})
-    unknown = set(options) - set(methods)
+    unknown = set(options) - {m.removesuffix("+polish") for m in methods}
     if unknown:
         raise ModelError(f"options given for methods not compared: {', '.join(sorted(unknown))}")
+    for m in methods:
+        if m.endswith("+polish") and m != "scr+polish":
+            raise ModelError(f"unknown method {m!r}: only 'scr+polish' is polished")
     truth_vec = None if truth is None else model.theta_vector(truth)
     x0s = make_starts(model, starts, seed, x0, zero_first=isinstance(model, StateSpaceModel))
+    runs: dict[str, tuple[Any, float, list[StartOutcome]]] = {}  # method → (solver, setup s, outcomes)
+
+    def run(method: str) -> tuple[Any, float, list[StartOutcome]]:
+        if method not in runs:
+            t0 = time.perf_counter()
+            solver = prepare(model, data, method, dict(options.get(method, {})))
+            setup = time.perf_counter() - t0
+            outcomes = [solver.run(x) for x in progress_bar(x0s, desc=method, enabled=progress)]
+            runs[method] = (solver, setup, outcomes)
+        return runs[method]
+
     stats = []
     for method in methods:
-        t0 = time.perf_counter()
-        solver = prepare(model, data, method, dict(options.get(method, {})))
-        setup = time.perf_counter() - t0
-        outcomes: list[StartOutcome] = []
-        for x in progress_bar(x0s, desc=f"{method}", enabled=progress):
-            outcomes.append(solver.run(x))
-        res = IdentificationResult.from_starts(solver.method, model.parameter_names, outcomes,
-                                               dict(getattr(solver, "options", {})))
+        if method == "scr+polish":
+            solver, setup, base = run("scr")
+            t0 = time.perf_counter()
+            polisher = _polisher(model, data, solver)
+            setup += time.perf_counter() - t0
+            outcomes = [polish_outcome(polisher, o) for o in progress_bar(base, desc=method, enabled=progress)]
+            ran_as = f"{solver.method}+polish"
+            opts = {**getattr(solver, "options", {}), "polish": getattr(polisher, "method", "polish")}
+        else:
+            solver, setup, outcomes = run(method)
+            ran_as, opts = solver.method, dict(getattr(solver, "options", {}))
+        res = IdentificationResult.from_starts(ran_as, model.parameter_names, outcomes, opts)
         if truth_vec is not None:
             ok = [relative_parameter_error(o.theta, truth_vec) <= param_tol for o in outcomes]
             best_err = relative_parameter_error(res.theta_vector, truth_vec)
@@ -181,7 +231,7 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
             best_err = None
         n_ok = int(sum(ok))
         total = setup + sum(o.wall_time for o in outcomes)
-        stats.append(MethodStats(method=method, ran_as=solver.method, n_starts=len(outcomes), n_success=n_ok,
+        stats.append(MethodStats(method=method, ran_as=ran_as, n_starts=len(outcomes), n_success=n_ok,
                                  success_rate=n_ok / len(outcomes),
                                  median_time=float(np.median([o.wall_time for o in outcomes])), setup_time=setup,
                                  time_to_solution=total / n_ok if n_ok else float("inf"),

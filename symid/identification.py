@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
@@ -11,6 +12,7 @@ import numpy as np
 from symid.errors import DataError, ModelError
 from symid.formulations.frf_ls import LinearFRF, ls_applicable
 from symid.nlls.frf import IpoptFRF
+from symid.polish import polish_outcome
 from symid.progress import progress_bar
 from symid.result import IdentificationResult, StartOutcome
 from symid.secondorder import SecondOrderModel
@@ -66,11 +68,19 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any]) -> Any:
     kind has its own ``_prepare_*`` function. A solver has ``method`` (the method that
     actually runs), ``options`` and ``run(x0) -> StartOutcome``.
     """
-    from symid.data import FrequencyData
+    from symid.data import BlackBox, FrequencyData, IOData, SpectralData
 
     _check_model(model)
     if isinstance(data, FrequencyData):
         return _prepare_frf(model, data, method, options)
+    if isinstance(data, SpectralData):
+        from symid.formulations.psd_prepare import prepare_spectral
+
+        return prepare_spectral(model, data, method, options)
+    if isinstance(data, (BlackBox, IOData)):
+        from symid.similarity import prepare_similarity
+
+        return prepare_similarity(model, data, method, options)
     raise DataError(f"identify() for {type(model).__name__} does not take {type(data).__name__} data here")
 
 
@@ -83,9 +93,12 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
     ----------
     model : StateSpaceModel or SecondOrderModel
         The grey-box model.
-    data : FrequencyData
-        The measurements.
-    method : {"scr", "ipopt", "ls"}
+    data : FrequencyData, BlackBox or IOData
+        The measurements. A black box, or input/output records (then N4SID and an
+        exact zero-order-hold ``d2c`` first), go to the similarity-transformation
+        formulations of thesis chapters 6 and 7 (:mod:`symid.similarity`), where the
+        methods are ``"scr"``, ``"als"``, ``"gb"``, ``"ipopt"`` and ``"ls"``.
+    method : {"scr", "ipopt", "ls", "als", "gb"}
         ``"scr"``: sequential convex relaxation (thesis Algorithm 3.1 / (4-8)); for a
         second-order model whose C or B is known, square and invertible the linear
         least squares (4-10)/(4-11) is exact and is used instead (reported as method
@@ -102,8 +115,11 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
     seed : int, optional
         Seed of the random starts.
     polish : bool
-        After SCR, refine the best estimate with IPOPT; reported in ``result.polished``,
-        never mixed into the SCR figures.
+        After SCR, refine the best estimate with IPOPT (kept only when it lowers the
+        misfit, :func:`symid.polish.polish_outcome`); reported as its own result in
+        ``result.polished`` (method ``"scr+polish"``, time = all SCR starts + polish),
+        never mixed into the SCR figures. :func:`symid.compare` polishes every start
+        (method ``"scr+polish"``).
     progress : bool, optional
         Show a progress bar over the starts (default: when there is more than one start
         and standard error is a terminal).
@@ -148,11 +164,11 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
     result = IdentificationResult.from_starts(solver.method, model.parameter_names, outcomes, options_used)
     if polish and solver.method == "scr":
         t0 = time.perf_counter()
-        polisher = IpoptFRF(model, data)
-        out = polisher.run(result.theta_vector)
-        out = StartOutcome(start=result.theta_vector, theta=out.theta, cost=out.cost, converged=out.converged,
-                           iterations=out.iterations, wall_time=time.perf_counter() - t0,
-                           message=f"IPOPT polish from the SCR estimate: {out.message}")
-        polished = IdentificationResult.from_starts("scr+polish", model.parameter_names, [out], {"polish": "ipopt"})
-        result = IdentificationResult(**{**result.__dict__, "polished": polished})
+        polisher = getattr(solver, "polisher", None) or IpoptFRF(model, data)
+        out = polish_outcome(polisher, result.best_start)
+        # the polished estimate cost every SCR start plus the polish
+        out = dataclasses.replace(out, wall_time=result.wall_time + time.perf_counter() - t0)
+        polished = IdentificationResult.from_starts("scr+polish", model.parameter_names, [out],
+                                                    {"polish": getattr(polisher, "method", "polish")})
+        result = dataclasses.replace(result, polished=polished)
     return result

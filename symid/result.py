@@ -10,6 +10,11 @@ import numpy as np
 __all__ = ["IdentificationResult", "StartOutcome"]
 
 
+def _best_index(starts: tuple[StartOutcome, ...] | list[StartOutcome]) -> int:
+    """Index of the lowest data misfit (non-finite costs rank last; the first on ties)."""
+    return int(np.argmin([s.cost if np.isfinite(s.cost) else np.inf for s in starts]))
+
+
 @dataclass(frozen=True)
 class StartOutcome:
     """What one start of one method produced.
@@ -102,14 +107,18 @@ class IdentificationResult:
         """Pick the best start by data misfit (non-finite costs rank last)."""
         if not starts:
             raise ValueError("no start outcome to report")
-        costs = np.array([s.cost if np.isfinite(s.cost) else np.inf for s in starts])
-        best = starts[int(np.argmin(costs))]
+        best = starts[_best_index(starts)]
         return cls(method=method, parameter_names=tuple(parameter_names),
                    theta=dict(zip(parameter_names, np.asarray(best.theta, dtype=float).tolist(), strict=True)),
                    theta_vector=np.asarray(best.theta, dtype=float), cost=float(best.cost),
                    success=bool(best.converged), iterations=int(best.iterations),
                    wall_time=float(sum(s.wall_time for s in starts)), message=best.message,
                    starts=tuple(starts), polished=polished, options=dict(options or {}))
+
+    @property
+    def best_start(self) -> StartOutcome:
+        """The start whose outcome is reported (lowest data misfit)."""
+        return self.starts[_best_index(self.starts)]
 
     @property
     def n_starts(self) -> int:

@@ -86,3 +86,46 @@ def test_console_script_runs_from_any_directory(tmp_path):
                           cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert "theta1" in proc.stdout
+
+
+def test_identify_scr_with_polish_and_its_progress_bar(tmp_path, capsys):
+    code = main(["identify", "mass_damper_2dof", "--method", "scr", "--starts", "2", "--seed", "1", "--max-iter", "15",
+                 "--polish", "--out", str(tmp_path)])
+    captured = capsys.readouterr()
+    assert code == 0
+    assert "method: scr " in captured.out and "after polish:" in captured.out
+    assert "scr starts" in captured.err  # the progress bar of the multi-start run (standard error)
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["method"] == "scr" and result["polished"]["method"] == "scr+polish"
+    assert (tmp_path / "convergence.png").stat().st_size > 10_000
+
+
+def test_compare_scr_polish_ipopt(capsys):
+    assert main(["compare", "belt_drive", "--methods", "scr,scr+polish,ipopt", "--starts", "3"]) == 0
+    captured = capsys.readouterr()
+    for row in ("   scr ", "scr+polish", "ipopt"):
+        assert row in captured.out
+    assert "ipopt" in captured.err  # progress bars
+
+
+def test_data_that_does_not_fit_the_model_is_a_clear_error(tmp_path, capsys):
+    import numpy as np
+
+    import symid as si
+
+    path = tmp_path / "two_outputs.npz"
+    si.FrequencyData(np.array([0.4, 0.5, 0.6]), np.ones((3, 2, 1), dtype=complex)).to_npz(path)
+    assert main(["identify", "belt_drive", "--data", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "symid: error: data H has 2 output(s) × 1 input(s) per frequency; the model has 1 output(s)" in err
+    assert "Traceback" not in err
+
+
+def test_demo_writes_table_and_both_figures(tmp_path, capsys):
+    from symid.demo import run_demo
+
+    assert run_demo(out=tmp_path, starts=3, convergence_iterations=20) == 0
+    out = capsys.readouterr().out
+    assert "time to solution s" in out and "‖θ̂ − θ*‖₂" in out
+    for name in ("bode.png", "convergence.png"):
+        assert (tmp_path / name).stat().st_size > 10_000

@@ -13,6 +13,22 @@ Hᵢ = fᵢ C(θ) Γᵢ with fᵢ = 1, jωᵢ or −ωᵢ² for position, veloci
 Every equation is posed as a bilinear term; the engine's presolve turns the rows that
 hold no product of unknowns into linear equalities and eliminates what they determine
 (scr-lessons 1 and 7), so only what is truly bilinear is relaxed.
+
+Choices, measured (``examples/belt_drive_scr.py``, ``examples/mass_damper_2dof_scr.py``,
+``benchmarks/frf.py``):
+
+- Γ alone by default. On the belt drive from zero, every equation relaxed, Γ reaches
+  ‖θ − θ*‖₂ ≤ 1e-6 (ADMM: iteration 131; Clarabel: 84); Γ and Ψ with unit weights
+  stall (ADMM 2e-2, Clarabel 0.26 after 1000 / 300 iterations); with the Ψ families
+  weighed δ = ρ = 0.01 they converge (1e-6 at iteration 95).
+- Unit weights λᵢ = γᵢ = 1 otherwise, as the thesis; the engine equilibrates every block
+  (rows, columns, P), which is the block scaling.
+- Γᵢ started at seeded N(0, 1) draws: on the 2-DOF the zero start and 10 of 10 default
+  starts (seed 0) converge with them; with Γᵢ computed from the model at θ0, 2 of the
+  same 10 stalled.
+- ADMM back end, tolerance 1e-6 on the normalised residual (relative parameter error
+  about 3e-6 on the 2-DOF): Clarabel costs ~1 s per iteration there, and the ADMM
+  cannot go much below 1e-7; ``polish`` finishes to machine precision.
 """
 
 from __future__ import annotations
@@ -28,6 +44,11 @@ from symid.misfit import relative_misfit
 from symid.result import StartOutcome
 
 __all__ = ["ScrFRF"]
+
+# constraint families: key of ``weights`` → label in plots (thesis Algorithm 3.1 weights λ, γ, δ, ρ)
+_FAMILIES_STATE_SPACE = {"gamma_dynamics": "f1: A Γ = jωΓ − B  (λ)", "gamma_output": "f2: H − D = C Γ  (γ)",
+                         "psi_dynamics": "f3: Ψ A = jωΨ − C  (δ)", "psi_output": "f4: H − D = Ψ B  (ρ)"}
+_FAMILIES_SECOND_ORDER = {"dynamics": "[M V K] P Γ = B", "output": "H = f C Γ"}
 
 
 def _theta_coef(amap: Any) -> np.ndarray:
@@ -55,44 +76,67 @@ class ScrFRF:
         State-space models: which substitution of thesis (3-10)/(3-12) to use
         (default ``"gamma"``; the thesis uses both, but with C known Ψ only slows
         convergence, scr-lessons 7). Second-order models always use Γ.
-    weights : array_like, optional
-        Per-frequency weights λᵢ (3-15); default 1 for every frequency.
+    weights : array_like or dict, optional
+        Weights of the nuclear-norm relaxations (Algorithm 3.1's λᵢ, γᵢ, δᵢ, ρᵢ). An
+        array of one positive number per frequency weighs every constraint family at
+        that frequency alike (3-15); a dict weighs families apart, by key
+        ``"gamma_dynamics"`` (λ), ``"gamma_output"`` (γ), ``"psi_dynamics"`` (δ),
+        ``"psi_output"`` (ρ) for a state-space model and ``"dynamics"``, ``"output"``
+        for a second-order one, each a number or one number per frequency (missing
+        families weigh 1). Default: 1 everywhere, as the thesis's examples. The engine
+        first equilibrates every term (:mod:`symid.scr.presolve`), so a weight means the
+        same whatever the units of H.
     lmis : bool, optional
         Second-order models: M, V, K ⪰ 0 (default True; thesis §5-7 and scr-lessons 2
         show they are decisive).
     backend : {"admm", "cvxpy"}
-        Engine back end (default ``"cvxpy"``: Clarabel).
+        Engine back end (default ``"admm"``: numpy ADMM, LMIs by projection, tens of
+        milliseconds per SCR iteration here; ``"cvxpy"``, Clarabel, solves each
+        sub-problem exactly and needs fewer iterations but costs about a second per
+        iteration on the 2-DOF problem, see ``benchmarks/frf.py``).
     max_iter : int
         SCR iterations per start (default 500).
     tol : float
-        Stopping tolerance on the normalised bilinear residual (default 1e-9).
-    gamma0 : {"model", "zero", "random"}
-        Initial Γᵢ (and Ψᵢ): computed from the start θ when that model is well defined
-        (default), zero (thesis ch. 3: "all matrices initialised as zero"), or seeded
-        N(0, 1) draws (scr-lessons 9: zero Γ makes the first 2-DOF sub-problem degenerate).
+        Stop when the largest normalised bilinear residual is ≤ ``tol`` and the step is
+        small (default 1e-6: the ADMM back end is inexact near 1e-7, scr-lessons 8; use
+        ``polish`` in :func:`symid.identify` / ``"scr+polish"`` in :func:`symid.compare`
+        for full precision).
+    gamma0 : {"random", "model", "zero"}
+        Initial Γᵢ (and Ψᵢ): seeded N(0, 1) draws (default; scr-lessons 9: zero or
+        model-consistent Γ made some 2-DOF starts stall), computed from the start θ
+        (``"model"``), or zero (thesis ch. 3: "all matrices initialised as zero").
+    seed : int
+        Seed of the random Γᵢ, combined with the start θ (so a start gives the same run
+        every time).
+    presolve : bool
+        Let the engine turn the rows that hold no product of unknowns into linear
+        equalities and eliminate what they fix (default True; ``False`` relaxes every
+        equation, as the thesis posed (3-15)).
+    heuristic : {"nuclear", "truncated"}
+        Rank surrogate of the engine (:func:`symid.scr.solve`).
+    admm : symid.scr.ADMMOptions, optional
+        Options of the ADMM back end.
     """
 
     method = "scr"
 
     def __init__(self, model: Any, data: Any, *, substitution: str = "gamma", weights: Any = None,
-                 lmis: bool = True, backend: str = "cvxpy", max_iter: int = 500, tol: float = 1e-9,
-                 gamma0: str = "model", seed: int = 0, presolve: bool = True, heuristic: str = "nuclear",
+                 lmis: bool = True, backend: str = "admm", max_iter: int = 500, tol: float = 1e-6,
+                 gamma0: str = "random", seed: int = 0, presolve: bool = True, heuristic: str = "nuclear",
                  admm: Any = None):
         if substitution not in ("gamma", "psi", "both"):
             raise ModelError(f"substitution must be 'gamma', 'psi' or 'both'; got {substitution!r}")
         if gamma0 not in ("model", "zero", "random"):
-            raise ModelError(f"gamma0 must be 'model', 'zero' or 'random'; got {gamma0!r}")
+            raise ModelError(f"gamma0 must be 'random', 'model' or 'zero'; got {gamma0!r}")
+        if backend not in ("admm", "cvxpy"):
+            raise ModelError(f"backend must be 'admm' or 'cvxpy'; got {backend!r}")
         self.model, self.data = model, data
         self.second_order = "M" in model.maps
         if self.second_order:
             substitution = "gamma"
         self.substitution = substitution
-        w = np.asarray(data.w, dtype=float)
-        self.w = w
-        s = w.size
-        lam = np.ones(s) if weights is None else np.asarray(weights, dtype=float).reshape(-1)
-        if lam.shape != (s,) or np.any(~np.isfinite(lam)) or np.any(lam <= 0):
-            raise ModelError(f"weights must be {s} positive finite numbers (one per frequency)")
+        self.w = np.asarray(data.w, dtype=float)
+        lam = self._weights(weights)
         self.options = {"substitution": substitution, "weights": "uniform" if weights is None else "given",
                         "lmis": lmis, "backend": backend, "max_iter": max_iter, "tol": tol, "gamma0": gamma0,
                         "presolve": presolve, "heuristic": heuristic}
@@ -105,7 +149,38 @@ class ScrFRF:
         self.problem = self._build(lam, lmis)
 
     # -- problem construction ---------------------------------------------------------------
-    def _build(self, lam: np.ndarray, lmis: bool) -> scr.BilinearProblem:
+    def _families(self) -> dict[str, str]:
+        """Constraint families of this formulation: key (for ``weights``) → label (for plots)."""
+        if self.second_order:
+            return dict(_FAMILIES_SECOND_ORDER)
+        return {k: v for k, v in _FAMILIES_STATE_SPACE.items()
+                if self.substitution == "both" or k.startswith(self.substitution)}
+
+    def _weights(self, weights: Any) -> dict[str, np.ndarray]:
+        """Per family, the weight of each frequency's relaxation (λᵢ, γᵢ, δᵢ, ρᵢ of Algorithm 3.1)."""
+        s = self.w.size
+        fams = self._families()
+
+        def vector(value: Any, what: str) -> np.ndarray:
+            v = np.broadcast_to(np.asarray(value, dtype=float), (s,)) if np.ndim(value) == 0 else \
+                np.asarray(value, dtype=float).reshape(-1)
+            if v.shape != (s,) or np.any(~np.isfinite(v)) or np.any(v <= 0):
+                raise ModelError(f"{what} must be a positive number or {s} positive finite numbers "
+                                 f"(one per frequency); got {np.asarray(value).shape} values")
+            return np.array(v, dtype=float)
+
+        if weights is None:
+            return {k: np.ones(s) for k in fams}
+        if isinstance(weights, dict):
+            unknown = sorted(set(weights) - set(fams))
+            if unknown:
+                raise ModelError(f"weights for unknown constraint famil{'y' if len(unknown) == 1 else 'ies'} "
+                                 f"{', '.join(unknown)}; this formulation has {', '.join(fams)}")
+            return {k: vector(weights.get(k, 1.0), f"weights[{k!r}]") for k in fams}
+        lam = vector(weights, "weights")
+        return {k: lam for k in fams}
+
+    def _build(self, lam: dict[str, np.ndarray], lmis: bool) -> scr.BilinearProblem:
         model, H = self.model, np.asarray(self.data.H, dtype=complex)
         maps = model.maps
         l = model.n_parameters
@@ -114,11 +189,13 @@ class ScrFRF:
         variables: list[scr.Variable] = [theta]
         terms: list[scr.Bilinear] = []
         lmi_list: list[Any] = []
+        labels = self._families()
         self.families: dict[str, list[int]] = {}
 
-        def add(family: str, term: scr.Bilinear) -> None:
-            self.families.setdefault(family, []).append(len(terms))
-            terms.append(term)
+        def add(family: str, i: int, **maps_: Any) -> None:
+            """The bilinear term A P B = C of frequency i in a constraint family, with its weight."""
+            self.families.setdefault(labels[family], []).append(len(terms))
+            terms.append(scr.Bilinear(**maps_, weight=float(lam[family][i]), name=f"{family}[{i}]"))
 
         def aff(amap: Any, sign: float = 1.0) -> scr.Affine:
             return scr.Affine(sign * amap.X0, {theta: sign * _theta_coef(amap)})
@@ -137,11 +214,8 @@ class ScrFRF:
                 self.gamma_vars.append(G)
                 Pi = np.vstack([-(wi**2) * np.eye(n), 1j * wi * np.eye(n), np.eye(n)])
                 Gi = scr.Affine(np.zeros((n, m)), {G: _identity((n, m))})
-                add("dynamics [M V K] P Γ = B", scr.Bilinear(A=A_mvk, P=Pi, B=Gi, C=aff(maps["B"]),
-                                                          weight=lam[i], name=f"dynamics[{i}]"))
-                # Hᵢ = fᵢ C(θ) Γᵢ
-                add("output H = C Γ", scr.Bilinear(A=aff(maps["C"]), P=f[i] * np.eye(n), B=Gi,
-                                                   C=scr.Affine(H[i]), weight=lam[i], name=f"output[{i}]"))
+                add("dynamics", i, A=A_mvk, P=Pi, B=Gi, C=aff(maps["B"]))
+                add("output", i, A=aff(maps["C"]), P=f[i] * np.eye(n), B=Gi, C=scr.Affine(H[i]))  # Hᵢ = fᵢ C Γᵢ
             if lmis:
                 for name in "MVK":
                     if maps[name].is_constant:
@@ -162,20 +236,16 @@ class ScrFRF:
                     self.gamma_vars.append(G)
                     Gi = scr.Affine(np.zeros((n, m)), {G: _identity((n, m))})
                     rhs = scr.Affine(-maps["B"].X0, {G: 1j * wi * _identity((n, m)), theta: -_theta_coef(maps["B"])})
-                    add("Γ dynamics A Γ = jωΓ − B", scr.Bilinear(A=aff(maps["A"]), P=eye, B=Gi, C=rhs,
-                                                                 weight=lam[i], name=f"gamma_dynamics[{i}]"))
-                    add("Γ output H − D = C Γ", scr.Bilinear(A=aff(maps["C"]), P=eye, B=Gi, C=Hi_minus_D,
-                                                             weight=lam[i], name=f"gamma_output[{i}]"))
+                    add("gamma_dynamics", i, A=aff(maps["A"]), P=eye, B=Gi, C=rhs)
+                    add("gamma_output", i, A=aff(maps["C"]), P=eye, B=Gi, C=Hi_minus_D)
                 if self.substitution in ("psi", "both"):
                     S = scr.Variable(f"Psi{i}", (p, n), complex=True)
                     variables.append(S)
                     self.psi_vars.append(S)
                     Si = scr.Affine(np.zeros((p, n)), {S: _identity((p, n))})
                     rhs = scr.Affine(-maps["C"].X0, {S: 1j * wi * _identity((p, n)), theta: -_theta_coef(maps["C"])})
-                    add("Ψ dynamics Ψ A = jωΨ − C", scr.Bilinear(A=Si, P=eye, B=aff(maps["A"]), C=rhs,
-                                                                 weight=lam[i], name=f"psi_dynamics[{i}]"))
-                    add("Ψ output H − D = Ψ B", scr.Bilinear(A=Si, P=eye, B=aff(maps["B"]), C=Hi_minus_D,
-                                                             weight=lam[i], name=f"psi_output[{i}]"))
+                    add("psi_dynamics", i, A=Si, P=eye, B=aff(maps["A"]), C=rhs)
+                    add("psi_output", i, A=Si, P=eye, B=aff(maps["B"]), C=Hi_minus_D)
         # positivity declared on parameters: θk ≥ 0 as 1×1 LMIs
         for k, pos in enumerate(model.positive):
             if pos:
@@ -229,21 +299,31 @@ class ScrFRF:
         return scr.solve(self.problem, self._aux_start(np.asarray(x0, dtype=float)), **self._solve_opts)
 
     def family_residuals(self, sol: scr.SCRSolution) -> dict[str, list[float]]:
-        """Per iteration, the summed residual of each constraint family (thesis Figure 3-2)."""
-        out = {}
-        for fam, idx in self.families.items():
-            out[fam] = [float(np.sum(np.asarray(h.residuals)[idx])) for h in sol.history]
-        return out
+        """Per iteration, the summed residual of each constraint family (thesis Figure 3-2's f_q)."""
+        return {fam: [float(np.sum(np.asarray(h.residuals)[idx])) for h in sol.history]
+                for fam, idx in self.families.items()}
+
+    def _history(self, sol: scr.SCRSolution) -> tuple[dict[str, Any], ...]:
+        """Per iteration: residual, objective, relaxation, time, θ and the family residuals."""
+        fams = self.family_residuals(sol)
+        return tuple({"residual": h.residual, "objective": h.objective, "relaxation": h.relaxation, "time": h.time,
+                      "theta": np.asarray(it["theta"], dtype=float).reshape(-1).tolist(),
+                      "families": {f: v[k] for f, v in fams.items()}}
+                     for k, (h, it) in enumerate(zip(sol.history, sol.iterates, strict=True)))
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start ``x0``; never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
-        sol = self.solve(x0)
+        try:
+            sol = self.solve(x0)
+        except (np.linalg.LinAlgError, ArithmeticError) as exc:  # a numerical breakdown inside the engine
+            return StartOutcome(start=x0, theta=np.full_like(x0, np.nan), cost=float("inf"), converged=False,
+                                iterations=0, wall_time=time.perf_counter() - t0,
+                                message=f"SCR failed: {type(exc).__name__}: {exc}")
         elapsed = time.perf_counter() - t0
         theta = np.asarray(sol.x["theta"], dtype=float).reshape(-1)
         cost = relative_misfit(self.model, self.data, theta)
-        hist = tuple({"residual": h.residual, "objective": h.objective, "relaxation": h.relaxation,
-                      "time": h.time} for h in sol.history)
         return StartOutcome(start=x0, theta=theta, cost=cost, converged=bool(sol.success and np.isfinite(cost)),
-                            iterations=sol.iterations, wall_time=elapsed, message=sol.message, history=hist)
+                            iterations=sol.iterations, wall_time=elapsed, message=sol.message,
+                            history=self._history(sol))
