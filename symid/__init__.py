@@ -30,7 +30,10 @@ if TYPE_CHECKING:
     from symid.comparison import Comparison, MethodStats, compare
     from symid.identification import identify
     from symid.simulate import simulate_frf, simulate_io, simulate_spectra
+    from symid.spectra import estimate_spectra
     from symid.structural import IdentifiabilityReport, identifiability
+    from symid.subspace import n4sid
+    from symid.zoh import d2c
 
 __version__ = "0.1.0"
 
@@ -38,10 +41,13 @@ _LAZY = {
     "Comparison": "symid.comparison",
     "MethodStats": "symid.comparison",
     "compare": "symid.comparison",
+    "d2c": "symid.zoh",
+    "n4sid": "symid.subspace",
     "identify": "symid.identification",
     "simulate_frf": "symid.simulate",
     "simulate_io": "symid.simulate",
     "simulate_spectra": "symid.simulate",
+    "estimate_spectra": "symid.spectra",
     "IdentifiabilityReport": "symid.structural",
     "identifiability": "symid.structural",
 }
@@ -81,10 +87,13 @@ __all__ = [
     "SymidError",
     "ZooEntry",
     "compare",
+    "d2c",
+    "estimate_spectra",
     "identifiability",
     "identify",
     "list_models",
     "load_model",
+    "n4sid",
     "parameters",
     "simulate_frf",
     "simulate_io",

@@ -1,0 +1,265 @@
+"""Subspace identification (N4SID) of a discrete-time state-space model from input/output records.
+
+Step 1 of the thesis's Algorithms 6.1 and 7.1: a black box (Ad, Bd, C, D) in an unknown
+state basis, from sampled u[k], y[k]. The algorithm is the deterministic–stochastic
+N4SID of Van Overschee & De Moor (1994; thesis reference [26]):
+
+1. block Hankel matrices of the past and future inputs and outputs over a horizon of
+   i samples, Up, Uf, Yp, Yf, and Wp = [Up; Yp];
+2. the oblique projection O = Yf /_Uf Wp, computed on the triangular factor of one LQ
+   decomposition of [Uf; Wp; Yf];
+3. its singular value decomposition; the n leading left singular vectors scaled by the
+   square roots of the singular values are the extended observability matrix Γ;
+4. C is the first block row of Γ and Ad solves the shift equation Γ↑ Ad = Γ↓ in least
+   squares;
+5. with Ad and C fixed the output is linear in Bd, D and the initial state, which are
+   then found by one linear least squares over the whole record.
+
+On noise-free data from a system of order n driven by a persistently exciting input
+the result is exact up to rounding (a similarity transform of the truth).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+
+from symid.data import BlackBox, IOData
+from symid.errors import DataError
+
+__all__ = ["DiscreteStateSpace", "n4sid"]
+
+#: A singular value below this fraction of the largest is treated as zero: the data do
+#: not hold that many states.
+_RANK_TOL = 1e-12
+
+
+@dataclass(frozen=True)
+class DiscreteStateSpace:
+    """A discrete-time model x[k+1] = A x[k] + B u[k], y[k] = C x[k] + D u[k] with sample time dt.
+
+    Attributes
+    ----------
+    A, B, C, D : numpy.ndarray
+        The matrices, shapes (n, n), (n, m), (p, n), (p, m).
+    dt : float
+        Sample time in seconds.
+    singular_values : numpy.ndarray
+        N4SID: singular values of the oblique projection (the order is the number of
+        clearly nonzero ones); empty for a model not estimated by :func:`n4sid`.
+    horizon : int
+        N4SID: block rows i of the past and future Hankel matrices (0 otherwise).
+    x0 : numpy.ndarray
+        N4SID: the estimated initial state.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    dt: float
+    singular_values: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    horizon: int = 0
+    x0: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def n_states(self) -> int:
+        """Order n."""
+        return int(self.A.shape[0])
+
+    @property
+    def poles(self) -> np.ndarray:
+        """Eigenvalues of A (discrete-time poles)."""
+        return np.linalg.eigvals(self.A)
+
+    def frequency_response(self, w: Any) -> np.ndarray:
+        """H(e^{jω dt}) = C (e^{jω dt} I − A)⁻¹ B + D at angular frequencies ``w`` (rad/s), shape (s, p, m)."""
+        w = np.atleast_1d(np.asarray(w, dtype=float))
+        z = np.exp(1j * w * self.dt)
+        n = self.n_states
+        X = np.linalg.solve(z[:, None, None] * np.eye(n) - self.A, np.broadcast_to(self.B.astype(complex),
+                                                                                     (w.size, *self.B.shape)))
+        return self.C @ X + self.D
+
+    def to_continuous(self) -> BlackBox:
+        """The exact zero-order-hold continuous-time equivalent (:func:`symid.d2c`)."""
+        from symid.zoh import d2c
+
+        return d2c(self.A, self.B, self.C, self.D, self.dt)
+
+    def summary(self) -> str:
+        """Sizes, sample time, poles and (for N4SID) the leading singular values."""
+        poles = np.sort_complex(self.poles)
+        lines = ["DiscreteStateSpace", f"  states n  : {self.n_states}", f"  inputs m  : {self.B.shape[1]}",
+                 f"  outputs p : {self.C.shape[0]}", f"  dt        : {self.dt:.6g} s",
+                 f"  poles     : {', '.join(f'{z:.6g}' for z in poles)}"]
+        if self.singular_values.size:
+            sv = self.singular_values[: self.n_states + 3]
+            lines.append(f"  N4SID singular values (horizon {self.horizon}): {', '.join(f'{v:.3e}' for v in sv)}")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form, suitable for JSON."""
+        return {"A": self.A.tolist(), "B": self.B.tolist(), "C": self.C.tolist(), "D": self.D.tolist(),
+                "dt": self.dt, "singular_values": self.singular_values.tolist(), "horizon": self.horizon,
+                "x0": self.x0.tolist()}
+
+
+def _hankel(x: np.ndarray, rows: int, cols: int) -> np.ndarray:
+    """Block Hankel matrix with ``rows`` block rows: block row r holds x[r : r + cols]ᵀ."""
+    return np.vstack([x[r:r + cols].T for r in range(rows)])
+
+
+def _min_samples(i: int, order: int, m: int, p: int) -> int:
+    """Samples needed for horizon i: j = N − 2i + 1 columns, at least 2(m + p)i + n of them."""
+    return 2 * i - 1 + 2 * (m + p) * i + order
+
+
+def _default_horizon(order: int, m: int, p: int, n_samples: int) -> int:
+    """``max(n + 1, 2⌈n/p⌉)``, raised to 10 when the record is long enough (oversampled data need it)."""
+    low = max(order + 1, 2 * math.ceil(order / p))
+    i = max(low, 10)
+    while i > low and n_samples < _min_samples(i, order, m, p):
+        i -= 1
+    return i
+
+
+def _check(io: Any, order: Any, horizon: Any) -> tuple[int, int]:
+    if not isinstance(io, IOData):
+        raise DataError(f"n4sid needs input/output records as symid.IOData(u, y, dt); got {type(io).__name__}")
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
+        raise DataError(f"order must be a positive integer (the number of states); got {order!r}")
+    order = int(order)
+    p, m = io.n_outputs, io.n_inputs
+    if horizon is None:
+        horizon = _default_horizon(order, m, p, io.n_samples)
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise DataError(f"horizon must be a positive integer (block rows of the Hankel matrices); got {horizon!r}")
+    i = int(horizon)
+    if p * i < order:
+        raise DataError(f"horizon {i} with {p} output(s) can reveal at most {p * i} states, fewer than order {order}: "
+                        f"use horizon >= {math.ceil(order / p)}")
+    need = _min_samples(i, order, m, p)
+    if io.n_samples < need:
+        raise DataError(f"the record of N = {io.n_samples} samples is too short for order {order} with horizon {i}, "
+                        f"{m} input(s) and {p} output(s): N4SID needs at least 2i − 1 + 2(m + p)i + n = {need} "
+                        "samples; record longer, or lower the order or the horizon")
+    return order, i
+
+
+def _b_d_x0(io: IOData, A: np.ndarray, C: np.ndarray, feedthrough: bool) -> tuple[np.ndarray, ...]:
+    """Least squares for B, D and x0 with A and C fixed (the output is linear in them)."""
+    u, y = io.u, io.y
+    N, m = u.shape
+    p, n = C.shape
+    # X[c] = Σ_{l<k} A^{k-1-l} u_l[c] : the state response to a unit column in B for input c
+    X = np.zeros((m, n, n))
+    P = np.eye(n)  # A^k for the initial-state regressor
+    rows_B = np.empty((N, p, m, n))
+    rows_x0 = np.empty((N, p, n))
+    for k in range(N):
+        rows_B[k] = np.einsum("pn,cnr->pcr", C, X)
+        rows_x0[k] = C @ P
+        X = A @ X + u[k][:, None, None] * np.eye(n)
+        P = A @ P
+    # y_k = Σ_c (C X_k[c]) B[:, c] + D u_k + C A^k x0 ; unknowns vec(B) (row-major: B[r, c] at r*m + c)
+    JB = np.transpose(rows_B, (0, 1, 3, 2)).reshape(N * p, n * m)
+    blocks = [JB]
+    if feedthrough:
+        JD = np.einsum("pq,kc->kpqc", np.eye(p), u).reshape(N * p, p * m)
+        blocks.append(JD)
+    blocks.append(rows_x0.reshape(N * p, n))
+    J = np.hstack(blocks)
+    sol, *_ = np.linalg.lstsq(J, y.reshape(-1), rcond=None)
+    B = sol[: n * m].reshape(n, m)
+    pos = n * m
+    D = np.zeros((p, m))
+    if feedthrough:
+        D = sol[pos:pos + p * m].reshape(p, m)
+        pos += p * m
+    return B, D, sol[pos:]
+
+
+def n4sid(io: IOData, order: int, *, horizon: int | None = None, feedthrough: bool = True) -> DiscreteStateSpace:
+    """Estimate a discrete-time state-space model of the given order from input/output records (N4SID).
+
+    Parameters
+    ----------
+    io : IOData
+        Input samples u (N, m), output samples y (N, p) and the sample time dt.
+    order : int
+        Number of states n.
+    horizon : int, optional
+        Block rows i of the past and future Hankel matrices; default
+        ``max(n + 1, 2⌈n/p⌉, 10)`` (less than 10 when the record is too short for it).
+        Larger values see more of the dynamics (oversampled records need them) but
+        cost more.
+    feedthrough : bool
+        Estimate D (default); ``False`` fixes D = 0 (strictly proper, e.g. position
+        outputs of a mechanical model).
+
+    Returns
+    -------
+    DiscreteStateSpace
+        (A, B, C, D) with ``dt = io.dt``, the singular values of the oblique projection
+        and the estimated initial state.
+
+    Raises
+    ------
+    DataError
+        On a bad order or horizon, a record too short for them, an input that is not
+        persistently exciting, or data that hold fewer than ``order`` states (the
+        ``order``-th singular value is zero: the order is too high for these data, or
+        the black box would not be minimal).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> a = si.parameters("a", positive=True)
+    >>> model = si.StateSpaceModel(A=[[-a]], B=[[1]], C=[[1]])
+    >>> u = np.random.default_rng(0).standard_normal(200)
+    >>> io = si.simulate_io(model, {"a": 2.0}, u, dt=0.1)
+    >>> dss = si.n4sid(io, 1, feedthrough=False)
+    >>> bool(np.isclose(dss.A[0, 0], np.exp(-0.2), rtol=1e-9))
+    True
+    >>> bool(np.isclose(dss.to_continuous().A[0, 0], -2.0, rtol=1e-8))
+    True
+    """
+    n, i = _check(io, order, horizon)
+    u, y = io.u, io.y
+    m, p = io.n_inputs, io.n_outputs
+    j = io.n_samples - 2 * i + 1
+    U = _hankel(u, 2 * i, j)
+    Y = _hankel(y, 2 * i, j)
+    Up, Uf = U[: m * i], U[m * i:]
+    Yp, Yf = Y[: p * i], Y[p * i:]
+    H = np.vstack([Uf, Up, Yp, Yf]) / math.sqrt(j)
+    L = scipy.linalg.qr(H.T, mode="r")[0][: H.shape[0]].T  # H = L Qᵀ, L lower triangular
+    mu, mw = m * i, (m + p) * i
+    Luu = L[:mu, :mu]
+    if np.min(np.abs(np.diag(Luu))) <= 1e-10 * max(np.max(np.abs(np.diag(Luu))), 1e-300):
+        raise DataError(f"the input is not persistently exciting of order {2 * i} (horizon {i}): its future block "
+                        "Hankel matrix is rank deficient; use a richer input (e.g. white noise) or a smaller horizon")
+    L_uw = L[: mu + mw, : mu + mw]
+    L_y = L[mu + mw:, : mu + mw]
+    coef = L_y @ np.linalg.pinv(L_uw)
+    Lw = coef[:, mu:]
+    O = Lw @ L[mu: mu + mw, : mu + mw]  # oblique projection Yf /_Uf Wp, in the Q basis
+    Us, s, _ = np.linalg.svd(O, full_matrices=False)
+    if s[0] <= 0 or not np.isfinite(s[0]):
+        raise DataError("the outputs hold no response to the inputs (the oblique projection is zero)")
+    if n > s.size or s[n - 1] <= _RANK_TOL * s[0]:
+        k = int(np.sum(s > _RANK_TOL * s[0]))
+        raise DataError(f"the data determine at most {k} state(s), fewer than order {n}: the order is too high for "
+                        f"these data (singular values {', '.join(f'{v:.2e}' for v in s[: n + 1])}); a model of this "
+                        f"order would not be minimal")
+    G = Us[:, :n] * np.sqrt(s[:n])
+    C = G[:p]
+    A, *_ = np.linalg.lstsq(G[:-p], G[p:], rcond=None)
+    B, D, x0 = _b_d_x0(io, A, C, feedthrough)
+    return DiscreteStateSpace(A=A, B=B, C=C, D=D, dt=io.dt, singular_values=s, horizon=i, x0=x0)
