@@ -70,28 +70,17 @@ def symmetric_truth(value: np.ndarray, prefix: str = "theta", start: int = 1) ->
 
 
 def balanced_realisation(A, B, C) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Balanced realisation of a stable, minimal continuous-time system (MATLAB ``balreal``).
+    """Balanced realisation (T A T⁻¹, T B, C T⁻¹) of a stable, minimal system (MATLAB ``balreal``).
 
-    Square-root method: Gramians Wc, Wo from the Lyapunov equations, ``Wc = L Lᵀ``,
-    ``Lᵀ Wo L = U Σ² Uᵀ``, ``T⁻¹ = L U Σ^(-1/2)``; both Gramians of
-    ``(T A T⁻¹, T B, C T⁻¹)`` equal Σ = diag(Hankel singular values), in decreasing
-    order. The sign of each balanced state is fixed so that the first nonzero entry of
-    its row of ``T B`` is positive (balreal's sign choice is not documented).
+    The transform is :func:`symid.realisation.balanced_realisation` (square-root method,
+    both Gramians equal to diag(Hankel singular values), sign of each state fixed by the
+    first clearly nonzero entry of its row of T B).
     """
-    import scipy.linalg as sla  # imported here: loading any zoo model should not pay for scipy (cold CLI)
+    from symid.realisation import balanced_realisation as balancing  # lazy: scipy only when a recipe runs
 
     A, B, C = (np.asarray(X, dtype=float) for X in (A, B, C))
-    Wc = sla.solve_continuous_lyapunov(A, -B @ B.T)
-    Wo = sla.solve_continuous_lyapunov(A.T, -C.T @ C)
-    L = np.linalg.cholesky((Wc + Wc.T) / 2)
-    U, s2, _ = np.linalg.svd(L.T @ Wo @ L)
-    Tinv = L @ U @ np.diag(s2**-0.25)
-    T = np.linalg.inv(Tinv)
-    Bb = T @ B
-    signs = np.array([np.sign(row[np.flatnonzero(np.abs(row) > 1e-12)[0]]) if np.any(np.abs(row) > 1e-12) else 1.0
-                      for row in Bb])
-    S = np.diag(signs)
-    return S @ T @ A @ Tinv @ S, S @ Bb, C @ Tinv @ S
+    T, Tinv = balancing(A, B, C)
+    return T @ A @ Tinv, T @ B, C @ Tinv
 
 
 def similar_to(A, B, C, A_ref, B_ref, C_ref) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

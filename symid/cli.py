@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 
@@ -157,7 +158,9 @@ def build_parser() -> argparse.ArgumentParser:
                                    "(CSV or NPZ written by symid); without --data, from the zoo's own recipe.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     p.add_argument("--data", metavar="FILE", help="data file (CSV or NPZ); default: simulate the zoo recipe")
-    p.add_argument("--method", choices=("scr", "ipopt", "ls"), default="scr", help="estimator (default: scr)")
+    p.add_argument("--method", choices=("scr", "ipopt", "ls", "als", "gb"), default="scr",
+                   help="estimator (default: scr); als and gb (alternating least squares, gradient-based BFGS, "
+                        "thesis appendix C) take black-box or I/O data")
     p.add_argument("--starts", type=int, default=1, metavar="N", help="number of starts (default: 1)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the random starts (default: 0)")
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
@@ -174,7 +177,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--data", metavar="FILE", help="data file; default: simulate the zoo recipe (truth known)")
     p.add_argument("--methods", default="scr,ipopt",
                    help="comma-separated methods among scr, scr+polish (SCR then IPOPT from its estimate, "
-                        "reported apart), ipopt, ls (default: scr,ipopt)")
+                        "reported apart), ipopt, ls, and for black-box or I/O data als, gb (default: scr,ipopt)")
     p.add_argument("--starts", type=int, default=10, metavar="N", help="number of starts (default: 10)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the random starts (default: 0)")
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
@@ -210,10 +213,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
+        sys.stdout.flush()  # inside the try: a closed pipe surfaces here, not at interpreter exit
+        return code
     except SymidError as exc:
         print(f"symid: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # the reader went away (`symid models | head`): stop quietly, as other command-line tools do
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":

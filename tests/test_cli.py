@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -129,3 +130,25 @@ def test_demo_writes_table_and_both_figures(tmp_path, capsys):
     assert "time to solution s" in out and "‖θ̂ − θ*‖₂" in out
     for name in ("bode.png", "convergence.png"):
         assert (tmp_path / name).stat().st_size > 10_000
+
+
+def test_closed_pipe_is_not_a_traceback(monkeypatch, tmp_path):
+    """`symid models | head -1`: when the reader has closed the pipe, writing raises BrokenPipeError;
+    the command stops quietly with exit code 0 instead of a traceback."""
+
+    class ClosedPipe:
+        def __init__(self, fd):
+            self.fd = fd
+
+        def write(self, text):
+            raise BrokenPipeError(32, "Broken pipe")
+
+        def flush(self):
+            raise BrokenPipeError(32, "Broken pipe")
+
+        def fileno(self):
+            return self.fd
+
+    with open(tmp_path / "stdout", "w") as sink:
+        monkeypatch.setattr(sys, "stdout", ClosedPipe(os.dup(sink.fileno())))
+        assert main(["models"]) == 0

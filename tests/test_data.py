@@ -426,3 +426,8 @@ def test_round_trip_property(obj, fmt):
     assert type(back) is type(obj)
     for name in type(obj)._npz_keys:
         assert np.asarray(getattr(back, name)).tobytes() == np.asarray(getattr(obj, name)).tobytes()
+
+
+def test_iodata_without_dt_names_it():
+    with pytest.raises(DataError, match=r"dt \(the sample time in seconds\) is required"):
+        IOData(np.ones(5), np.ones(5))

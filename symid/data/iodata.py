@@ -80,7 +80,7 @@ class IOData(DataContainer):
     _kind: ClassVar[str] = "IOData"
     _npz_keys: ClassVar[tuple[str, ...]] = ("u", "y", "dt")
 
-    def __init__(self, u: Any, y: Any, dt: Any):
+    def __init__(self, u: Any, y: Any, dt: Any = None):
         u_ = _signal(u, "u", "m")
         y_ = _signal(y, "y", "p")
         if u_.shape[0] != y_.shape[0]:
@@ -94,6 +94,8 @@ class IOData(DataContainer):
                 raise DataError(f"{label} has shape {_checks.shape_text(arr.shape)}: {arr.shape[1]} channels but only "
                                 f"{arr.shape[0]} samples; arrays are (samples, channels), one row per sample "
                                 f"(pass {label}.T if you have one row per channel)")
+        if dt is None:
+            raise DataError("dt (the sample time in seconds) is required: IOData(u, y, dt)")
         dt_ = _checks.check_positive_scalar(dt, "dt")
         object.__setattr__(self, "u", _checks.frozen(u_))
         object.__setattr__(self, "y", _checks.frozen(y_))
