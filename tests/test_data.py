@@ -429,5 +429,5 @@ def test_round_trip_property(obj, fmt):
 
 
 def test_iodata_without_dt_names_it():
-    with pytest.raises(DataError, match=r"dt \(the sample time in seconds\) is required"):
+    with pytest.raises(DataError, match=r"dt is missing: IOData\(u, y, dt\) needs the sample time"):
         IOData(np.ones(5), np.ones(5))

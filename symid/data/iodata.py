@@ -95,7 +95,7 @@ class IOData(DataContainer):
                                 f"{arr.shape[0]} samples; arrays are (samples, channels), one row per sample "
                                 f"(pass {label}.T if you have one row per channel)")
         if dt is None:
-            raise DataError("dt (the sample time in seconds) is required: IOData(u, y, dt)")
+            raise DataError("dt is missing: IOData(u, y, dt) needs the sample time in seconds")
         dt_ = _checks.check_positive_scalar(dt, "dt")
         object.__setattr__(self, "u", _checks.frozen(u_))
         object.__setattr__(self, "y", _checks.frozen(y_))
