@@ -11,8 +11,11 @@ Methods, from the same seeded starts (:func:`symid.compare`; state-space models 
 zero start first, as thesis ch. 3):
 
 - ``scr``: default options (ADMM back end, presolve, tol 1e-6, unit weights);
-- ``scr+polish``: the same SCR runs, each followed by IPOPT from its estimate; time per
-  start = SCR + polish;
+- ``scr+polish``: SCR handing over to IPOPT (:meth:`symid.formulations.frf_scr.ScrFRF.run_polished`):
+  after SCR iterations 1, 2, 4, … a trial IPOPT run from the current SCR estimate, and the
+  start ends as soon as one fits the data (relative misfit ≤ 1e-8); else the final SCR
+  estimate is polished. Built and run on its own (nothing shared with the ``scr`` row);
+  time per start = SCR + every polish, trials included;
 - ``ipopt``: CasADi ``nlpsol`` with exact Hessian, objective normalised by Σ‖Hᵢ‖², bounds
   θ ≥ 0 on parameters declared positive, tolerance 1e-12 (scr-lessons 3 and 11). Other
   IPOPT configurations (L-BFGS, no bounds, parameter scaling, looser tolerance) run from

@@ -13,7 +13,7 @@ from symid.identification import prepare
 from symid.misfit import relative_parameter_error
 from symid.polish import polish_outcome
 from symid.progress import progress_bar
-from symid.result import IdentificationResult, StartOutcome
+from symid.result import IdentificationResult
 from symid.starts import make_starts
 from symid.statespace import StateSpaceModel
 
@@ -146,12 +146,15 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     model : StateSpaceModel or SecondOrderModel
     data : FrequencyData
     methods : sequence of str
-        Methods to compare (see :func:`symid.identify`). ``"scr+polish"`` is SCR followed,
-        from every start, by a local IPOPT refinement of its estimate (kept only when it
-        lowers the misfit, :func:`symid.polish.polish_outcome`); its time per start is the
-        SCR time plus the polish time. When ``"scr"`` is compared too, the SCR runs are
-        shared, so the two rows report SCR alone and SCR + polish on the same SCR
-        estimates, never mixed.
+        Methods to compare (see :func:`symid.identify`). ``"scr+polish"`` is SCR handing
+        over, from every start, to a local IPOPT refinement: SCR stops as soon as a trial
+        polish from its current estimate fits the data (relative misfit ≤ the SCR option
+        ``polish_misfit``, default 1e-8; trials after SCR iterations 1, 2, 4, …), else
+        its final estimate is polished (kept only when that lowers the misfit,
+        :func:`symid.polish.polish_outcome`); see
+        :meth:`symid.formulations.frf_scr.ScrFRF.run_polished`. It is built and run on its
+        own, so its setup and time per start (SCR + every polish) share nothing with the
+        ``"scr"`` row: the two rows report SCR alone and SCR + polish, never mixed.
     starts : int
         Number of starts; every method gets the same list (:func:`symid.starts.make_starts`).
     seed : int, optional
@@ -198,29 +201,26 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
             raise ModelError(f"unknown method {m!r}: only 'scr+polish' is polished")
     truth_vec = None if truth is None else model.theta_vector(truth)
     x0s = make_starts(model, starts, seed, x0, zero_first=isinstance(model, StateSpaceModel))
-    runs: dict[str, tuple[Any, float, list[StartOutcome]]] = {}  # method → (solver, setup s, outcomes)
-
-    def run(method: str) -> tuple[Any, float, list[StartOutcome]]:
-        if method not in runs:
-            t0 = time.perf_counter()
-            solver = prepare(model, data, method, dict(options.get(method, {})))
-            setup = time.perf_counter() - t0
-            outcomes = [solver.run(x) for x in progress_bar(x0s, desc=method, enabled=progress)]
-            runs[method] = (solver, setup, outcomes)
-        return runs[method]
-
     stats = []
     for method in methods:
+        base = method.removesuffix("+polish")
+        t0 = time.perf_counter()
+        solver = prepare(model, data, base, dict(options.get(base, {})))  # every row builds its own: nothing shared
+        bar = progress_bar(x0s, desc=method, enabled=progress)
         if method == "scr+polish":
-            solver, setup, base = run("scr")
-            t0 = time.perf_counter()
             polisher = _polisher(model, data, solver)
-            setup += time.perf_counter() - t0
-            outcomes = [polish_outcome(polisher, o) for o in progress_bar(base, desc=method, enabled=progress)]
+            setup = time.perf_counter() - t0
+            if hasattr(solver, "run_polished"):  # hands over to the polish once in a good basin
+                outcomes = [solver.run_polished(x, polisher) for x in bar]
+            else:
+                outcomes = [polish_outcome(polisher, solver.run(x)) for x in bar]
             ran_as = f"{solver.method}+polish"
             opts = {**getattr(solver, "options", {}), "polish": getattr(polisher, "method", "polish")}
+            if hasattr(solver, "polish_misfit"):
+                opts["polish_misfit"] = solver.polish_misfit
         else:
-            solver, setup, outcomes = run(method)
+            setup = time.perf_counter() - t0
+            outcomes = [solver.run(x) for x in bar]
             ran_as, opts = solver.method, dict(getattr(solver, "options", {}))
         res = IdentificationResult.from_starts(ran_as, model.parameter_names, outcomes, opts)
         if truth_vec is not None:

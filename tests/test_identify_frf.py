@@ -225,7 +225,7 @@ def test_polish_is_reported_apart_from_scr():
     assert "after polish" in res.summary()
 
 
-def test_compare_reports_scr_and_scr_plus_polish_from_the_same_runs():
+def test_compare_reports_scr_and_scr_plus_polish_from_the_same_starts():
     model = two_dof()
     frf = si.simulate_frf(model, TRUTH_2DOF, W_2DOF)
     cmp = si.compare(model, frf, methods=("scr", "scr+polish"), starts=2, seed=1, truth=TRUTH_2DOF,
@@ -234,11 +234,34 @@ def test_compare_reports_scr_and_scr_plus_polish_from_the_same_runs():
     assert pol.ran_as == "scr+polish" and scr.n_starts == pol.n_starts == 2
     for a, b in zip(scr.result.starts, pol.result.starts, strict=True):
         np.testing.assert_array_equal(a.start, b.start)
-        assert b.wall_time > a.wall_time and b.cost <= a.cost
+        assert b.cost <= 1e-8 and "handed over to ipopt" in b.message  # SCR + IPOPT, reported as such
+        assert "ipopt" not in a.message  # SCR alone: no polish mixed in
     assert pol.best_error < 1e-8 < scr.best_error
     assert "scr+polish" in cmp.table()
     with pytest.raises(si.ModelError, match="only 'scr\\+polish' is polished"):
         si.compare(model, frf, methods=("ipopt+polish",), starts=1)
+
+
+def test_run_polished_hands_over_only_when_the_trial_fits():
+    from symid.formulations.frf_scr import ScrFRF
+    from symid.nlls.frf import IpoptFRF
+    from symid.starts import make_starts
+
+    model = two_dof()
+    frf = si.simulate_frf(model, TRUTH_2DOF, W_2DOF)
+    x0 = make_starts(model, 1, 1)[0]
+    truth = model.theta_vector(TRUTH_2DOF)
+    early = ScrFRF(model, frf).run_polished(x0, IpoptFRF(model, frf))
+    # a trial after SCR iteration 1, 2, 4, … reached misfit ≤ 1e-8: SCR stopped there (powers of two only)
+    k = int(early.message.split("after ")[1].split(" iteration")[0])
+    assert "handed over to ipopt" in early.message and k & (k - 1) == 0
+    assert early.converged and early.cost <= 1e-8 and len(early.history) == k
+    np.testing.assert_allclose(early.theta, truth, rtol=1e-6)
+    # no trials: SCR runs to its own end, then its final estimate is polished
+    late = ScrFRF(model, frf, polish_misfit=None, max_iter=8).run_polished(x0, IpoptFRF(model, frf))
+    assert "handed over" not in late.message and len(late.history) == 8
+    with pytest.raises(si.ModelError, match="polish_misfit must be a positive number or None"):
+        ScrFRF(model, frf, polish_misfit=0.0)
 
 
 # -- bad input ------------------------------------------------------------------------------------

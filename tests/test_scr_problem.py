@@ -328,3 +328,57 @@ def test_admm_warm_start_and_tightening():
     tightened = scr.solve(prob, x0=x0, admm=scr.ADMMOptions(**loose), **opts)
     assert not capped.success and capped.residual > 1e-4
     assert tightened.success and tightened.residual <= 1e-5
+
+
+def test_rank_deficient_P_is_compressed_without_changing_the_iterates(monkeypatch):
+    # A P B with A = [x, x], P = ones/4, B = [x; x] is x·x = y − a: presolve step 6 compresses P to
+    # rank 1; SCR on the compressed block must give the iterates of the uncompressed one
+
+    def padded():  # a new object each time: the presolve is cached on the problem
+        return scr.BilinearProblem(
+            variables=[x, y, a],
+            bilinear=[scr.Bilinear(A=[[x, x]], P=np.full((2, 2), 0.25), B=[[x], [x]], C=[[y - a]], weight=0.1)],
+            objective=100 * a**2 + (1 - x) ** 2)
+
+    assert presolve(padded()).terms[0].dims == (1, 1, 1, 1)  # (j, k, l, m): P 2×2 → 1×1
+    exact = {"admm": scr.ADMMOptions(eps_abs=1e-11, eps_rel=1e-11, inner_max=100_000), "cvxpy": None}
+    opts = {b: {"backend": b, "admm": exact[b], "max_iter": 3, "tol": 1e-12} for b in exact}
+    got = {b: scr.solve(padded(), x0={x: -1.9, y: 2}, **o) for b, o in opts.items()}
+    import symid.scr.presolve as pre
+
+    monkeypatch.setattr(pre, "_compress", lambda A, P, B: (A, P, B))
+    assert presolve(padded()).terms[0].dims == (1, 2, 2, 1)
+    for backend, sol in got.items():
+        ref = scr.solve(padded(), x0={x: -1.9, y: 2}, **opts[backend])
+        assert len(ref.iterates) == len(sol.iterates) == 3
+        # the same sub-problems: equal optimal values; equal iterates, to 1e-6 for the ADMM, and to
+        # 1e-3 for Clarabel, whose y (the sub-problem is flat in y near its optimum) moves by 3e-4
+        np.testing.assert_allclose([h.relaxation for h in sol.history], [h.relaxation for h in ref.history],
+                                   rtol=1e-6)
+        atol = 1e-6 if backend == "admm" else 1e-3
+        for i1, i2 in zip(ref.iterates, sol.iterates, strict=True):
+            np.testing.assert_allclose([i2["x"], i2["y"]], [i1["x"], i1["y"]], rtol=0, atol=atol)
+
+
+def test_callback_stops_the_iteration():
+    seen = []
+
+    def stop_at_two(k, xk):
+        seen.append((k, xk["x"]))
+        return k >= 2
+
+    sol = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, backend="admm", max_iter=10, callback=stop_at_two)
+    assert sol.status == "stopped" and not sol.success and sol.iterations == 2
+    assert [k for k, _ in seen] == [1, 2] and "stopped by the callback after 2 iterations" in sol.message
+    assert seen[0][1] == pytest.approx(0.900, abs=1e-3)  # the thesis's first iterate, §2-5-2
+    with pytest.raises(ModelError, match="callback must be callable"):
+        scr.solve(rosenbrock(), callback=3)
+
+
+def test_second_solve_reuses_presolve_and_compiled_problem():
+    prob = rosenbrock()
+    first = scr.solve(prob, x0={x: -1.9, y: 2}, backend="cvxpy", max_iter=3)
+    again = scr.solve(prob, x0={x: -1.9, y: 2}, backend="cvxpy", max_iter=3)
+    assert first.info["compilations"] == 1 and again.info["compilations"] == 0
+    for i1, i2 in zip(first.iterates, again.iterates, strict=True):  # same iterates, reused or not
+        np.testing.assert_allclose([i2["x"], i2["y"]], [i1["x"], i1["y"]], rtol=1e-9, atol=1e-9)

@@ -14,6 +14,11 @@
    by its spectral norm (C with it), each row of the equation by the largest coefficient
    of that row of A and C, each column by the largest coefficient of that column of B
    and C. A weight λ therefore means the same in problems whose data have other units.
+6. A P of rank r below its row count k or column count l (e.g. the stacked
+   Pᵢ = [−ωᵢ²I; jωᵢI; I] of thesis (4-8)) is compressed by its thin SVD P = U Σ Vᵀ:
+   A ← A U, P ← Σ, B ← Vᵀ B (each side only when rank-deficient). The matrix M of (2-6)
+   becomes diag(I, Uᵀ) M diag(I, V), whose singular values are M's, so every SCR
+   sub-problem is the same, on a block of (j + r) × (m + r) instead of (j + k) × (m + l).
 """
 
 from __future__ import annotations
@@ -231,6 +236,23 @@ def _scale(t: CompiledTerm) -> CompiledTerm:
     return CompiledTerm(t.name, A, P, B, C, t.weight)
 
 
+def _compress(A: LocalMap, P: np.ndarray, B: LocalMap) -> tuple[LocalMap, np.ndarray, LocalMap]:
+    """Drop the null directions of a rank-deficient real P (step 6 of the module docstring)."""
+    k, l = P.shape
+    U, sv, Vt = np.linalg.svd(P, full_matrices=False)
+    r = int(np.sum(sv > 1e-12 * sv[0])) if sv.size else 0
+    if r == 0 or r == k == l:
+        return A, P, B
+    U, sv, Vt = U[:, :r], sv[:r], Vt[:r]
+    if r < k:
+        A = LocalMap(A.const @ U, A.idx, np.einsum("jku,kr->jru", A.coef, U))
+        P = U.T @ P
+    if r < l:
+        B = LocalMap(Vt @ B.const, B.idx, np.einsum("rl,lmu->rmu", Vt, B.coef))
+        P = P @ Vt.T
+    return A, P, B
+
+
 def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = True) -> Reduced:
     """Reduce ``prob`` to the real problem on the free variables that the back ends solve.
 
@@ -287,7 +309,8 @@ def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = Tru
         if cplx:
             A, B, C, P, w = _realrep(A), _realrep(B), _realrep(C), _realrep_p(P), w / 2
         A, B, C = (LocalMap(m.const.real, pos[m.idx], m.coef.real) for m in (A, B, C))
-        real_terms.append(RealTerm(A, np.asarray(P.real, dtype=float), B, C, w, src, cplx))
+        A, P, B = _compress(A, np.asarray(P.real, dtype=float), B)
+        real_terms.append(RealTerm(A, P, B, C, w, src, cplx))
     lmis = []
     for m in prob.lmis:
         m = _substitute(m, fixed, xfix)
