@@ -12,6 +12,7 @@ parameter vector per block made compilation quadratic).
 from __future__ import annotations
 
 import time
+import warnings
 
 import cvxpy as cp
 import numpy as np
@@ -115,7 +116,9 @@ class CvxpyBackend:
         prog_before = getattr(cache, "param_prog", None)
         t = time.perf_counter()
         try:
-            self.problem.solve(solver=self.solver, **self.solver_options)
+            with warnings.catch_warnings():  # an inaccurate solve is reported through the status below
+                warnings.filterwarnings("ignore", message="Solution may be inaccurate", category=UserWarning)
+                self.problem.solve(solver=self.solver, **self.solver_options)
         except cp.error.SolverError as exc:
             tm["solve"] = time.perf_counter() - t
             return z0, False, f"cvxpy/{self.solver} failed: {exc}", tm
