@@ -1,0 +1,146 @@
+"""Identification from power spectra (thesis ch. 5): Algorithm 5.1, IPOPT on (5-13), bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import symid as si
+from symid.formulations.psd_data import spectral_equations, spectral_misfit
+from symid.formulations.psd_scr import ScrPSD
+from symid.nlls.psd import IpoptPSD
+from symid.starts import make_starts
+
+TRUTH_2DOF = {"m1": 1, "m2": 1, "c1": 0.1, "c2": 0.3, "k1": 2, "k2": 1}  # thesis (4-20)
+W_2DOF = np.logspace(np.log10(0.3), np.log10(3), 12)  # rad/s, around both resonances (0.62, 1.62 rad/s)
+
+
+def two_dof(C=((1, 0), (0, 1)), output="position"):
+    """Thesis (4-19) with a full sensor set, force on the first mass."""
+    m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+    return si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
+                               K=[[k1 + k2, -k2], [-k2, k2]], B=[[1], [0]], C=[list(r) for r in C], output=output)
+
+
+@pytest.fixture(scope="module")
+def spec():
+    return si.simulate_spectra(two_dof(), TRUTH_2DOF, W_2DOF, 1.0)
+
+
+# -- the equations (5-6)/(5-8) -------------------------------------------------------------
+
+@pytest.mark.parametrize("output", ["position", "velocity", "acceleration"])
+def test_equations_hold_at_the_truth(output):
+    model = two_dof(C=((2, 1), (0, 1)), output=output)
+    data = si.simulate_spectra(model, TRUTH_2DOF, W_2DOF, lambda w: w**-0.5)
+    eq = spectral_equations(model, data)
+    scale = np.linalg.norm(eq.Q, axis=(1, 2))
+    # X Pᵢ Xᴴ = Qᵢ, thesis (5-6), to rounding
+    np.testing.assert_allclose(eq.residuals(model.theta_vector(TRUTH_2DOF)) / scale, 0, atol=1e-12)
+    assert eq.residuals(model.theta_vector(TRUTH_2DOF) * 1.1).min() > 1e-3 * scale.min()
+    assert spectral_misfit(model, data, TRUTH_2DOF) < 1e-28
+
+
+def test_full_sensor_set_is_required(spec):
+    one_sensor = two_dof(C=((1, 0),))
+    data = si.simulate_spectra(one_sensor, TRUTH_2DOF, W_2DOF, 1.0)
+    with pytest.raises(si.ModelError, match=r"full set of sensors.*C must be square and invertible.*1×2"):
+        si.identify(one_sensor, data, method="scr")
+    singular = two_dof(C=((1, 1), (1, 1)))
+    with pytest.raises(si.ModelError, match=r"C must be invertible.*singular"):
+        ScrPSD(singular, spec)
+
+
+def test_parameterised_C_or_B_is_refused(spec):
+    m, c, k, g = si.parameters("m c k g", positive=True)
+    data = si.SpectralData(W_2DOF, np.ones(12), np.ones(12))
+    with pytest.raises(si.ModelError, match="C must hold no parameter"):
+        ScrPSD(si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[g]]), data)
+    with pytest.raises(si.ModelError, match="B must hold no parameter"):
+        ScrPSD(si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[g]], C=[[1]]), data)
+
+
+def test_bad_spectral_input_is_refused(spec):
+    with pytest.raises(si.DataError, match=r"the spectra have 1 output.*the model has 2 output"):
+        si.identify(two_dof(), si.SpectralData(W_2DOF, np.ones(12), np.ones(12)), method="scr")
+    few = si.simulate_spectra(two_dof(), TRUTH_2DOF, W_2DOF[:1], 1.0)
+    with pytest.raises(si.DataError, match="at least 2 frequencies"):
+        si.identify(two_dof(), few, method="ipopt")
+    with pytest.raises(si.ModelError, match="no linear least-squares special case"):
+        si.identify(two_dof(), spec, method="ls")
+    with pytest.raises(si.ModelError, match="init_sign must be -1 or 1"):
+        ScrPSD(two_dof(), spec, init_sign=0)
+
+
+# -- Algorithm 5.1 -------------------------------------------------------------------------
+
+@pytest.mark.parametrize("backend", ["cvxpy", "admm"])
+def test_scr_recovers_2dof_from_spectra(spec, backend):
+    res = si.identify(two_dof(), spec, method="scr", backend=backend, starts=2, seed=0)
+    assert res.method == "scr" and res.success, res.message
+    # exact spectra of thesis (4-20): the truth to the solver's accuracy
+    np.testing.assert_allclose(res.theta_vector, two_dof().theta_vector(TRUTH_2DOF), rtol=1e-6, atol=1e-7)
+    assert all(o.converged for o in res.starts)
+    assert res.cost < 1e-12
+
+
+def test_rank_compression_changes_no_iterate(spec):
+    """Pᵢ has rank 1 (one input): the compressed sub-problem is the same problem (module notes)."""
+    x0 = make_starts(two_dof(), 1, 3)[0]
+    sa = ScrPSD(two_dof(), spec, max_iter=3, rank_tol=1e-10, init="model")
+    sb = ScrPSD(two_dof(), spec, max_iter=3, rank_tol=0.0, init="model")
+    assert {S.shape for S in sa._S} == {(1, 1)} and (2, 2) in {S.shape for S in sb._S}  # Pᵢ: rank 1 of 2
+    a, b = sa.solve(x0)[1], sb.solve(x0)[1]
+    # same optimal values of the sub-problems and same iterates, to Clarabel's accuracy
+    np.testing.assert_allclose([h.relaxation for h in a.history], [h.relaxation for h in b.history], rtol=1e-5)
+    for ia, ib in zip(a.iterates, b.iterates, strict=True):
+        np.testing.assert_allclose(ia["theta"], ib["theta"], rtol=1e-4, atol=1e-4)
+
+
+def test_random_start_step_equals_a_start_at_Q_equal_Y(spec, monkeypatch):
+    """The first step with the extra variable t starts at Q = Yᵢ: with Yᵢ = −X(θa, ωᵢ) it must
+    give the iterate of the engine's own start from θa (module notes of psd_scr)."""
+    model = two_dof()
+    theta_a = make_starts(model, 1, 5)[0]
+    solver = ScrPSD(model, spec, max_iter=1)
+    monkeypatch.setattr(solver, "initial_Y", lambda x0: -solver.eq.X(theta_a))
+    first, _ = solver.solve(make_starts(model, 1, 1)[0])
+    direct = ScrPSD(model, spec, max_iter=1, init="model").solve(theta_a)[1]
+    assert abs(first.iterates[0]["t"]) < 1e-8
+    np.testing.assert_allclose(first.iterates[0]["theta"], direct.iterates[0]["theta"], rtol=1e-5, atol=1e-6)
+
+
+def test_random_start_is_seeded_and_negative_definite(spec):
+    solver = ScrPSD(two_dof(), spec)
+    x0 = make_starts(two_dof(), 1, 1)[0]
+    Y = solver.initial_Y(x0)
+    assert np.all(np.linalg.eigvalsh(Y) < 0)  # init_sign = -1 (module notes)
+    np.testing.assert_array_equal(Y, solver.initial_Y(x0.copy()))
+    assert not np.allclose(Y, solver.initial_Y(x0 + 1e-3))
+
+
+def test_without_lmis_the_constraints_are_gone(spec):
+    with_lmis = ScrPSD(two_dof(), spec)
+    without = ScrPSD(two_dof(), spec, lmis=False, bounds=False)
+    assert len(with_lmis.problem.lmis) == 3 + 6 and len(without.problem.lmis) == 0  # M, V, K ⪰ 0 and θ ≥ 0
+
+
+# -- IPOPT and the comparison --------------------------------------------------------------
+
+@pytest.mark.parametrize("objective", ["output", "equation"])
+@pytest.mark.parametrize("weighting", ["none", "frequency"])
+def test_ipopt_recovers_2dof_from_a_near_start(spec, objective, weighting):
+    start = two_dof().theta_vector(TRUTH_2DOF) * 1.2
+    out = IpoptPSD(two_dof(), spec, objective=objective, weighting=weighting).run(start)
+    assert out.converged, out.message
+    np.testing.assert_allclose(out.theta, two_dof().theta_vector(TRUTH_2DOF), rtol=1e-6, atol=1e-8)
+
+
+def test_compare_and_polish_work_for_spectra(spec):
+    cmp = si.compare(two_dof(), spec, methods=("scr", "ipopt", "scr+polish"), starts=2, seed=0, truth=TRUTH_2DOF,
+                     options={"scr": {"backend": "admm"}})
+    assert cmp["scr"].n_success == 2 and cmp["scr+polish"].n_success == 2
+    assert cmp["ipopt"].n_starts == 2 and np.isfinite(cmp["ipopt"].best_cost)
+    res = si.identify(two_dof(), spec, method="scr", backend="admm", seed=0, polish=True)
+    assert res.polished is not None and res.polished.options["polish"] == "ipopt"
+    assert res.polished.cost <= res.cost
