@@ -131,7 +131,7 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
             raise SystemExit(f"symid identifiability: --known {item!r}: {value!r} is not a number") from None
     positive = {"declared": None, "all": True, "ignore": False}[args.positive]
     report = identifiability(load_model(args.model).model, known=known, positive=positive,
-                             timeout=args.timeout, seed=args.seed)
+                             timeout=args.timeout, exact_count=args.exact_count, seed=args.seed)
     print(report.summary())
     return 0
 
@@ -199,6 +199,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--timeout", type=float, default=30.0, metavar="S",
                    help="time budget of the analysis in seconds; if the global (Gröbner) step does not finish "
                         "in it, the local verdict is reported and the global one marked undetermined (default: 30)")
+    p.add_argument("--exact-count", action="store_true",
+                   help="keep the Gröbner step running for the exact number of solutions even when certified "
+                        "numerical solutions already prove the model locally but not globally identifiable")
     p.add_argument("--known", nargs="*", metavar="NAME=VALUE", help="parameters taken as known")
     p.add_argument("--positive", choices=("declared", "all", "ignore"), default="declared",
                    help="discard solutions with non-positive values of the parameters declared positive "

@@ -14,6 +14,7 @@ import sympy as sp
 import symid as si
 from symid.cli import main as cli_main
 from symid.structural import check_local, exhaustive_summary, warn_if_not_identifiable
+from symid.structural.analyse import DEFAULT_TIMEOUT
 from symid.structural.deadline import run_with_deadline
 from symid.structural.global_ import global_analysis
 
@@ -186,21 +187,76 @@ def test_positivity_discards_the_negative_solution():
 
 # -- timeout (item 4) --------------------------------------------------------------------
 
-def test_timeout_returns_the_exact_local_verdict_and_never_hangs():
+def test_timeout_returns_the_exact_local_verdict_and_never_hangs(monkeypatch):
+    # the Gröbner step made to hang on the belt drive (globally identifiable: no witness can
+    # exist): first slice, fruitless witness search, re-run with the rest, then undetermined
+    calls = []
+
+    def hang(**kwargs):
+        calls.append(time.perf_counter())
+        time.sleep(60)
+
+    monkeypatch.setattr("symid.structural.analyse.global_analysis", hang)
+    model = si.load_model("belt_drive").model
+    t0 = time.perf_counter()
+    rep = si.identifiability(model, timeout=4.0)
+    elapsed = time.perf_counter() - t0
+    assert len(calls) == 2  # 0.75 s slice, then the rest of the budget
+    assert not rep.global_determined and not rep.verdicts_proven
+    assert rep.global_status.startswith("undetermined (timeout after 4 s)")
+    assert rep.verdict == "local"
+    assert rep.jacobian_ranks == (4, 4)  # exact, at two points
+    assert set(rep.verdicts.values()) == {"local"}
+    assert rep.n_solutions is None and rep.n_solutions_at_least is None and rep.witnesses == ()
+    assert any("no second solution found numerically" in n for n in rep.notes)
+    assert "global verdict undetermined" in rep.summary()
+    assert elapsed < 4.0 + 10  # hang guard only
+
+
+def test_random5_is_proven_not_global_by_certified_witnesses():
     # random5 (thesis (6-29), 10 unknown entries): summary(θ) = summary(θ*) has hundreds of
-    # complex solutions; sympy's Gröbner basis does not finish in minutes
+    # complex solutions and sympy's Gröbner basis does not finish in minutes; certified
+    # witnesses settle every verdict within the default budget
     model = si.load_model("random5").model
     t0 = time.perf_counter()
-    rep = si.identifiability(model, timeout=1.0)
+    rep = si.identifiability(model)
     elapsed = time.perf_counter() - t0
-    assert not rep.global_determined
-    assert rep.global_status.startswith("undetermined (timeout after 1 s)")
-    assert rep.verdict == "local"
-    assert rep.jacobian_ranks == (10, 10)  # exact, at two points
+    assert rep.verdict == "local" and rep.verdicts_proven and not rep.global_determined
+    assert rep.jacobian_ranks == (10, 10)
     assert set(rep.verdicts.values()) == {"local"}
+    assert rep.shown_not_global == rep.parameters
     assert rep.n_solutions is None
-    assert "undetermined" in rep.summary()
-    assert elapsed < 1.0 + 10  # hang guard only (the exact global step alone takes minutes)
+    assert len(rep.witnesses_certified) == len(rep.witnesses) >= 1
+    assert rep.n_solutions_at_least == 1 + sum(rep.witnesses_certified) >= 2
+    assert "proven" in rep.summary() and "certified witness" in rep.summary()
+    star = {k: float(sp.Rational(v)) for k, v in rep.theta_star.items()}
+    w = np.array([0.3, 1.0, 4.0])
+    H0 = model.frequency_response(star, w)
+    for sol in rep.witnesses:  # same transfer function as θ*, a different θ
+        assert max(abs(sol[k] - star[k]) for k in star) > 1e-3
+        np.testing.assert_allclose(model.frequency_response(sol, w), H0, rtol=1e-9, atol=1e-12)
+    assert elapsed < DEFAULT_TIMEOUT  # stopped early: the budget was not used up
+
+
+def test_exact_count_keeps_the_groebner_step_running(monkeypatch):
+    calls = []
+
+    def hang(**kwargs):
+        calls.append(time.perf_counter())
+        time.sleep(60)
+
+    monkeypatch.setattr("symid.structural.analyse.global_analysis", hang)
+    model = si.load_model("random5").model
+    t0 = time.perf_counter()
+    rep = si.identifiability(model, timeout=2.0, exact_count=True)
+    assert len(calls) == 1
+    # one Gröbner run with the budget less the witness reserve (0.3·2 = 0.6 s), not a 0.5 s slice
+    assert time.perf_counter() - t0 >= 2.0 - 0.6
+    assert not rep.global_determined and rep.verdict == "local"
+    if rep.verdicts_proven:  # the reserve sufficed to certify witnesses
+        assert "did not finish within the timeout of 2 s" in rep.global_status
+    else:
+        assert rep.global_status.startswith("undetermined (timeout after 2 s)")
 
 
 def test_tiny_timeout_falls_back_to_the_float_screen_with_known_values():
@@ -249,6 +305,34 @@ def test_witnesses_on_random5():
     for sol in res.witnesses:
         assert max(abs(sol[k] - star[k]) for k in star) > 1e-3
         np.testing.assert_allclose(model.frequency_response(sol, w), H0, rtol=1e-9, atol=1e-12)
+
+
+def test_krawczyk_certifies_a_true_root_and_rejects_a_near_miss():
+    import mpmath
+    from sympy import QQ
+
+    from symid.structural.witness import _interval_terms, _krawczyk
+
+    # F(x, y) = (x² − 2, x·y − 1): the root (√2, 1/√2), exact rational coefficients
+    terms = _interval_terms([[((2, 0), QQ(1)), ((0, 0), QQ(-2))], [((1, 1), QQ(1)), ((0, 0), QQ(-1))]])
+    with mpmath.workdps(60):
+        root = [mpmath.sqrt(2), 1 / mpmath.sqrt(2)]
+        near = [root[0] + mpmath.mpf("1e-15"), root[1]]  # outside the 1e-20 box: no root there
+    star = [QQ(1), QQ(1)]
+    assert _krawczyk(terms, [], root, star, [True, True]) is not None
+    assert _krawczyk(terms, [], near, star, [True, True]) is None
+    # the box must exclude θ*: with θ* at the root itself the certificate is refused
+    lin = _interval_terms([[((1, 0), QQ(1)), ((0, 0), QQ(-2))], [((0, 1), QQ(1)), ((0, 0), QQ(-3))]])
+    at = [mpmath.mpf(2), mpmath.mpf(3)]
+    assert _krawczyk(lin, [], at, [QQ(1), QQ(1)], [True, True]) is not None
+    assert _krawczyk(lin, [], at, [QQ(2), QQ(3)], [True, True]) is None
+    with mpmath.workdps(60):
+        neg = [-mpmath.sqrt(2), -1 / mpmath.sqrt(2)]
+    assert _krawczyk(terms, [], neg, star, [False, False]) is not None
+    assert _krawczyk(terms, [], neg, star, [True, True]) is None  # not in the positive orthant
+    # a denominator vanishing at the root (x·y − 1 itself) refuses it
+    den = _interval_terms([[((1, 1), QQ(1)), ((0, 0), QQ(-1))]])
+    assert _krawczyk(terms, den, root, star, [True, True]) is None
 
 
 def _fail(**kwargs):
@@ -477,3 +561,11 @@ def test_cli(capsys):
     assert cli_main(["identifiability", "compartment_catenary", "--known", "theta4=0.2", "--timeout", "20"]) == 0
     out = capsys.readouterr().out
     assert "theta2" in out and "known" in out
+
+
+def test_cli_exact_count_gives_the_groebner_step_the_budget(capsys):
+    # random5: with --exact-count the report waits for the Gröbner step until the timeout
+    assert cli_main(["identifiability", "random5", "--timeout", "1.5", "--exact-count"]) == 0
+    out = capsys.readouterr().out
+    assert "1.5 s" in out and "LOCALLY" in out
+    assert "Gröbner basis stopped after" not in out  # the early stop of the default path

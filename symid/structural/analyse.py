@@ -11,7 +11,7 @@ import sympy as sp
 from symid.errors import IdentifiabilityWarning, ModelError
 from symid.structural.combinations import monomial_candidates, parameters_to_fix, select_combinations
 from symid.structural.deadline import run_with_deadline
-from symid.structural.global_ import GlobalResult, global_analysis
+from symid.structural.global_ import GlobalResult, global_analysis, star_and_summary
 from symid.structural.local import local_analysis
 from symid.structural.numeric import numeric_local_check
 from symid.structural.report import IdentifiabilityReport, NecessaryCondition
@@ -21,6 +21,10 @@ from symid.structural.witness import find_witnesses
 _EXACT_LIMIT = 400
 _WITNESS_TIME = 1.0
 """Seconds of the budget kept for the numerical witness search (at most 0.3·``timeout``)."""
+_GROEBNER_FIRST = 0.75
+"""Seconds the Gröbner step gets before the witness search (every zoo model but random5 needs < 0.35 s)."""
+_WITNESS_SEARCH = 0.5
+"""Seconds after which the witness search begins no new batch of starts (when it has found one)."""
 
 __all__ = ["DEFAULT_TIMEOUT", "check_local", "identifiability", "warn_if_not_identifiable"]
 
@@ -59,7 +63,8 @@ def _complexity(expr: sp.Expr) -> tuple[int, int]:
 
 
 def identifiability(model, *, known: Mapping[str, float] | None = None, positive: bool | None = None,
-                    timeout: float | None = DEFAULT_TIMEOUT, seed: int = 0) -> IdentifiabilityReport:
+                    timeout: float | None = DEFAULT_TIMEOUT, exact_count: bool = False,
+                    seed: int = 0) -> IdentifiabilityReport:
     """Structural identifiability of a model's parameters from its input-output map.
 
     Local identifiability comes from the exact rank of the Jacobian of an exhaustive
@@ -87,14 +92,22 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     timeout : float or None, optional
         Wall-time budget in seconds of the whole analysis (default 30 s). The exact
         local step comes first (if even it does not finish, the local verdicts come
-        from a floating-point rank, flagged as a screen); the Gröbner step gets what is
-        left, less a reserve of min(1 s, 0.3·timeout). If the Gröbner step does not
-        finish, the report carries the local verdicts, marks the global one
-        undetermined, and spends the reserve searching numerically for a second
-        solution of summary(θ) = summary(θ*): any such verified witness shows the
-        model is not globally identifiable (``report.witnesses``). The combinations
-        of a non-identifiable model are computed after the budget (small, bounded
-        work). ``None`` waits for ever.
+        from a floating-point rank, flagged as a screen). For a locally identifiable
+        model the Gröbner step then gets 0.75 s; if it has not finished, a numerical
+        search for other solutions of summary(θ) = summary(θ*) runs (about 0.5 s,
+        within a reserve of min(1 s, 0.3·timeout)), and each solution found is certified by the Krawczyk
+        interval test when the summary system is square. Certified solutions that
+        move every parameter prove the model locally but not globally identifiable:
+        the report stops there, with ``n_solutions_at_least`` in place of the exact
+        count. Otherwise the Gröbner step is re-run with the rest of the budget; if
+        it does not finish, the global verdict is marked undetermined (numerical
+        witnesses, if any, are reported as evidence). The combinations of a
+        non-identifiable model are computed after the budget (small, bounded work).
+        ``None`` waits for ever.
+    exact_count : bool, optional
+        Give the Gröbner step the whole budget (less the witness reserve) even when
+        certified witnesses could settle the verdicts sooner: for the exact solution
+        count k. Default False.
     seed : int, optional
         Seed of the random rational points (the verdicts are generic; the seed only
         matters on a measure-zero set).
@@ -134,46 +147,80 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     monos = monomial_candidates(local)
     full_rank = local.rank == len(free)
 
-    # One budget: the global step gets what the local step left, less a reserve for the
-    # numerical witness search that runs if the Gröbner basis does not finish.
-    reserve = min(_WITNESS_TIME, 0.3 * timeout) if timeout is not None and full_rank and free else 0.0
-    remaining = None if timeout is None else timeout - (time.perf_counter() - t0) - reserve
+    # One budget. The Gröbner step runs first for at most _GROEBNER_FIRST s; if it has not
+    # finished, the numerical witness search runs; certified witnesses that show every
+    # locally identifiable parameter is not global settle all verdicts (unless
+    # exact_count), otherwise the Gröbner step is re-run with the rest of the budget.
+    search = full_rank and bool(free)
+    reserve = min(_WITNESS_TIME, 0.3 * timeout) if timeout is not None and search else 0.0
     t1 = time.perf_counter()
-    if remaining is not None and remaining <= 0:
-        status, glob = "timeout", None
+    status, glob, first = "timeout", None, None
+    # θ* and the summary once, shared by the Gröbner runs and the witness search
+    p_status, prepared = run_with_deadline(star_and_summary, {"model": model, "known": known_exact, "seed": seed},
+                                           None if timeout is None else max(timeout - (t1 - t0) - reserve, 1e-3))
+    if p_status == "error":
+        status, glob = "error", prepared
+    g_kwargs = {"model": model, "known": known_exact, "positive": pos, "seed": seed,
+                "extra_candidates": monos, "expressions": not full_rank, "prepared": prepared}
+    now = time.perf_counter() - t0
+    if exact_count or not search:
+        remaining = None if timeout is None else timeout - now - reserve
     else:
-        status, glob = run_with_deadline(
-            global_analysis, {"model": model, "known": known_exact, "positive": pos, "seed": seed,
-                              "extra_candidates": monos, "expressions": not full_rank}, remaining)
-    if status == "ok" and not isinstance(glob, GlobalResult):  # pragma: no cover - defensive
-        status, glob = "error", "unexpected result"
-    determined = status == "ok"
-    if status == "timeout":
-        global_status = f"undetermined (timeout after {timeout:g} s)"
-    elif status == "error":
-        global_status = f"undetermined (error: {str(glob).splitlines()[0]})"
-    else:
-        global_status = "determined"
+        remaining = _GROEBNER_FIRST if timeout is None else min(_GROEBNER_FIRST, timeout - now - reserve)
+        first = remaining
+    if p_status == "ok" and (remaining is None or remaining > 0):
+        status, glob = run_with_deadline(global_analysis, g_kwargs, remaining)
     witnesses: tuple = ()
+    certified: tuple = ()
     theta_star: dict[str, str] = {}
-    if not determined and full_rank and reserve > 0:
-        left = max(timeout - (time.perf_counter() - t0), 0.05)
+    proven_by_witnesses = False
+    if status == "timeout" and search and p_status == "ok":
+        left = _WITNESS_TIME / 0.3 if timeout is None else max(timeout - (time.perf_counter() - t0), 0.05)
         wstatus, wit = run_with_deadline(
             find_witnesses, {"model": model, "known": known_exact, "positive": pos, "seed": seed,
-                             "max_time": min(0.5 * left, 5.0)}, left)
+                             "max_time": min(0.5 * left, _WITNESS_SEARCH), "prepared": prepared}, left)
         if wstatus == "ok":
-            theta_star, witnesses = wit.theta_star, wit.witnesses
-            if witnesses:
-                global_status += (f"; {len(witnesses)} other admissible solution(s) of summary(θ) = summary(θ*) "
-                                  "found numerically: NOT globally identifiable")
-                notes.append(f"the {len(witnesses)} solution(s) θ ≠ θ* in `witnesses` were found by Gauss–Newton "
-                             "from random starts and verified by Newton's method at 60 digits (residual < 1e-40, "
-                             "quadratic convergence); the exact solution count is undetermined")
-            else:
+            theta_star, witnesses, certified = wit.theta_star, wit.witnesses, wit.certified
+            star_f = {k: float(sp.Rational(v)) for k, v in theta_star.items()}
+            moved = {nm for w, ok in zip(witnesses, certified, strict=True) if ok
+                     for nm in names if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
+            proven_by_witnesses = moved == set(names)
+            if witnesses and not any(certified):
+                notes.append("the witnesses could not be certified (the Krawczyk test needs as many summary "
+                             f"equations as unknowns; here {'it' if wit.square else 'the system is not square and it'}"
+                             " failed): they are numerical evidence, not a proof")
+            elif not witnesses:
                 notes.append(f"no second solution found numerically ({wit.n_starts} starts in {wit.seconds:.1f} s); "
                              "this proves nothing: the global verdict stays undetermined")
         else:
             notes.append(f"the numerical search for a second solution did not finish ({wstatus})")
+        if first is not None and not proven_by_witnesses:
+            rest = None if timeout is None else timeout - (time.perf_counter() - t0)
+            if rest is None or rest > first:  # a shorter re-run of the same computation cannot finish
+                status, glob = run_with_deadline(global_analysis, g_kwargs, rest)
+    if status == "ok" and not isinstance(glob, GlobalResult):  # pragma: no cover - defensive
+        status, glob = "error", "unexpected result"
+    determined = status == "ok"
+    if determined:
+        global_status = "determined"
+    elif status == "error":
+        global_status = f"undetermined (error: {str(glob).splitlines()[0]})"
+    elif proven_by_witnesses:
+        why = (f"Gröbner basis stopped after {first:g} s; exact_count=True keeps it running until the timeout"
+               if first is not None else f"Gröbner basis did not finish within the timeout of {timeout:g} s")
+        global_status = (f"NOT globally identifiable, proven by {sum(certified)} certified solution(s) θ ≠ θ* of "
+                         f"summary(θ) = summary(θ*); exact count not computed ({why})")
+    else:
+        global_status = f"undetermined (timeout after {timeout:g} s)"
+        if witnesses:
+            global_status += (f"; {len(witnesses)} other admissible solution(s) of summary(θ) = summary(θ*) "
+                              "found numerically: NOT globally identifiable")
+    if witnesses and not determined:
+        n_cert = sum(certified)
+        notes.append(f"the {len(witnesses)} solution(s) θ ≠ θ* in `witnesses` were found by Gauss–Newton from random "
+                     "starts and refined by Newton's method at 60 digits (residual < 1e-40); "
+                     f"{n_cert} of them certified by the Krawczyk test in interval arithmetic (an exact real "
+                     "admissible solution within relative 1e-20, distinct from θ* and from each other)")
     t_global = time.perf_counter() - t1
 
     loc = dict(zip(names, local.identifiable, strict=True))
@@ -266,7 +313,9 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         n_summary=len(glob.summary_labels) if determined else None,
         necessary_condition=necessary, combinations=tuple(combos), reparameterisation=reparam, fix=fix,
         positivity_changed=positivity_changed, notes=tuple(notes), theta_star=theta_star,
-        solutions=tuple(solutions), witnesses=witnesses, timing=timing)
+        solutions=tuple(solutions), witnesses=witnesses, witnesses_certified=tuple(certified),
+        n_solutions_at_least=(1 + sum(certified)) if proven_by_witnesses else None,
+        verdicts_proven=determined or proven_by_witnesses, timing=timing)
 
 
 def _numeric_report(model, names, known, necessary, timeout, t0) -> IdentifiabilityReport:

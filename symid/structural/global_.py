@@ -237,8 +237,8 @@ def _in_radical(G, R: PolyRing, f: PolyElement) -> bool:
 
 
 def global_analysis(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
-                    seed: int = 0, extra_candidates: Sequence[sp.Expr] = (), expressions: bool = True
-                    ) -> GlobalResult:
+                    seed: int = 0, extra_candidates: Sequence[sp.Expr] = (), expressions: bool = True,
+                    prepared: tuple | None = None) -> GlobalResult:
     """Solve summary(θ) = summary(θ*) exactly at a random rational θ* and classify the solutions.
 
     Parameters
@@ -257,6 +257,9 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
         Return the summary entries and the Gröbner-basis candidates as sympy
         expressions (needed only for the combinations of a non-identifiable model;
         building them is a noticeable part of the run on large models).
+    prepared : tuple, optional
+        The result of :func:`star_and_summary` for the same model, ``known`` and
+        ``seed`` (saves recomputing it when the step is re-run; not modified).
 
     Returns
     -------
@@ -274,7 +277,11 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     """
     times = {}
     t0 = time.perf_counter()
-    params, star, minimal, summ, rng = star_and_summary(model, known, seed=seed)
+    if prepared is None:
+        prepared = star_and_summary(model, known, seed=seed)
+    params, star, minimal, summ, shared_rng = prepared
+    rng = random.Random()
+    rng.setstate(shared_rng.getstate())  # a re-run makes the same random choices
     names = [p.name for p in params]
     positive = list(positive) if positive is not None else [False] * len(params)
     theta_star = dict(zip(names, star, strict=True))

@@ -100,6 +100,16 @@ class IdentifiabilityReport:
         When the Gröbner step did not finish: admissible solutions θ ≠ θ* found
         numerically and verified at 60 digits. Any witness shows the model is not
         globally identifiable (at least ``1 + len(witnesses)`` solutions).
+    witnesses_certified : tuple of bool
+        Per witness, whether the Krawczyk interval test proved an exact admissible
+        solution next to it (see :mod:`symid.structural.witness`).
+    n_solutions_at_least : int or None
+        When certified witnesses settled the verdicts without the exact count:
+        1 + the number of certified witnesses, a proven lower bound of the number of
+        admissible solutions.
+    verdicts_proven : bool
+        Whether the model verdict and every per-parameter verdict are proven: by the
+        Gröbner step, or by certified witnesses that move every parameter.
     timing : dict of str to float
         Wall time (s) of ``local``, ``global`` and ``total``.
     """
@@ -127,6 +137,9 @@ class IdentifiabilityReport:
     theta_star: dict[str, str] = field(default_factory=dict)
     solutions: tuple[dict[str, float], ...] = ()
     witnesses: tuple[dict[str, float], ...] = ()
+    witnesses_certified: tuple[bool, ...] = ()
+    n_solutions_at_least: int | None = None
+    verdicts_proven: bool = False
     timing: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -159,9 +172,12 @@ class IdentifiabilityReport:
             verdict = f"LOCALLY IDENTIFIABLE ({self.n_solutions} solutions)"
         if not self.global_determined and self.verdict == "local":
             verdict = "LOCALLY IDENTIFIABLE (global verdict undetermined)"
-            if self.witnesses:
-                verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE (at least {1 + len(self.witnesses)} solutions; "
-                           "exact count undetermined)")
+            if self.n_solutions_at_least is not None:
+                verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE (proven; at least {self.n_solutions_at_least} "
+                           "solutions, exact count not computed)")
+            elif self.witnesses:
+                verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE (at least {1 + len(self.witnesses)} solutions found "
+                           "numerically; exact count undetermined)")
         L.append(f"verdict            : {verdict}")
         if self.known:
             L.append("known              : " + ", ".join(f"{k} = {v:g}" for k, v in self.known.items()))
@@ -191,7 +207,12 @@ class IdentifiabilityReport:
         for p in self.parameters:
             v = self.verdicts[p]
             if v == "local" and not self.global_determined:
-                v = "local (not global: differs at a witness)" if p in not_global else "local (global undetermined)"
+                if p not in not_global:
+                    v = "local (global undetermined)"
+                elif self.verdicts_proven:
+                    v = "local (not global: differs at a certified witness)"
+                else:
+                    v = "local (not global: differs at a numerical witness)"
             L.append(f"  {p:<{width}}  {v}")
         if self.combinations:
             L.append("")
