@@ -95,8 +95,9 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         from a floating-point rank, flagged as a screen). For a locally identifiable
         model the Gröbner step then gets 0.75 s; if it has not finished, a numerical
         search for other solutions of summary(θ) = summary(θ*) runs (about 0.5 s,
-        within a reserve of min(1 s, 0.3·timeout)), and each solution found is certified by the Krawczyk
-        interval test when the summary system is square. Certified solutions that
+        within a reserve of min(1 s, 0.3·timeout)), and each solution found is
+        certified by the Krawczyk interval test when the summary system is square
+        (as many equations as unknowns). Certified solutions that
         move every parameter prove the model locally but not globally identifiable:
         the report stops there, with ``n_solutions_at_least`` in place of the exact
         count. Otherwise the Gröbner step is re-run with the rest of the budget; if
@@ -186,9 +187,9 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
                      for nm in names if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
             proven_by_witnesses = moved == set(names)
             if witnesses and not any(certified):
-                notes.append("the witnesses could not be certified (the Krawczyk test needs as many summary "
-                             f"equations as unknowns; here {'it' if wit.square else 'the system is not square and it'}"
-                             " failed): they are numerical evidence, not a proof")
+                why = ("the Krawczyk test failed for each" if wit.square else
+                       "the Krawczyk test needs as many summary equations as unknowns; this system has more")
+                notes.append(f"the witnesses are not certified ({why}): they are numerical evidence, not a proof")
             elif not witnesses:
                 notes.append(f"no second solution found numerically ({wit.n_starts} starts in {wit.seconds:.1f} s); "
                              "this proves nothing: the global verdict stays undetermined")

@@ -20,7 +20,7 @@ summary(θ) = summary(θ*). The search:
 5. when the system is square (as many equations as unknowns, e.g. the 2n normalised
    transfer-function coefficients of a SISO model with 2n unknowns), *certifies* each
    verified point with the Krawczyk test in outward-rounded interval arithmetic
-   (``mpmath.iv``, 200 bits): for a box X around the point x̃ and Y ≈ F′(x̃)⁻¹,
+   (``mpmath.iv``, 256 bits): for a box X around the point x̃ and Y ≈ F′(x̃)⁻¹,
    ``K(X) = x̃ − Y F(x̃) + (I − Y F′(X))(X − x̃) ⊂ int X`` proves that X holds exactly
    one real root of F (Krawczyk 1969; Neumaier, *Interval Methods for Systems of
    Equations*, Thm. 5.1.7). The same interval evaluation shows that X excludes θ*,
