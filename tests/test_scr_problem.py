@@ -124,6 +124,17 @@ def test_presolve_keeps_only_the_bilinear_row():
     assert red.D.shape == (3 * 4, prob.n)  # 2 complex rows per term = 4 real equalities
 
 
+def test_max_iter_message_says_when_the_iterate_is_stationary():
+    # x² = 1 and x² = 4 cannot both hold: SCR stops moving with a residual it cannot reduce
+    inconsistent = scr.BilinearProblem(variables=[x], bilinear=[
+        scr.Bilinear(A=[[x]], P=[[1]], B=[[x]], C=[[1]]), scr.Bilinear(A=[[x]], P=[[1]], B=[[x]], C=[[4]])])
+    sol = scr.solve(inconsistent, x0={x: 1.0}, max_iter=5)
+    assert sol.status == "max_iter" and not sol.success
+    assert "the iterate is stationary" in sol.message and "cannot all hold" in sol.message
+    moving = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, max_iter=1)  # one step from far away
+    assert "last step" in moving.message and "stationary" not in moving.message
+
+
 def test_result_object():
     sol = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, backend="admm", max_iter=2)
     assert sol.status == "max_iter" and not sol.success

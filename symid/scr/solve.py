@@ -298,7 +298,16 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         message = (f"stopped by the callback after {len(history)} iterations; bilinear residual "
                    f"{history[-1].residual:.3e}")
     elif status == "max_iter":
-        message = (f"maximum number of iterations ({max_iter}) reached; bilinear residual "
-                   f"{history[-1].residual:.3e} > tol = {tol:g} or step {history[-1].step:.3e} too large")
+        last = history[-1]
+        if last.residual > tol and last.step <= stol:
+            why = (f"the iterate is stationary (last step {last.step:.3e} ≤ {stol:.3e}) but the bilinear residual "
+                   f"{last.residual:.3e} > tol = {tol:g}: the equalities cannot all hold here (inconsistent or "
+                   "noisy data, or a local minimum of the residual)")
+        elif last.residual <= tol:
+            why = (f"the bilinear residual {last.residual:.3e} ≤ tol = {tol:g} but the last step {last.step:.3e} "
+                   f"> {stol:.3e}")
+        else:
+            why = f"bilinear residual {last.residual:.3e} > tol = {tol:g}, last step {last.step:.3e} > {stol:.3e}"
+        message = f"maximum number of iterations ({max_iter}) reached; {why}"
     return SCRSolution(lay.unpack(x_final), iterates, tuple(history), status, status == "converged", message,
                        len(history), time.perf_counter() - t_start, backend, x_final, info)
