@@ -198,7 +198,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     p.add_argument("--timeout", type=float, default=30.0, metavar="S",
                    help="time budget of the analysis in seconds; if the global (Gröbner) step does not finish "
-                        "in it, the local verdict is reported and the global one marked undetermined (default: 30)")
+                        "in it and no certified solution θ ≠ θ* settles the verdicts, the local verdict is reported "
+                        "and the global one marked undetermined (default: 30)")
     p.add_argument("--exact-count", action="store_true",
                    help="keep the Gröbner step running for the exact number of solutions even when certified "
                         "numerical solutions already prove the model locally but not globally identifiable")

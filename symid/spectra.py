@@ -34,7 +34,7 @@ from symid.errors import DataError
 __all__ = ["estimate_spectra"]
 
 
-def _cross_spectra(x: np.ndarray, fs: float, nperseg: int, window: str, detrend: str
+def _cross_spectra(x: np.ndarray, fs: float, nperseg: int, window: Any, detrend: str | bool
                    ) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies (Hz) and two-sided density matrices S[f, a, b] = E[X_a conj(X_b)] per Hz."""
     f, S = scipy.signal.csd(x[:, None, :], x[:, :, None], fs=fs, window=window, nperseg=nperseg,
@@ -141,7 +141,7 @@ def _check_window(window: Any, nperseg: int) -> None:
 
 
 def estimate_spectra(data: Any, *, dt: float | None = None, Phi_uu: Any = None, nperseg: int | None = None,
-                     window: str = "hann", detrend: str = "constant", band: Any = None,
+                     window: Any = "hann", detrend: str | bool = "constant", band: Any = None,
                      n_frequencies: int | None = None) -> SpectralData:
     """Output (and input) spectral density matrices from sampled records by Welch's method.
 

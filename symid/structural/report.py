@@ -68,7 +68,10 @@ class IdentifiabilityReport:
     global_determined : bool
         Whether the global (Gröbner) step finished.
     global_status : str
-        ``"determined"`` or ``"undetermined (...)"`` with the reason (timeout, error).
+        ``"determined"``; ``"NOT globally identifiable, proven by k certified
+        solution(s) ..."`` when certified witnesses settled the verdicts before the
+        Gröbner step finished; or ``"undetermined (...)"`` with the reason (timeout,
+        error).
     n_solutions : int or None
         Admissible solutions of summary(θ) = summary(θ*) (real, positive where declared);
         None when infinitely many or undetermined.
