@@ -187,16 +187,22 @@ def test_positivity_discards_the_negative_solution():
 
 # -- timeout (item 4) --------------------------------------------------------------------
 
-def test_timeout_returns_the_exact_local_verdict_and_never_hangs(monkeypatch):
-    # the Gröbner step made to hang on the belt drive (globally identifiable: no witness can
-    # exist): first slice, fruitless witness search, re-run with the rest, then undetermined
-    calls = []
+def _hang_global_step(monkeypatch) -> list[float]:
+    """Make the Gröbner step hang; returns the list its calls are recorded in."""
+    calls: list[float] = []
 
     def hang(**kwargs):
         calls.append(time.perf_counter())
         time.sleep(60)
 
     monkeypatch.setattr("symid.structural.analyse.global_analysis", hang)
+    return calls
+
+
+def test_timeout_returns_the_exact_local_verdict_and_never_hangs(monkeypatch):
+    # the Gröbner step made to hang on the belt drive (globally identifiable: no witness can
+    # exist): first slice, fruitless witness search, re-run with the rest, then undetermined
+    calls = _hang_global_step(monkeypatch)
     model = si.load_model("belt_drive").model
     t0 = time.perf_counter()
     rep = si.identifiability(model, timeout=4.0)
@@ -239,13 +245,7 @@ def test_random5_is_proven_not_global_by_certified_witnesses():
 
 
 def test_exact_count_keeps_the_groebner_step_running(monkeypatch):
-    calls = []
-
-    def hang(**kwargs):
-        calls.append(time.perf_counter())
-        time.sleep(60)
-
-    monkeypatch.setattr("symid.structural.analyse.global_analysis", hang)
+    calls = _hang_global_step(monkeypatch)
     model = si.load_model("random5").model
     t0 = time.perf_counter()
     rep = si.identifiability(model, timeout=2.0, exact_count=True)

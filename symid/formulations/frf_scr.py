@@ -78,6 +78,20 @@ def _symmetric(amap: Any) -> bool:
     return bool(np.allclose(amap.X0, amap.X0.T) and np.allclose(amap.Xi, np.swapaxes(amap.Xi, 1, 2)))
 
 
+def _mvk_lmis(maps: Any, theta: Any, options: dict[str, Any]) -> list[scr.Affine]:
+    """M, V, K ⪰ 0 as LMIs in θ, for each non-constant symmetric map; a non-symmetric one is
+    skipped and recorded in ``options`` (``lmi_M`` … ``"skipped: not symmetric"``)."""
+    out = []
+    for name in "MVK":
+        if maps[name].is_constant:
+            continue
+        if not _symmetric(maps[name]):
+            options[f"lmi_{name}"] = "skipped: not symmetric"
+            continue
+        out.append(scr.Affine(maps[name].X0, {theta: _theta_coef(maps[name])}))
+    return out
+
+
 class ScrFRF:
     """Sequential convex relaxation on a frequency response, built once, run per start.
 
@@ -245,13 +259,7 @@ class ScrFRF:
                 add("dynamics", i, A=A_mvk, P=Pi, B=Gi, C=aff(maps["B"]))
                 add("output", i, A=aff(maps["C"]), P=f[i] * np.eye(n), B=Gi, C=scr.Affine(H[i]))  # Hᵢ = fᵢ C Γᵢ
             if lmis:
-                for name in "MVK":
-                    if maps[name].is_constant:
-                        continue
-                    if not _symmetric(maps[name]):
-                        self.options[f"lmi_{name}"] = "skipped: not symmetric"
-                        continue
-                    lmi_list.append(aff(maps[name]))
+                lmi_list.extend(_mvk_lmis(maps, theta, self.options))
         else:
             n = model.n_states
             eye = np.eye(n)

@@ -47,7 +47,7 @@ import numpy as np
 
 from symid import scr
 from symid.errors import ModelError
-from symid.formulations.frf_scr import _symmetric, _theta_coef
+from symid.formulations.frf_scr import _mvk_lmis
 from symid.formulations.psd_data import spectral_equations, spectral_misfit
 from symid.result import StartOutcome
 
@@ -163,16 +163,8 @@ class ScrPSD:
         return U, S
 
     def _lmis(self, lmis: bool, bounds: bool) -> list[scr.Affine]:
-        maps, theta = self.model.maps, self.theta_var
-        out = []
-        if lmis:
-            for name in "MVK":
-                if maps[name].is_constant:
-                    continue
-                if not _symmetric(maps[name]):
-                    self.options[f"lmi_{name}"] = "skipped: not symmetric"
-                    continue
-                out.append(scr.Affine(maps[name].X0, {theta: _theta_coef(maps[name])}))
+        theta = self.theta_var
+        out = _mvk_lmis(self.model.maps, theta, self.options) if lmis else []
         if bounds:
             l = self.model.n_parameters
             for k, pos in enumerate(self.model.positive):

@@ -43,6 +43,7 @@ import numpy as np
 
 from symid import scr
 from symid.errors import ModelError
+from symid.formulations.frf_scr import _symmetric
 from symid.formulations.similarity_data import SimilarityData, transform_outcome
 from symid.formulations.similarity_scr import consistent, implied_equalities, left_times, right_times
 from symid.formulations.similarity_start import INITS, random_pair
@@ -187,10 +188,6 @@ class LinearSimilarity2nd:
         return StartOutcome(start=start, theta=theta, cost=cost, converged=bool(np.isfinite(cost)), iterations=1,
                             wall_time=time.perf_counter() - t0,
                             message=f"linear least squares (full set of {self.case}, thesis §7-5-2)")
-
-
-def _symmetric(amap: Any) -> bool:
-    return bool(np.allclose(amap.X0, amap.X0.T) and np.allclose(amap.Xi, np.swapaxes(amap.Xi, 1, 2)))
 
 
 def _minv_structure(mmap: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 import casadi as ca
@@ -11,11 +10,11 @@ import numpy as np
 from symid.errors import ModelError
 from symid.formulations.psd_data import check_spectral, spectral_equations, spectral_misfit
 from symid.nlls.casadi_model import casadi_frf, casadi_matrices
+from symid.nlls.ipopt_start import solve_from
 from symid.result import StartOutcome
 
 __all__ = ["IpoptPSD"]
 
-_SUCCESS = {"Solve_Succeeded", "Solved_To_Acceptable_Level"}
 _OBJECTIVES = ("output", "equation")
 _WEIGHTINGS = ("none", "frequency")
 
@@ -144,17 +143,8 @@ class IpoptPSD:
         """Solve from the start ``x0`` (parameter vector); never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
         z0 = np.clip(x0 / self.scale, self._lbz, self._ubz)
-        t0 = time.perf_counter()
-        try:
-            sol = self._solver(x0=z0, lbx=self._lbz, ubx=self._ubz)
-            stats = self._solver.stats()
-            theta = np.asarray(sol["x"]).reshape(-1) * self.scale
-            status = str(stats.get("return_status", "unknown"))
-            iters = int(stats.get("iter_count", 0))
-            converged = status in _SUCCESS
-        except RuntimeError as exc:  # CasADi evaluation errors (NaN in the linear solve)
-            theta, status, iters, converged = x0.copy(), f"IPOPT failed: {exc}", 0, False
-        elapsed = time.perf_counter() - t0
+        z, status, iters, converged, elapsed = solve_from(self._solver, z0, self._lbz, self._ubz)
+        theta = z * self.scale  # on a CasADi failure: the (clipped) start
         cost = spectral_misfit(self.model, self.data, theta) if np.all(np.isfinite(theta)) else float("inf")
         return StartOutcome(start=x0, theta=theta, cost=cost, converged=converged and np.isfinite(cost),
                             iterations=iters, wall_time=elapsed, message=status)

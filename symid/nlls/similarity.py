@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 import casadi as ca
@@ -13,11 +12,10 @@ from symid.errors import ModelError
 from symid.formulations.similarity_data import SimilarityData, transform_outcome
 from symid.formulations.similarity_start import INITS, initial_point
 from symid.nlls.casadi_model import casadi_matrices
+from symid.nlls.ipopt_start import solve_from
 from symid.result import StartOutcome
 
 __all__ = ["IpoptSimilarity"]
-
-_SUCCESS = {"Solve_Succeeded", "Solved_To_Acceptable_Level"}
 
 
 class IpoptSimilarity:
@@ -76,15 +74,6 @@ class IpoptSimilarity:
         x0 = np.asarray(x0, dtype=float)
         theta0, T0, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
         z0 = np.clip(self.misfit.join(theta0, T0), self._lb, self._ub)
-        t0 = time.perf_counter()
-        try:
-            sol = self._solver(x0=z0, lbx=self._lb, ubx=self._ub)
-            stats = self._solver.stats()
-            z = np.asarray(sol["x"]).reshape(-1)
-            status = str(stats.get("return_status", "unknown"))
-            iters, ok = int(stats.get("iter_count", 0)), status in _SUCCESS
-        except RuntimeError as exc:  # CasADi evaluation errors
-            z, status, iters, ok = z0, f"IPOPT failed: {exc}", 0, False
+        z, status, iters, ok, elapsed = solve_from(self._solver, z0, self._lb, self._ub)
         theta, T = self.misfit.split(z)
-        return transform_outcome(self.model, self.data, x0, theta, T, ok, iters, time.perf_counter() - t0,
-                                 f"IPOPT: {status}")
+        return transform_outcome(self.model, self.data, x0, theta, T, ok, iters, elapsed, f"IPOPT: {status}")
