@@ -180,7 +180,7 @@ class ScrFRF:
                         "lmis": lmis, "backend": backend, "max_iter": max_iter, "tol": tol, "gamma0": gamma0,
                         "presolve": presolve, "heuristic": heuristic}
         self._solve_opts = {"backend": backend, "max_iter": int(max_iter), "tol": float(tol),
-                            "presolve": presolve, "heuristic": heuristic}
+                            "heuristic": heuristic}
         if admm is None and backend == "admm" and self.second_order:
             admm = scr.ADMMOptions(eps_rel=1e-2)  # measured, see the module docstring
         if admm is not None:
@@ -189,6 +189,7 @@ class ScrFRF:
         self.gamma0 = gamma0
         self.polish_misfit = polish_misfit
         self.problem = self._build(lam, lmis)
+        self.compiled = scr.compile(self.problem, presolve=presolve)  # presolved once for every start
 
     # -- problem construction ---------------------------------------------------------------
     def _families(self) -> dict[str, str]:
@@ -332,7 +333,7 @@ class ScrFRF:
 
     def solve(self, x0: np.ndarray, callback: Any = None) -> scr.SCRSolution:
         """The raw engine solution from the start ``x0`` (parameter vector); ``callback`` as :func:`symid.scr.solve`."""
-        return scr.solve(self.problem, self._aux_start(np.asarray(x0, dtype=float)), callback=callback,
+        return scr.solve(self.compiled, self._aux_start(np.asarray(x0, dtype=float)), callback=callback,
                          **self._solve_opts)
 
     def family_residuals(self, sol: scr.SCRSolution) -> dict[str, list[float]]:

@@ -131,8 +131,8 @@ class ScrPSD:
                                         "max_iter": max_iter, "tol": tol, "init": init, "init_std": init_std,
                                         "init_sign": init_sign, "seed": seed, "rank_tol": rank_tol,
                                         "normalize": normalize}
-        self._solve_opts: dict[str, Any] = {"backend": backend, "max_iter": int(max_iter), "tol": float(tol),
-                                            "normalize": normalize}
+        self._solve_opts: dict[str, Any] = {"backend": backend, "max_iter": int(max_iter), "tol": float(tol)}
+        self._normalize = bool(normalize)
         if admm is not None:
             self._solve_opts["admm"] = admm
         self.scale = float(np.max(np.linalg.norm(self.eq.Q, ord=2, axis=(1, 2)))) or 1.0
@@ -141,6 +141,7 @@ class ScrPSD:
         self.theta_var = scr.Variable("theta", (model.n_parameters,))
         self._constraints = self._lmis(lmis, bounds)
         self.problem = self._build(None)
+        self.compiled = scr.compile(self.problem, normalize=self._normalize)  # presolved once for every start
 
     @property
     def polisher(self) -> Any:
@@ -213,11 +214,12 @@ class ScrPSD:
             Y = self.initial_Y(x0)
             shift = [(-Y[i] - self.eq.X(x0)[i]) @ self._U[i] for i in range(Y.shape[0])]
             opts = {**self._solve_opts, "max_iter": 1}
-            first = scr.solve(self._build(shift), {"theta": x0, "t": 1.0}, presolve=False, **opts)
+            first = scr.solve(self._build(shift), {"theta": x0, "t": 1.0}, presolve=False,
+                              normalize=self._normalize, **opts)
             if first.status == "solver_error":
                 return first, first
             start = np.asarray(first.x["theta"], dtype=float)
-        return first, scr.solve(self.problem, {"theta": start}, **self._solve_opts)
+        return first, scr.solve(self.compiled, {"theta": start}, **self._solve_opts)
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start ``x0``; never raises on solver failure."""

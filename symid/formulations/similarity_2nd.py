@@ -267,8 +267,10 @@ class ScrSimilarity2nd:
             self._solve_opts["admm"] = admm
         self.scale = scale
         self.problem = self._build(float(weight), lmis, implied)
-        if implied and not consistent(self.problem):
+        self.compiled = scr.compile(self.problem)  # presolved once for every start
+        if implied and not consistent(self.compiled):
             self.problem = self._build(float(weight), lmis, False)
+            self.compiled = scr.compile(self.problem)
             self.options["implied"] = "dropped: inconsistent with this (estimated) black box"
 
     def _build(self, lam: float, lmis: bool, implied: bool) -> scr.BilinearProblem:
@@ -382,7 +384,7 @@ class ScrSimilarity2nd:
 
     def solve(self, x0: np.ndarray) -> scr.SCRSolution:
         """The raw engine solution (θ, τ and the scaled T, S in ``sol.x``) from the start x₀."""
-        return scr.solve(self.problem, self.start(x0), **self._solve_opts)
+        return scr.solve(self.compiled, self.start(x0), **self._solve_opts)
 
     def estimate(self, sol: scr.SCRSolution) -> dict[str, np.ndarray]:
         """M = (M⁻¹(τ))⁻¹, V, K, H and the θ fitted to them, from an engine solution."""

@@ -95,16 +95,14 @@ def implied_equalities(T: scr.Variable, S: scr.Variable, bbA: np.ndarray, Bb: np
     return out
 
 
-def consistent(problem: scr.BilinearProblem) -> bool:
-    """Whether the engine's presolve finds the linear equalities of ``problem`` consistent.
+def consistent(compiled: scr.CompiledProblem) -> bool:
+    """Whether the engine's presolve found the linear equalities of a compiled problem consistent.
 
     On an estimated black box (N4SID on noisy records) the relations the implied
     equalities add hold only approximately, and together with T𝔹 = B(θ) they can
-    over-determine T; the engine then reports the problem infeasible. One cheap engine
-    call (presolve and a single, truncated sub-problem) tells.
+    over-determine T; the engine would then report the problem infeasible.
     """
-    sol = scr.solve(problem, None, backend="admm", max_iter=1, admm=scr.ADMMOptions(inner=1, inner_first=1))
-    return sol.status != "infeasible"
+    return compiled.reduced.inconsistent <= scr.INCONSISTENT_TOL
 
 
 def left_times(X: np.ndarray, n: int) -> np.ndarray:
@@ -168,8 +166,10 @@ class ScrSimilarity:
         if admm is not None:
             self._solve_opts["admm"] = admm
         self.problem = self._build(float(weight), positivity, implied)
-        if implied and not consistent(self.problem):
+        self.compiled = scr.compile(self.problem)  # presolved once for every start
+        if implied and not consistent(self.compiled):
             self.problem = self._build(float(weight), positivity, False)
+            self.compiled = scr.compile(self.problem)
             self.options["implied"] = "dropped: inconsistent with this (estimated) black box"
 
     def _build(self, lam: float, positivity: bool, implied: bool) -> scr.BilinearProblem:
@@ -216,7 +216,7 @@ class ScrSimilarity:
 
     def solve(self, x0: np.ndarray) -> scr.SCRSolution:
         """The raw engine solution from the start x₀; its T and S are in the scaled basis (T/α, αS)."""
-        return scr.solve(self.problem, self.start(np.asarray(x0, dtype=float)), **self._solve_opts)
+        return scr.solve(self.compiled, self.start(np.asarray(x0, dtype=float)), **self._solve_opts)
 
     def transform(self, sol: scr.SCRSolution, original: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """(T, S) of an engine solution for ``data.blackbox`` (the balanced one when stable), or with

@@ -16,7 +16,9 @@ Two ways to pose a problem:
   ``Affine(const, {variable: coef})``, compiled without sympy.
 
 Back ends: ``"admm"`` (numpy, vectorised over blocks, LMIs by PSD projection) and
-``"cvxpy"`` (Clarabel, compiled once per solve thanks to DPP parameters).
+``"cvxpy"`` (Clarabel, compiled once per solve thanks to DPP parameters). For many solves
+of one problem (multi-start), :func:`compile` prepares it once (presolve, blocks, the
+compiled SDP) and :func:`solve` reuses the :class:`CompiledProblem`.
 
 Scaling, so that one weight λ means the same in every problem (``solve(normalize=True)``,
 the default; details in :mod:`symid.scr.presolve`): every bilinear equation is
@@ -31,6 +33,7 @@ is that of the equilibrated terms; ``sol.history[k].residuals`` are the user's, 
 """
 
 from symid.scr.backend_admm import ADMMOptions
+from symid.scr.compiled import INCONSISTENT_TOL, CompiledProblem, compile
 from symid.scr.maps import Affine
 from symid.scr.problem import Bilinear, BilinearProblem, SumSquares
 from symid.scr.result import Iteration, SCRSolution
@@ -38,14 +41,17 @@ from symid.scr.solve import solve
 from symid.scr.variables import Layout, Variable
 
 __all__ = [
+    "INCONSISTENT_TOL",
     "ADMMOptions",
     "Affine",
     "Bilinear",
     "BilinearProblem",
+    "CompiledProblem",
     "Iteration",
     "Layout",
     "SCRSolution",
     "SumSquares",
     "Variable",
+    "compile",
     "solve",
 ]

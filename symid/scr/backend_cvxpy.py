@@ -37,6 +37,12 @@ class CvxpyBackend:
 
     def __init__(self, red: Reduced, groups: list[TermGroup], lmis: list[LMIGroup], solver: str = "CLARABEL",
                  solver_options: dict | None = None):
+        """Build the parametrised SDP; cvxpy compiles it at the first :meth:`step`.
+
+        Every step solves with ``warm_start=False`` unless ``solver_options`` says
+        otherwise: cvxpy's default would update the previous Clarabel solver in place,
+        and the iterates would then depend (in the last digits) on what was solved before.
+        """
         self.red, self.groups = red, groups
         self.solver = solver
         self.solver_options = dict(solver_options or {})
@@ -118,7 +124,7 @@ class CvxpyBackend:
         try:
             with warnings.catch_warnings():  # an inaccurate solve is reported through the status below
                 warnings.filterwarnings("ignore", message="Solution may be inaccurate", category=UserWarning)
-                self.problem.solve(solver=self.solver, **self.solver_options)
+                self.problem.solve(solver=self.solver, **{"warm_start": False, **self.solver_options})
         except cp.error.SolverError as exc:
             tm["solve"] = time.perf_counter() - t
             return z0, False, f"cvxpy/{self.solver} failed: {exc}", tm

@@ -10,9 +10,10 @@ import numpy as np
 
 from symid.errors import ModelError
 from symid.scr.backend_admm import ADMMBackend, ADMMOptions
-from symid.scr.blocks import TermGroup, group_lmis, group_terms
+from symid.scr.blocks import TermGroup
+from symid.scr.compiled import INCONSISTENT_TOL, CompiledProblem
+from symid.scr.compiled import compile as _compile
 from symid.scr.presolve import Reduced
-from symid.scr.presolve import presolve as _presolve
 from symid.scr.problem import BilinearProblem
 from symid.scr.result import Iteration, SCRSolution
 
@@ -20,45 +21,6 @@ __all__ = ["solve"]
 
 _BACKENDS = ("admm", "cvxpy")
 _HEURISTICS = ("nuclear", "truncated")
-
-
-def _prepared(prob: BilinearProblem, presolve: bool, normalize: bool) -> tuple[Reduced, list[TermGroup], list, float]:
-    """Presolve and block grouping of ``prob``, computed once per problem and options.
-
-    Both depend on the problem only, not on the start, so a multi-start run pays for
-    them once (they were ~90% of a start's time when the presolve leaves a convex
-    problem). The cache lives on the problem object, which is not changed after
-    construction; the returned objects are only read by :func:`solve` and the back ends.
-    """
-    cache = prob.__dict__.setdefault("_scr_prepared", {})
-    key = (bool(presolve), bool(normalize))
-    if key not in cache:
-        t0 = time.perf_counter()
-        red = _presolve(prob, split=presolve, normalize=normalize)
-        groups = group_terms(red.terms) if red.inconsistent <= 1e-8 else []
-        lgroups = group_lmis(red.lmis) if red.inconsistent <= 1e-8 else []
-        cache[key] = (red, groups, lgroups, time.perf_counter() - t0)
-    return cache[key]
-
-
-def _cvxpy_backend(prob: BilinearProblem, key: tuple, red: Reduced, groups: list[TermGroup], lgroups: list,
-                   solver_options: Mapping | None) -> Any:
-    """The compiled cvxpy back end of ``prob``, built once per problem and options.
-
-    Every step overwrites all its parameters, and Clarabel starts cold, so reusing it
-    across starts gives the same iterates without recompiling the SDP (0.5–0.8 s).
-    """
-    from symid.scr.backend_cvxpy import CvxpyBackend
-
-    cache = prob.__dict__.setdefault("_scr_cvxpy", {})
-    try:
-        okey = (*key, tuple(sorted((solver_options or {}).items())))
-        hash(okey)
-    except TypeError:  # unhashable solver options: no reuse
-        return CvxpyBackend(red, groups, lgroups, solver_options=solver_options)
-    if okey not in cache:
-        cache[okey] = CvxpyBackend(red, groups, lgroups, solver_options=solver_options)
-    return cache[okey]
 
 
 def _relaxation(red: Reduced, groups: list[TermGroup], built: list[tuple[np.ndarray, np.ndarray]],
@@ -100,9 +62,9 @@ def _truncation(groups: list[TermGroup], ranks: list[np.ndarray], Q_old: list[np
     return out
 
 
-def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend: str = "admm",
+def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None = None, *, backend: str = "admm",
           max_iter: int = 100, tol: float = 1e-6, step_tol: float | None = None, heuristic: str = "nuclear",
-          truncate_after: int = 0, presolve: bool = True, normalize: bool = True,
+          truncate_after: int = 0, presolve: bool | None = None, normalize: bool | None = None,
           admm: ADMMOptions | None = None, solver_options: dict | None = None,
           callback: Callable[[int, dict[str, Any]], bool] | None = None) -> SCRSolution:
     """Solve a bilinear problem by Sequential Convex Relaxation (thesis Algorithm 2.1).
@@ -113,7 +75,10 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
 
     Parameters
     ----------
-    prob : BilinearProblem
+    prob : BilinearProblem or CompiledProblem
+        A problem, or one prepared by :func:`symid.scr.compile` for many solves
+        (multi-start): its presolve, blocks and compiled SDP are then reused, with the
+        same iterates as a solve of the bare problem.
     x0 : dict, optional
         Starting values by variable name, sympy symbol or Variable; missing variables
         start at 0. Unknown names and non-finite values raise :class:`ModelError`.
@@ -135,17 +100,16 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         Groups of terms share the largest rank(P) of the group.
     truncate_after : int
         Plain nuclear-norm iterations before the truncated ones start.
-    presolve : bool
+    presolve : bool, optional
         Move the affine rows/columns of the bilinear terms to linear equalities and
         eliminate variables they determine (default ``True``); see :mod:`symid.scr.presolve`.
-        The presolve, the block grouping and the compiled cvxpy problem depend on the
-        problem only: they are built by the first solve of ``prob`` and reused by later
-        ones (multi-start), with the same iterates.
-    normalize : bool
+        For a :class:`CompiledProblem` it is fixed at compilation (leave it ``None``).
+    normalize : bool, optional
         Equilibrate each term so one λ means the same across problems (default ``True``):
         P scaled to unit spectral norm, each row of the equation by its largest coefficient
         in A and C, each column by its largest coefficient in B and C; complex terms get
         half the weight in the real representation (2-8). See :mod:`symid.scr`.
+        For a :class:`CompiledProblem` it is fixed at compilation (leave it ``None``).
     admm : ADMMOptions, optional
         Options of the ADMM back end.
     solver_options : dict, optional
@@ -181,8 +145,16 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
     True
     """
     t_start = time.perf_counter()
-    if not isinstance(prob, BilinearProblem):
-        raise ModelError(f"solve() needs a BilinearProblem, got {type(prob).__name__}")
+    if isinstance(prob, CompiledProblem):
+        for name, given, fixed in (("presolve", presolve, prob.presolve), ("normalize", normalize, prob.normalize)):
+            if given is not None and bool(given) != fixed:
+                raise ModelError(f"{name}={given!r} differs from the compiled problem's {name}={fixed}; "
+                                 f"compile the problem again with {name}={given!r}")
+        compiled = prob
+    elif isinstance(prob, BilinearProblem):
+        compiled = None
+    else:
+        raise ModelError(f"solve() needs a BilinearProblem or a CompiledProblem, got {type(prob).__name__}")
     if backend not in _BACKENDS:
         raise ModelError(f"unknown backend {backend!r}; choose one of {_BACKENDS}")
     if heuristic not in _HEURISTICS:
@@ -201,14 +173,18 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         raise ModelError(f"solver_options must be a dict, got {type(solver_options).__name__}")
     if callback is not None and not callable(callback):
         raise ModelError(f"callback must be callable, got {type(callback).__name__}")
-    lay = prob.layout
+    lay = (compiled.problem if compiled is not None else prob).layout
     x_start = lay.pack(x0)
-    red, groups, lgroups, t_first = _prepared(prob, presolve, normalize)
+    if compiled is None:
+        compiled = _compile(prob, presolve=True if presolve is None else presolve,
+                            normalize=True if normalize is None else normalize)
+    prob = compiled.problem
+    red, groups, lgroups = compiled.reduced, compiled.groups, compiled.lmi_groups
     t_pre = time.perf_counter() - t_start
     info: dict[str, Any] = dict(red.info)
-    info["presolve_time"] = t_pre
-    info["presolve_first_time"] = t_first  # the first solve of this problem paid it; later ones reuse it
-    if red.inconsistent > 1e-8:
+    info["presolve_time"] = t_pre  # ~0 when a compiled problem is reused
+    info["presolve_first_time"] = compiled.prepare_time  # what compiling the problem cost
+    if red.inconsistent > INCONSISTENT_TOL:
         return SCRSolution(lay.unpack(x_start), (), (), "infeasible", False,
                            f"the linear equalities (given and split off the bilinear terms) are inconsistent: "
                            f"residual {red.inconsistent:.3e}", 0, time.perf_counter() - t_start, backend,
@@ -221,7 +197,7 @@ def solve(prob: BilinearProblem, x0: Mapping[Any, Any] | None = None, *, backend
         be = ADMMBackend(red, groups, lgroups, admm or ADMMOptions())
         info["rho"] = be.rho
     else:
-        be = _cvxpy_backend(prob, (bool(presolve), bool(normalize)), red, groups, lgroups, solver_options)
+        be = compiled.cvxpy_backend(solver_options)
         compilations0, compile_time0 = be.compilations, be.compile_time
         info["is_dpp"] = bool(be.problem.is_dpp())
     info["setup_time"] = time.perf_counter() - t0
