@@ -8,12 +8,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from symid.errors import ModelError
+from symid.errors import DataError, ModelError
 from symid.identification import prepare
+from symid.interrupt import Interrupted
 from symid.misfit import relative_parameter_error
 from symid.polish import polish_outcome
 from symid.progress import progress_bar
-from symid.result import IdentificationResult
+from symid.result import IdentificationResult, StartOutcome
+from symid.runlog import RunLog
 from symid.starts import make_starts
 from symid.statespace import StateSpaceModel
 
@@ -138,7 +140,7 @@ def _polisher(model: Any, data: Any, solver: Any) -> Any:
 def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *, starts: int = 10,
             seed: int | None = 0, truth: Any = None, x0: Any = None, param_tol: float = 1e-3,
             cost_tol: float = 1e-8, progress: bool | None = None,
-            options: dict[str, dict[str, Any]] | None = None) -> Comparison:
+            options: dict[str, dict[str, Any]] | None = None, log: RunLog | None = None) -> Comparison:
     """Run several methods from identical starts and tabulate success and time.
 
     Parameters
@@ -170,10 +172,22 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     options : dict, optional
         Per-method options, e.g. ``{"scr": {"backend": "admm"}}``; ``"scr+polish"``
         uses the options of ``"scr"``.
+    log : symid.runlog.RunLog, optional
+        Record every start as it ends (JSON Lines, flushed); starts already in the log
+        are read back instead of run, so an interrupted comparison resumes where it
+        stopped. Use :meth:`~symid.runlog.RunLog.scoped` to keep several comparisons in
+        one file. A log written with other starts is refused.
 
     Returns
     -------
     Comparison
+
+    Raises
+    ------
+    symid.interrupt.Interrupted
+        On Ctrl-C after at least one start finished; its ``partial`` is the comparison
+        of the finished starts (an unfinished method's row counts only its finished
+        starts).
 
     Examples
     --------
@@ -201,27 +215,13 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
             raise ModelError(f"unknown method {m!r}: only 'scr+polish' is polished")
     truth_vec = None if truth is None else model.theta_vector(truth)
     x0s = make_starts(model, starts, seed, x0, zero_first=isinstance(model, StateSpaceModel))
-    stats = []
-    for method in methods:
-        base = method.removesuffix("+polish")
-        t0 = time.perf_counter()
-        solver = prepare(model, data, base, dict(options.get(base, {})))  # every row builds its own: nothing shared
-        bar = progress_bar(x0s, desc=method, enabled=progress)
-        if method == "scr+polish":
-            polisher = _polisher(model, data, solver)
-            setup = time.perf_counter() - t0
-            if hasattr(solver, "run_polished"):  # hands over to the polish once in a good basin
-                outcomes = [solver.run_polished(x, polisher) for x in bar]
-            else:
-                outcomes = [polish_outcome(polisher, solver.run(x)) for x in bar]
-            ran_as = f"{solver.method}+polish"
-            opts = {**getattr(solver, "options", {}), "polish": getattr(polisher, "method", "polish")}
-            if hasattr(solver, "polish_misfit"):
-                opts["polish_misfit"] = solver.polish_misfit
-        else:
-            setup = time.perf_counter() - t0
-            outcomes = [solver.run(x) for x in bar]
-            ran_as, opts = solver.method, dict(getattr(solver, "options", {}))
+    if log is not None and not isinstance(log, RunLog):
+        raise ModelError(f"log must be a symid.runlog.RunLog; got {type(log).__name__}")
+    criterion = (f"relative parameter error <= {param_tol:g}" if truth_vec is not None
+                 else f"relative misfit <= {cost_tol:g}")
+    stats: list[MethodStats] = []
+
+    def tabulate(method: str, ran_as: str, opts: dict, outcomes: list[StartOutcome], setup: float) -> MethodStats:
         res = IdentificationResult.from_starts(ran_as, model.parameter_names, outcomes, opts)
         if truth_vec is not None:
             ok = [relative_parameter_error(o.theta, truth_vec) <= param_tol for o in outcomes]
@@ -231,12 +231,77 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
             best_err = None
         n_ok = int(sum(ok))
         total = setup + sum(o.wall_time for o in outcomes)
-        stats.append(MethodStats(method=method, ran_as=ran_as, n_starts=len(outcomes), n_success=n_ok,
-                                 success_rate=n_ok / len(outcomes),
-                                 median_time=float(np.median([o.wall_time for o in outcomes])), setup_time=setup,
-                                 time_to_solution=total / n_ok if n_ok else float("inf"),
-                                 best_cost=res.cost, best_error=best_err, result=res))
-    criterion = (f"relative parameter error <= {param_tol:g}" if truth_vec is not None
-                 else f"relative misfit <= {cost_tol:g}")
-    return Comparison(stats=tuple(stats), n_starts=len(x0s), seed=seed, criterion=criterion,
-                      truth=None if truth is None else model.theta_dict(truth))
+        return MethodStats(method=method, ran_as=ran_as, n_starts=len(outcomes), n_success=n_ok,
+                           success_rate=n_ok / len(outcomes),
+                           median_time=float(np.median([o.wall_time for o in outcomes])), setup_time=setup,
+                           time_to_solution=total / n_ok if n_ok else float("inf"),
+                           best_cost=res.cost, best_error=best_err, result=res)
+
+    def partial() -> Comparison:
+        return Comparison(stats=tuple(stats), n_starts=len(x0s), seed=seed, criterion=criterion,
+                          truth=None if truth is None else model.theta_dict(truth))
+
+    for method in methods:
+        outcomes: list[StartOutcome] = []
+        ran_as, opts, setup = method, {}, 0.0
+        try:
+            method_options = dict(options.get(method.removesuffix("+polish"), {}))
+            ran_as, opts, setup = _run_method(model, data, method, method_options, x0s, progress, log, outcomes)
+        except KeyboardInterrupt:
+            if outcomes:
+                stats.append(tabulate(method, ran_as, {**opts, "interrupted": True}, outcomes, setup))
+            if not stats:
+                raise
+            done = ", ".join(f"{s.method} {s.n_starts}/{len(x0s)}" for s in stats)
+            raise Interrupted(f"compare() interrupted (finished starts: {done}); they are in the exception's "
+                              f".partial comparison", partial()) from None
+        stats.append(tabulate(method, ran_as, opts, outcomes, setup))
+    return partial()
+
+
+def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s: list[np.ndarray],
+                progress: bool | None, log: RunLog | None, outcomes: list[StartOutcome]
+                ) -> tuple[str, dict[str, Any], float]:
+    """Run one method from every start, appending to ``outcomes`` as each ends; (ran_as, options, setup s).
+
+    Starts found in ``log`` are read back instead of run; each new one is logged as it ends.
+    """
+    base = method.removesuffix("+polish")
+    cached = [None if log is None else log.get(f"{method}/start{i}") for i in range(len(x0s))]
+    for i, (rec, x) in enumerate(zip(cached, x0s, strict=True)):
+        if rec is not None and not np.allclose(rec["start"], x, rtol=1e-12, atol=0):
+            raise DataError(f"the log {log.path} holds start {i} of {method} from another starting point "
+                            f"(another seed, x0 or model?); resume with the same arguments or use a new log")
+    head = None if log is None else log.get(f"{method}/setup")
+    if head is not None and all(rec is not None for rec in cached):  # everything done: nothing to build
+        outcomes.extend(StartOutcome.from_dict(rec) for rec in cached)
+        return str(head["ran_as"]), dict(head["options"]), float(head["setup_time"])
+    t0 = time.perf_counter()
+    solver = prepare(model, data, base, options)  # every row builds its own: nothing shared
+    polisher = _polisher(model, data, solver) if method == "scr+polish" else None
+    setup = time.perf_counter() - t0
+    if polisher is not None:
+        ran_as = f"{solver.method}+polish"
+        opts = {**getattr(solver, "options", {}), "polish": getattr(polisher, "method", "polish")}
+        if hasattr(solver, "polish_misfit"):
+            opts["polish_misfit"] = solver.polish_misfit
+    else:
+        ran_as, opts = solver.method, dict(getattr(solver, "options", {}))
+    if head is not None:
+        setup = float(head["setup_time"])  # the first run's setup is the one the figures count
+    elif log is not None:
+        log.append(f"{method}/setup", {"ran_as": ran_as, "options": opts, "setup_time": setup})
+    for i, x in enumerate(progress_bar(x0s, desc=method, enabled=progress)):
+        if cached[i] is not None:
+            outcomes.append(StartOutcome.from_dict(cached[i]))
+            continue
+        if polisher is None:
+            out = solver.run(x)
+        elif hasattr(solver, "run_polished"):  # hands over to the polish once in a good basin
+            out = solver.run_polished(x, polisher)
+        else:
+            out = polish_outcome(polisher, solver.run(x))
+        outcomes.append(out)
+        if log is not None:
+            log.append(f"{method}/start{i}", out.to_dict())
+    return ran_as, opts, setup

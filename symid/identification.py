@@ -11,6 +11,7 @@ import numpy as np
 
 from symid.errors import DataError, ModelError
 from symid.formulations.frf_ls import LinearFRF, ls_applicable
+from symid.interrupt import Interrupted
 from symid.nlls.frf import IpoptFRF
 from symid.polish import polish_outcome
 from symid.progress import progress_bar
@@ -136,6 +137,14 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
     IdentificationResult
         The best start by data misfit, and every start's outcome in ``result.starts``.
 
+    Raises
+    ------
+    symid.interrupt.Interrupted
+        On Ctrl-C after at least one start finished (a ``KeyboardInterrupt``, so a
+        script stops); its ``partial`` is the result of the finished starts, with
+        ``options["interrupted"] = True``. Ctrl-C stops a running start at once (IPOPT
+        and Clarabel within one iteration).
+
     Examples
     --------
     >>> import numpy as np
@@ -156,11 +165,19 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
         x0s = x0s[:1]
     outcomes: list[StartOutcome] = []
     label = f"{solver.method} starts"
-    for x in progress_bar(x0s, desc=label, enabled=progress):
-        outcomes.append(solver.run(x))
     options_used = dict(getattr(solver, "options", {}))
     if solver.method != method:
         options_used["chosen_because"] = f"{method} → {solver.method}: linear special case ({solver.case})"
+    try:
+        for x in progress_bar(x0s, desc=label, enabled=progress):
+            outcomes.append(solver.run(x))
+    except KeyboardInterrupt:
+        if not outcomes:
+            raise
+        partial = IdentificationResult.from_starts(solver.method, model.parameter_names, outcomes,
+                                                   {**options_used, "interrupted": True})
+        raise Interrupted(f"identify() interrupted after {len(outcomes)} of {len(x0s)} starts; "
+                          f"the finished starts are in the exception's .partial result", partial) from None
     result = IdentificationResult.from_starts(solver.method, model.parameter_names, outcomes, options_used)
     if polish and solver.method == "scr":
         t0 = time.perf_counter()

@@ -54,6 +54,18 @@ class StartOutcome:
                 "cost": float(self.cost), "converged": bool(self.converged), "iterations": int(self.iterations),
                 "wall_time": float(self.wall_time), "message": self.message}
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> StartOutcome:
+        """Rebuild an outcome written by :meth:`to_dict` (the history is not kept there).
+
+        A cost written as ``None`` (JSON has no NaN or infinity) reads back as ``inf``.
+        """
+        cost = d.get("cost")
+        return cls(start=np.asarray(d["start"], dtype=float), theta=np.asarray(d["theta"], dtype=float),
+                   cost=float("inf") if cost is None else float(cost), converged=bool(d["converged"]),
+                   iterations=int(d["iterations"]), wall_time=float(d["wall_time"]),
+                   message=str(d.get("message", "")))
+
 
 @dataclass(frozen=True)
 class IdentificationResult:

@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from symid.interrupt import native_interrupts
+
 __all__ = ["IPOPT_SUCCESS", "solve_from"]
 
 IPOPT_SUCCESS = frozenset({"Solve_Succeeded", "Solved_To_Acceptable_Level"})
@@ -37,7 +39,9 @@ def solve_from(solver: Any, z0: np.ndarray, lbx: np.ndarray, ubx: np.ndarray
     """
     t0 = time.perf_counter()
     try:
-        sol = solver(x0=z0, lbx=lbx, ubx=ubx)
+        # CasADi turns Ctrl-C into a failed start and goes on; this raises it after the solve
+        with native_interrupts(raise_now=True):
+            sol = solver(x0=z0, lbx=lbx, ubx=ubx)
         stats = solver.stats()
         z = np.asarray(sol["x"]).reshape(-1)
         status = str(stats.get("return_status", "unknown"))

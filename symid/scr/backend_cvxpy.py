@@ -18,7 +18,9 @@ import cvxpy as cp
 import numpy as np
 
 from symid.errors import ModelError
+from symid.interrupt import native_interrupts
 from symid.scr.blocks import LMIGroup, TermGroup
+from symid.scr.clarabel_solver import INTERRUPTIBLE_CLARABEL
 from symid.scr.presolve import Reduced
 
 __all__ = ["CvxpyBackend"]
@@ -121,10 +123,14 @@ class CvxpyBackend:
         cache = getattr(self.problem, "_cache", None)
         prog_before = getattr(cache, "param_prog", None)
         t = time.perf_counter()
+        solver = self.solver
+        if solver == "CLARABEL" and INTERRUPTIBLE_CLARABEL is not None:
+            solver = INTERRUPTIBLE_CLARABEL  # the same solve, stopped by Ctrl-C within an iteration
         try:
-            with warnings.catch_warnings():  # an inaccurate solve is reported through the status below
+            with warnings.catch_warnings(), native_interrupts(raise_now=False):
+                # an inaccurate solve is reported through the status below
                 warnings.filterwarnings("ignore", message="Solution may be inaccurate", category=UserWarning)
-                self.problem.solve(solver=self.solver, **{"warm_start": False, **self.solver_options})
+                self.problem.solve(solver=solver, **{"warm_start": False, **self.solver_options})
         except cp.error.SolverError as exc:
             tm["solve"] = time.perf_counter() - t
             return z0, False, f"cvxpy/{self.solver} failed: {exc}", tm
