@@ -3,13 +3,93 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
+import traceback
 from collections.abc import Sequence
 
 from symid.errors import SymidError
+from symid.interrupt import Interrupted
 
-__all__ = ["main"]
+__all__ = ["build_parser", "main"]
+
+_MAX_STARTS = 100_000
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with a one-line error (``symid identify: error: ...``) and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+
+
+def _int_in(low: int, high: int | None = None):
+    """An argparse type: an integer in [low, high]."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if value < low or (high is not None and value > high):
+            span = f"≥ {low}" if high is None else f"between {low} and {high}"
+            raise argparse.ArgumentTypeError(f"must be an integer {span}; got {value}")
+        return value
+    return parse
+
+
+def _positive_seconds(text: str) -> float:
+    """An argparse type: a finite number of seconds > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds > 0; got {text}")
+    return value
+
+
+def _known_values(items: Sequence[str] | None, command: str) -> dict[str, float]:
+    known: dict[str, float] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise _UsageError(f"symid {command}: error: --known expects name=value, got {item!r}")
+        try:
+            number = float(value)
+        except ValueError:
+            raise _UsageError(f"symid {command}: error: --known {item!r}: {value.strip()!r} is not a number") from None
+        if not math.isfinite(number):
+            raise _UsageError(f"symid {command}: error: --known {item!r}: the value must be finite")
+        if name in known:
+            raise _UsageError(f"symid {command}: error: --known gives {name!r} twice")
+        known[name] = number
+    return known
+
+
+class _UsageError(Exception):
+    """A bad command line found after parsing: one line on standard error, exit status 2."""
+
+
+def _output_dir(path: str | None, command: str):
+    """Create the --out folder (before any long work) and check it is writable; ``None`` passes through."""
+    from pathlib import Path
+
+    if path is None:
+        return None
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise _UsageError(f"symid {command}: error: --out {path!r} exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".symid-write-test-{os.getpid()}"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise _UsageError(f"symid {command}: error: cannot write to --out {path!r}: "
+                          f"{exc.strerror or exc}") from None
+    return out
 
 
 def _cmd_models(args: argparse.Namespace) -> int:
@@ -31,6 +111,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
 def _cmd_demo(args: argparse.Namespace) -> int:
     from symid.demo import run_demo
 
+    _output_dir(args.out, "demo")
     return run_demo(out=args.out)
 
 
@@ -52,83 +133,97 @@ def _method_options(args: argparse.Namespace) -> dict:
     opts = {}
     if getattr(args, "backend", None):
         opts["backend"] = args.backend
-    if getattr(args, "max_iter", None):
+    if getattr(args, "max_iter", None) is not None:
         opts["max_iter"] = args.max_iter
     return opts
 
 
 def _cmd_identify(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
-
     from symid.identification import identify
-    from symid.plots import bode_plot, start_convergence_plot
 
+    out = _output_dir(args.out, "identify")
     entry, data, source = _entry_and_data(args.model, args.data)
     print(f"model: {entry.name}   data: {source}")
     opts = _method_options(args) if args.method == "scr" else {}
-    res = identify(entry.model, data, method=args.method, starts=args.starts, seed=args.seed,
-                   polish=args.polish, progress=True if args.starts > 1 else None, **opts)
     truth = entry.truth if args.data is None else None
+    try:
+        res = identify(entry.model, data, method=args.method, starts=args.starts, seed=args.seed,
+                       polish=args.polish, progress=True if args.starts > 1 else None, **opts)
+    except Interrupted as exc:  # keep the finished starts
+        res = exc.partial
+        print(res.summary(truth=truth))
+        if out is not None:
+            _write_identify(out, entry, data, res, truth)
+        raise
     print(res.summary(truth=truth))
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "result.json").write_text(json.dumps(res.to_dict(), indent=2))
-        (out / "summary.txt").write_text(res.summary(truth=truth) + "\n")
-        written = [out / "result.json", out / "summary.txt"]
-        if hasattr(data, "H"):
-            curves = {f"{res.method} estimate": (entry.model, res.theta_vector)}
-            if res.polished is not None:
-                curves["after polish"] = (entry.model, res.polished.theta_vector)
-            written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate"))
-        best = res.best_start
-        if best.history and "families" in best.history[0]:  # SCR: thesis Figure 3-2 for the reported start
-            written.append(start_convergence_plot(
-                best, out / "convergence.png", truth=None if truth is None else entry.model.theta_vector(truth),
-                title=f"{entry.name}: SCR convergence of the reported start"))
-        print("wrote " + ", ".join(str(p) for p in written))
+    if out is not None:
+        _write_identify(out, entry, data, res, truth)
     final = res.polished if res.polished is not None else res
     return 0 if final.success else 1
 
 
-def _cmd_compare(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
+def _write_identify(out, entry, data, res, truth) -> None:
+    """result.json, summary.txt and the plots, each written atomically."""
+    from symid.plots import bode_plot, start_convergence_plot
+    from symid.runlog import write_atomic, write_json_atomic
 
+    write_json_atomic(out / "result.json", res.to_dict(), indent=2)
+    with write_atomic(out / "summary.txt") as fh:
+        fh.write(res.summary(truth=truth) + "\n")
+    written = [out / "result.json", out / "summary.txt"]
+    if hasattr(data, "H"):
+        curves = {f"{res.method} estimate": (entry.model, res.theta_vector)}
+        if res.polished is not None:
+            curves["after polish"] = (entry.model, res.polished.theta_vector)
+        written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate"))
+    best = res.best_start
+    if best.history and "families" in best.history[0]:  # SCR: thesis Figure 3-2 for the reported start
+        written.append(start_convergence_plot(
+            best, out / "convergence.png", truth=None if truth is None else entry.model.theta_vector(truth),
+            title=f"{entry.name}: SCR convergence of the reported start"))
+    print("wrote " + ", ".join(str(p) for p in written))
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
     from symid.comparison import compare
 
+    out = _output_dir(args.out, "compare")
     entry, data, source = _entry_and_data(args.model, args.data)
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
+    if not methods:
+        raise _UsageError(f"symid compare: error: --methods {args.methods!r} names no method")
     truth = entry.truth if args.data is None else None
     print(f"model: {entry.name}   data: {source}")
     scr_opts = _method_options(args)
-    cmp = compare(entry.model, data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
-                  progress=True,
-                  options={"scr": scr_opts} if scr_opts and {"scr", "scr+polish"} & set(methods) else None)
+    try:
+        cmp = compare(entry.model, data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
+                      progress=True,
+                      options={"scr": scr_opts} if scr_opts and {"scr", "scr+polish"} & set(methods) else None)
+    except Interrupted as exc:  # keep the finished starts
+        print(exc.partial.table())
+        if out is not None:
+            _write_compare(out, exc.partial)
+        raise
     print(cmp.table())
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "comparison.json").write_text(json.dumps(cmp.to_dict(), indent=2, default=float))
-        (out / "comparison.md").write_text(cmp.to_markdown() + "\n")
-        print(f"wrote {out / 'comparison.json'}, {out / 'comparison.md'}")
+    if out is not None:
+        _write_compare(out, cmp)
     return 0
+
+
+def _write_compare(out, cmp) -> None:
+    from symid.runlog import write_atomic, write_json_atomic
+
+    write_json_atomic(out / "comparison.json", cmp.to_dict(), indent=2)
+    with write_atomic(out / "comparison.md") as fh:
+        fh.write(cmp.to_markdown() + "\n")
+    print(f"wrote {out / 'comparison.json'}, {out / 'comparison.md'}")
 
 
 def _cmd_identifiability(args: argparse.Namespace) -> int:
     from symid.structural import identifiability
     from symid.zoo import load_model
 
-    known = {}
-    for item in args.known or []:
-        name, sep, value = item.partition("=")
-        if not sep:
-            raise SystemExit(f"symid identifiability: --known expects name=value, got {item!r}")
-        try:
-            known[name.strip()] = float(value)
-        except ValueError:
-            raise SystemExit(f"symid identifiability: --known {item!r}: {value!r} is not a number") from None
+    known = _known_values(args.known, "identifiability")
     positive = {"declared": None, "all": True, "ignore": False}[args.positive]
     report = identifiability(load_model(args.model).model, known=known, positive=positive,
                              timeout=args.timeout, exact_count=args.exact_count, seed=args.seed)
@@ -138,11 +233,12 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``symid`` command."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="symid",
         description="Continuous-time grey-box system identification: symbolic models, "
                     "identifiability, and estimation by sequential convex relaxation (SCR).")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
     p = sub.add_parser("models", help="list the model zoo", description="List the models of the zoo.")
@@ -161,10 +257,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--method", choices=("scr", "ipopt", "ls", "als", "gb"), default="scr",
                    help="estimator (default: scr); als and gb (alternating least squares, gradient-based BFGS, "
                         "thesis appendix C) take black-box or I/O data")
-    p.add_argument("--starts", type=int, default=1, metavar="N", help="number of starts (default: 1)")
-    p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the random starts (default: 0)")
+    p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=1, metavar="N",
+                   help="number of starts (default: 1)")
+    p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
-    p.add_argument("--max-iter", type=int, dest="max_iter", metavar="K", help="SCR iterations per start")
+    p.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
+                   help="SCR iterations per start (≥ 1)")
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
     p.add_argument("--out", metavar="DIR",
                    help="write result.json, summary.txt, bode.png and (SCR) convergence.png here")
@@ -178,10 +276,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--methods", default="scr,ipopt",
                    help="comma-separated methods among scr, scr+polish (SCR then IPOPT from its estimate, "
                         "reported apart), ipopt, ls, and for black-box or I/O data als, gb (default: scr,ipopt)")
-    p.add_argument("--starts", type=int, default=10, metavar="N", help="number of starts (default: 10)")
-    p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the random starts (default: 0)")
+    p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=10, metavar="N",
+                   help="number of starts (default: 10)")
+    p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
-    p.add_argument("--max-iter", type=int, dest="max_iter", metavar="K", help="SCR iterations per start")
+    p.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
+                   help="SCR iterations per start (≥ 1)")
     p.add_argument("--out", metavar="DIR", help="write comparison.json and comparison.md here")
     p.set_defaults(func=_cmd_compare)
 
@@ -196,7 +296,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "parameter global / local / none (exact Jacobian rank and a Gröbner basis), the number of "
                     "solutions, identifiable combinations and a reparameterisation.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
-    p.add_argument("--timeout", type=float, default=30.0, metavar="S",
+    p.add_argument("--timeout", type=_positive_seconds, default=30.0, metavar="S",
                    help="time budget of the analysis in seconds; if the global (Gröbner) step does not finish "
                         "in it and no certified solution θ ≠ θ* settles the verdicts, the local verdict is reported "
                         "and the global one marked undetermined (default: 30)")
@@ -207,26 +307,62 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--positive", choices=("declared", "all", "ignore"), default="declared",
                    help="discard solutions with non-positive values of the parameters declared positive "
                         "(default), of all parameters, or ignore positivity")
-    p.add_argument("--seed", type=int, default=0, help="seed of the random rational points (default: 0)")
+    p.add_argument("--seed", type=_int_in(0), default=0, metavar="S",
+                   help="seed of the random rational points (default: 0)")
     p.set_defaults(func=_cmd_identifiability)
     return parser
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("symid")
+    except PackageNotFoundError:  # pragma: no cover - a source tree that was never installed
+        return "unknown (not installed)"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``symid`` console script."""
+    """Entry point of the ``symid`` console script.
+
+    Exit status: 0 done; 1 ``identify`` ran but its reported start did not converge;
+    2 bad input (arguments, model, data or files), said in one line on standard
+    error; 3 an internal error (a bug: the traceback is shown with ``SYMID_TRACEBACK=1``);
+    130 interrupted by Ctrl-C (what had finished is printed and, with ``--out``, written).
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         code = int(args.func(args) or 0)
         sys.stdout.flush()  # inside the try: a closed pipe surfaces here, not at interpreter exit
         return code
-    except SymidError as exc:
-        print(f"symid: error: {exc}", file=sys.stderr)
-        return 2
     except BrokenPipeError:
         # the reader went away (`symid models | head`): stop quietly, as other command-line tools do
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except _UsageError as exc:
+        print(exc, file=sys.stderr)
+        return 2
+    except SymidError as exc:
+        print(f"symid: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        kept = " (the finished starts are shown above)" if isinstance(exc, Interrupted) else ""
+        print(f"symid: interrupted{kept}", file=sys.stderr)
+        return 130
+    except MemoryError:
+        print("symid: error: out of memory (is a data file much larger than expected?)", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a file that cannot be read or written
+        where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        print(f"symid: error: cannot access{where}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except Exception as exc:
+        if os.environ.get("SYMID_TRACEBACK"):
+            traceback.print_exc()
+        print(f"symid: internal error: {type(exc).__name__}: {exc} (a bug: please report it; "
+              f"SYMID_TRACEBACK=1 shows the traceback)", file=sys.stderr)
+        return 3
 
 
 if __name__ == "__main__":

@@ -69,11 +69,7 @@ def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | P
     ax_m.legend(loc="best", fontsize=8)
     ax_m.set_title(title or f"Bode plot, output {output}, input {input}")
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path, dpi=110)
 
 
 def convergence_plot(groups: Mapping[str, Sequence[float]], path: str | Path, *, title: str | None = None,
@@ -129,10 +125,20 @@ def convergence_plot(groups: Mapping[str, Sequence[float]], path: str | Path, *,
     ax.legend(loc="best", fontsize=9)
     ax.set_title(title or "SCR convergence per constraint group", fontsize=11)
     fig.tight_layout()
+    return _save(fig, path, dpi=120)
+
+
+def _save(fig: Any, path: str | Path, dpi: int) -> Path:
+    """Save and close ``fig``; the file appears whole or not at all (written beside it, then renamed)."""
+    from symid.runlog import write_atomic
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        with write_atomic(path, "wb") as fh:
+            fig.savefig(fh, dpi=dpi, format=path.suffix.lstrip(".").lower() or "png")
+    finally:
+        _pyplot().close(fig)
     return path
 
 

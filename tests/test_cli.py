@@ -152,3 +152,103 @@ def test_closed_pipe_is_not_a_traceback(monkeypatch, tmp_path):
     with open(tmp_path / "stdout", "w") as sink:
         monkeypatch.setattr(sys, "stdout", ClosedPipe(os.dup(sink.fileno())))
         assert main(["models"]) == 0
+
+
+def _exit_code(argv: list[str]) -> int:
+    """main()'s status, whether it returns it or argparse exits with it."""
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return int(exc.code)
+
+
+@pytest.fixture
+def bad_paths(tmp_path):
+    afile = tmp_path / "afile.txt"
+    afile.write_text("not data\n")
+    (tmp_path / "adir").mkdir()
+    return {"file": str(afile), "dir": str(tmp_path / "adir"), "missing": str(tmp_path / "missing.csv")}
+
+
+BAD_COMMAND_LINES = {  # issue 12 item 6, and the same kinds found while fixing them
+    "negative seed": (["identify", "belt_drive", "--seed", "-1"], "--seed: must be an integer ≥ 0"),
+    "float seed": (["identifiability", "belt_drive", "--seed", "1.5"], "'1.5' is not an integer"),
+    "missing data file": (["identify", "belt_drive", "--data", "{missing}"], "No such file"),
+    "data is a folder": (["identify", "belt_drive", "--data", "{dir}"], "Is a directory"),
+    "data not symid": (["identify", "belt_drive", "--data", "{file}"], "{file}"),
+    "out is a file": (["identify", "belt_drive", "--out", "{file}"], "exists and is not a folder"),
+    "out unwritable": (["identify", "belt_drive", "--out", "/proc/x"], "cannot write to --out"),
+    "compare out is a file": (["compare", "belt_drive", "--out", "{file}"], "exists and is not a folder"),
+    "demo out is a file": (["demo", "--out", "{file}"], "exists and is not a folder"),
+    "timeout nan": (["identifiability", "belt_drive", "--timeout", "nan"], "finite number of seconds > 0"),
+    "timeout inf": (["identifiability", "belt_drive", "--timeout", "inf"], "finite number of seconds > 0"),
+    "timeout negative": (["identifiability", "belt_drive", "--timeout", "-1"], "finite number of seconds > 0"),
+    "known nan": (["identifiability", "belt_drive", "--known", "theta1=nan"], "must be finite"),
+    "known inf": (["identifiability", "belt_drive", "--known", "theta1=inf"], "must be finite"),
+    "known overflow": (["identifiability", "belt_drive", "--known", "theta1=1e400"], "must be finite"),
+    "known no value": (["identifiability", "belt_drive", "--known", "theta1"], "expects name=value"),
+    "known twice": (["identifiability", "belt_drive", "--known", "theta1=1", "theta1=2"], "twice"),
+    "max-iter 0": (["identify", "belt_drive", "--max-iter", "0"], "--max-iter: must be an integer ≥ 1"),
+    "starts 0": (["identify", "belt_drive", "--starts", "0"], "--starts: must be an integer between 1"),
+    "starts huge": (["compare", "belt_drive", "--starts", "1000000000"], "--starts: must be an integer between"),
+    "no methods": (["compare", "belt_drive", "--methods", ","], "names no method"),
+    "unknown command": (["frobnicate"], "invalid choice"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_COMMAND_LINES))
+def test_bad_command_lines_give_one_line_and_status_2(case, bad_paths, capsys):
+    argv, expected = BAD_COMMAND_LINES[case]
+    argv = [a.format(**bad_paths) for a in argv]
+    assert _exit_code(argv) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1, err
+    assert expected.format(**bad_paths) in err
+
+
+def test_version_is_printed(capsys):
+    from importlib.metadata import version
+
+    assert _exit_code(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"symid {version('symid')}"
+
+
+def test_max_iter_is_honoured(tmp_path, capsys):
+    # `--max-iter 1` must reach SCR (it was dropped by a truthiness test when 0, and is now checked ≥ 1)
+    assert main(["identify", "mass_damper_2dof", "--max-iter", "1", "--out", str(tmp_path)]) in (0, 1)
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["iterations"] == 1 and result["options"]["max_iter"] == 1
+
+
+def test_internal_error_is_one_line_and_status_3(monkeypatch, capsys):
+    import symid.zoo
+
+    def broken(name):
+        raise RuntimeError("simulated bug")
+
+    monkeypatch.setattr(symid.zoo, "load_model", broken)
+    monkeypatch.delenv("SYMID_TRACEBACK", raising=False)
+    assert main(["show", "belt_drive"]) == 3
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "internal error: RuntimeError: simulated bug" in err
+
+
+def test_interrupted_identify_writes_the_finished_starts(tmp_path, monkeypatch, capsys):
+    from symid.nlls import frf as nlls_frf
+
+    real = nlls_frf.IpoptFRF.run
+    calls = {"n": 0}
+
+    def run(self, x0):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise KeyboardInterrupt
+        return real(self, x0)
+
+    monkeypatch.setattr(nlls_frf.IpoptFRF, "run", run)
+    assert main(["identify", "belt_drive", "--method", "ipopt", "--starts", "5", "--out", str(tmp_path)]) == 130
+    captured = capsys.readouterr()
+    assert "symid: interrupted (the finished starts are shown above)" in captured.err
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert len(result["starts"]) == 2 and result["options"]["interrupted"] is True
