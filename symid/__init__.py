@@ -16,6 +16,7 @@ from symid.errors import (
     IdentifiabilityWarning,
     ModelError,
     NonAffineError,
+    OptionError,
     SolverError,
     SymidError,
 )
@@ -78,6 +79,7 @@ __all__ = [
     "MethodStats",
     "ModelError",
     "NonAffineError",
+    "OptionError",
     "SecondOrderModel",
     "SolverError",
     "SpectralData",

@@ -12,6 +12,7 @@ __all__ = [
     "IdentifiabilityWarning",
     "ModelError",
     "NonAffineError",
+    "OptionError",
     "SolverError",
     "SymidError",
 ]
@@ -51,6 +52,13 @@ class NonAffineError(ModelError):
 
 class DataError(SymidError, ValueError):
     """Measured or simulated data are malformed (shape, NaN/inf, frequencies, symmetry)."""
+
+
+class OptionError(SymidError, ValueError):
+    """An option of an estimator or an analysis is unknown, misspelt or has a bad value.
+
+    The message names the option and, for an unknown name, lists the valid ones.
+    """
 
 
 class SolverError(SymidError, RuntimeError):
