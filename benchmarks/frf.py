@@ -11,7 +11,7 @@ Methods, from the same seeded starts (:func:`symid.compare`; state-space models 
 zero start first, as thesis ch. 3):
 
 - ``scr``: default options (ADMM back end, presolve, tol 1e-6, unit weights);
-- ``scr+polish``: SCR handing over to IPOPT (:meth:`symid.formulations.frf_scr.ScrFRF.run_polished`):
+- ``scr+polish``: SCR handing over to IPOPT (:meth:`symid.fit.frf.scr.ScrFRF.run_polished`):
   after SCR iterations 1, 2, 4, … a trial IPOPT run from the current SCR estimate, and the
   start ends as soon as one fits the data (relative misfit ≤ 1e-8); else the final SCR
   estimate is polished. Built and run on its own (nothing shared with the ``scr`` row);
@@ -80,7 +80,7 @@ def belt_drive_from_zeros() -> dict:
 IPOPT_VARIANTS = {  # the default first; the others show it is IPOPT's best configuration here
     "default (exact Hessian, bounds, scale 1)": {},
     "L-BFGS Hessian": {"hessian": "limited-memory"},
-    "no bounds": {"bounds": False},
+    "no bounds": {"positivity": False},
     "scale 0.5": {"scale": 0.5},
     "scale 2": {"scale": 2.0},
     "tol 1e-8": {"tol": 1e-8},

@@ -4,14 +4,14 @@ Problem: the zoo's ``msd3_psd``, thesis (5-9)/(5-10): 3-DOF mass-spring-damper, 
 force, all positions measured, 170 log-spaced frequencies in 0.1–100 rad/s, pink input
 Φuu = ω^−0.5 (5-11), full symmetric M, V, K (18 parameters), exact spectra.
 
-Variants, each from its own seeded starts (``symid.starts.make_starts``, seed ``--seed``;
+Variants, each from its own seeded starts (``symid.fit.starts.make_starts``, seed ``--seed``;
 for SCR the start θ₀ only seeds the §5-6 draws Yᵢ = ±ZᵢZᵢᵀ, Zᵢ with N(0, 10²) entries):
 
 - ``scr-cvxpy``: Algorithm 5.1 with M, V, K ⪰ 0, Clarabel sub-problems (the default);
 - ``scr-admm``: the same on the ADMM back end with its default options (40 SCR
   iterations; with 20× longer inner caps a start did not finish in 6 minutes);
 - ``scr-printed-sign``: Yᵢ = +ZᵢZᵢᵀ as printed in §5-6 (symid defaults to −ZᵢZᵢᵀ, see
-  :mod:`symid.formulations.psd_scr`);
+  :mod:`symid.fit.spectra.scr`);
 - ``scr-no-lmi``: Algorithm 5.1 without the LMIs and bounds (§5-7: "no success");
 - ``ipopt``: CasADi/IPOPT on (5-13) from N(0, 1) starts (absolute values for the
   diagonal, which is declared positive) (§5-7: ``fmincon`` found the optimum 0 times);
@@ -47,17 +47,17 @@ from pathlib import Path
 import numpy as np
 
 import symid as si
-from symid.formulations.psd_scr import ScrPSD
-from symid.nlls.psd import IpoptPSD
+from symid.fit.spectra.ipopt import IpoptPSD
+from symid.fit.spectra.scr import ScrPSD
+from symid.fit.starts import make_starts
 from symid.progress import progress_bar
-from symid.starts import make_starts
 
 SUCCESS = 1e-4  # largest entry error of M, V, K (issue 6)
 VARIANTS = {
     "scr-cvxpy": ("scr", {"backend": "cvxpy"}),
     "scr-admm": ("scr", {"backend": "admm"}),
-    "scr-printed-sign": ("scr", {"backend": "cvxpy", "init_sign": 1}),
-    "scr-no-lmi": ("scr", {"backend": "cvxpy", "lmis": False, "bounds": False}),
+    "scr-printed-sign": ("scr", {"backend": "cvxpy", "aux_sign": 1}),
+    "scr-no-lmi": ("scr", {"backend": "cvxpy", "lmis": False, "positivity": False}),
     "ipopt": ("ipopt", {}),
     "ipopt-weighted": ("ipopt", {"weighting": "frequency"}),
     "ipopt-equation": ("ipopt", {"objective": "equation", "weighting": "frequency"}),
@@ -85,7 +85,7 @@ def run_variant(name: str, starts: int, seed: int) -> dict:
         err = float(np.max(np.abs(out.theta - truth))) if np.all(np.isfinite(out.theta)) else float("inf")
         rows.append({"start": x0.tolist(), "theta": out.theta.tolist(), "max_entry_error": err,
                      "misfit": float(out.cost), "iterations": int(out.iterations), "wall_time": float(out.wall_time),
-                     "converged": bool(out.converged), "message": out.message})
+                     "success": bool(out.success), "status": out.status, "message": out.message})
     n_ok = sum(r["max_entry_error"] <= SUCCESS for r in rows)
     total = setup + sum(r["wall_time"] for r in rows)
     return {"variant": name, "method": kind, "options": {k: repr(v) for k, v in opts.items()},

@@ -13,7 +13,7 @@ least twice as good at 10.
 ``prior`` — §6-7-2, Figure 6-4 (prior knowledge). The driver belt (6-37), truth all −10
 (6-38), black box the zoo's (a seeded similarity transform; the system is unstable).
 Starts θ₀ = θ* + ε, ε ~ N(0, σ² I), σ² ∈ {0.01, 0.1, 1, 10, 100} (6-34)–(6-36), 10 runs
-per σ², T₀ from θ₀ by least squares (C-7) (``init="theta"``). Recorded: ‖θ₀ − θ*‖ and
+per σ², T₀ from θ₀ by least squares (C-7) (``aux_init="model"``). Recorded: ‖θ₀ − θ*‖ and
 ‖θ − θ*‖ per run and method.
 
 Method settings: SCR with symid's defaults (λ = 1, nuclear norm, ADMM, 1000 iterations;
@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 import symid as si
-from symid.identification import prepare
+from symid.fit.registry import prepare
 from symid.progress import progress_bar
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -123,7 +123,7 @@ def prior_study(runs: int, fresh: bool) -> list[dict]:
         x0 = tv + np.sqrt(SIGMA2[i]) * np.random.default_rng([638, i, r]).standard_normal(tv.size)
         rec = {"key": [i, r, method], "sigma2": SIGMA2[i], "run": r, "method": method,
                "initial_error": float(np.linalg.norm(x0 - tv)),
-               **_one(model, data, method, {"init": "theta", "allow_unstable": True}, x0, tv)}
+               **_one(model, data, method, {"aux_init": "model", "allow_unstable": True}, x0, tv)}
         rec["final_error"] = rec["nee"] * float(np.linalg.norm(tv))
         _append(path, rec)
         done[(i, r, method)] = rec

@@ -5,8 +5,8 @@ Sections (``--only`` picks one):
 ``enose``
     Model (6-19), truth (6-16), black box: the zoo's exact similarity transform of the
     truth closest to the printed N4SID + d2c estimate (6-18). SCR, ALS, GB and IPOPT
-    from the same 10 seeded random starts (random T, S; :mod:`symid.formulations.
-    similarity_start`); success = ‖θ − θ*‖/‖θ*‖ ≤ 1e-3. Thesis §6-6-2: SCR "roughly 3
+    from the same 10 seeded random starts (random T, S; :mod:`symid.fit.
+    similarity.start`); success = ‖θ − θ*‖/‖θ*‖ ≤ 1e-3. Thesis §6-6-2: SCR "roughly 3
     out of every 10". Also SCR on the printed (6-18) itself, which is a noisy estimate
     (DC gain 0.1526 against 0.15), so no exact solution exists: its best parameter error.
 ``enose_over``
@@ -37,12 +37,12 @@ from pathlib import Path
 import numpy as np
 
 import symid as si
-from symid.formulations.similarity_data import similarity_data
-from symid.formulations.similarity_scr import ScrSimilarity
-from symid.identification import prepare
-from symid.misfit import relative_parameter_error
+from symid.fit.compare import relative_parameter_error
+from symid.fit.registry import prepare
+from symid.fit.similarity.data import similarity_data
+from symid.fit.similarity.scr import ScrSimilarity
+from symid.fit.starts import make_starts
 from symid.progress import progress_bar
-from symid.starts import make_starts
 
 RESULTS = Path(__file__).resolve().parent / "results" / "similarity_thesis.json"
 SUCCESS = 1e-3  # thesis (6-32)/(6-33)
@@ -64,7 +64,7 @@ def enose(starts: int = 10, seed: int = 0) -> dict:
                                     "times": [o.wall_time for o in s.result.starts],
                                     "median_time": s.median_time, "options": s.result.options}
     # thesis §6-6-2: "S, T initialized as zero matrices ... the method fails"
-    zero = prepare(entry.model, entry.data(), "scr", {"init": "zero", **SCR_OPTIONS}).run(
+    zero = prepare(entry.model, entry.data(), "scr", {"aux_init": "zero", **SCR_OPTIONS}).run(
         np.zeros(entry.model.n_parameters))
     zero_err = relative_parameter_error(zero.theta, truth)
     print(f"SCR from T = S = 0: parameter error {zero_err:.3e} after {zero.iterations} iterations")

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 import symid as si
-from symid.misfit import relative_parameter_error
+from symid.fit.compare import relative_parameter_error
 
 
 def main() -> None:

@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 import symid as si
-from symid.formulations.frf_scr import ScrFRF
+from symid.fit.frf.scr import ScrFRF
 
 
 def first_below(errors: list[float], level: float) -> str:
@@ -51,7 +51,7 @@ def main(quick: bool = False) -> None:
     if not quick:
         cases += [("cvxpy", "gamma", None, 500), ("cvxpy", "both", None, 300)]
     for backend, sub, weights, iters in cases:
-        solver = ScrFRF(model, data, backend=backend, substitution=sub, presolve=False, gamma0="zero",
+        solver = ScrFRF(model, data, backend=backend, substitution=sub, presolve=False, aux_init="zero",
                         max_iter=iters, tol=1e-10, weights=weights)
         label = sub if weights is None else f"{sub}, δ = ρ = 0.01"
         t0 = time.perf_counter()

@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import symid as si
-from symid.misfit import relative_parameter_error
+from symid.fit.compare import relative_parameter_error
 
 
 def run(model, data, starts, truth):

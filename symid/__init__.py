@@ -20,16 +20,16 @@ from symid.errors import (
     SolverError,
     SymidError,
 )
+from symid.fit.result import IdentificationResult, StartOutcome
 from symid.parametric import StateSpaceMatrices
-from symid.result import IdentificationResult, StartOutcome
 from symid.secondorder import SecondOrderModel
 from symid.statespace import StateSpaceModel
 from symid.symbols import parameters
 from symid.zoo import ZooEntry, list_models, load_model
 
 if TYPE_CHECKING:
-    from symid.comparison import Comparison, MethodStats, compare
-    from symid.identification import identify
+    from symid.fit.compare import Comparison, MethodStats, compare
+    from symid.fit.identify import identify
     from symid.simulate import simulate_frf, simulate_io, simulate_spectra
     from symid.spectra import estimate_spectra
     from symid.structural import IdentifiabilityReport, identifiability
@@ -39,12 +39,12 @@ if TYPE_CHECKING:
 __version__ = "0.1.0"
 
 _LAZY = {
-    "Comparison": "symid.comparison",
-    "MethodStats": "symid.comparison",
-    "compare": "symid.comparison",
+    "Comparison": "symid.fit.compare",
+    "MethodStats": "symid.fit.compare",
+    "compare": "symid.fit.compare",
     "d2c": "symid.zoh",
     "n4sid": "symid.subspace",
-    "identify": "symid.identification",
+    "identify": "symid.fit.identify",
     "simulate_frf": "symid.simulate",
     "simulate_io": "symid.simulate",
     "simulate_spectra": "symid.simulate",

@@ -10,6 +10,7 @@ import traceback
 from collections.abc import Sequence
 
 from symid.errors import SymidError
+from symid.fit.registry import all_methods
 from symid.interrupt import Interrupted
 
 __all__ = ["build_parser", "main"]
@@ -139,7 +140,7 @@ def _method_options(args: argparse.Namespace) -> dict:
 
 
 def _cmd_identify(args: argparse.Namespace) -> int:
-    from symid.identification import identify
+    from symid.fit.identify import identify
 
     out = _output_dir(args.out, "identify")
     entry, data, source = _entry_and_data(args.model, args.data)
@@ -177,7 +178,7 @@ def _write_identify(out, entry, data, res, truth) -> None:
             curves["after polish"] = (entry.model, res.polished.theta_vector)
         written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate"))
     best = res.best_start
-    if best.history and "families" in best.history[0]:  # SCR: thesis Figure 3-2 for the reported start
+    if best.history and best.history[0].families:  # SCR: thesis Figure 3-2 for the reported start
         written.append(start_convergence_plot(
             best, out / "convergence.png", truth=None if truth is None else entry.model.theta_vector(truth),
             title=f"{entry.name}: SCR convergence of the reported start"))
@@ -185,7 +186,7 @@ def _write_identify(out, entry, data, res, truth) -> None:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from symid.comparison import compare
+    from symid.fit.compare import compare
 
     out = _output_dir(args.out, "compare")
     entry, data, source = _entry_and_data(args.model, args.data)
@@ -254,7 +255,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "(CSV or NPZ written by symid); without --data, from the zoo's own recipe.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     p.add_argument("--data", metavar="FILE", help="data file (CSV or NPZ); default: simulate the zoo recipe")
-    p.add_argument("--method", choices=("scr", "ipopt", "ls", "als", "gb"), default="scr",
+    p.add_argument("--method", choices=all_methods(), default="scr",
                    help="estimator (default: scr); als and gb (alternating least squares, gradient-based BFGS, "
                         "thesis appendix C) take black-box or I/O data")
     p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=1, metavar="N",

@@ -33,8 +33,8 @@ def run_demo(out: str | Path = "symid-demo", *, starts: int = 20, seed: int = 0,
     int
         0 when SCR recovered the truth to 1e-6, 1 otherwise (the exit code of the command).
     """
-    from symid.comparison import compare
-    from symid.formulations.frf_scr import ScrFRF
+    from symid.fit.compare import compare
+    from symid.fit.frf.scr import ScrFRF
     from symid.plots import bode_plot, convergence_plot
     from symid.structural import identifiability
     from symid.zoo import load_model
@@ -70,7 +70,7 @@ def run_demo(out: str | Path = "symid-demo", *, starts: int = 20, seed: int = 0,
                      title="Belt drive (3-17): 10 FRF samples around the resonance")
     # Figure 3-2 of the thesis: SCR on (3-15) as posed there, every equation relaxed (no
     # presolve), all matrices initialised at zero; with presolve symid solves it in one step.
-    raw = ScrFRF(model, data, presolve=False, gamma0="zero", max_iter=convergence_iterations, tol=1e-12)
+    raw = ScrFRF(model, data, presolve=False, aux_init="zero", max_iter=convergence_iterations, tol=1e-12)
     sol = raw.solve(np.zeros(model.n_parameters))
     errors = [float(np.linalg.norm(np.asarray(it["theta"]) - truth_vec)) for it in sol.iterates]
     conv = convergence_plot(raw.family_residuals(sol), out / "convergence.png", error=errors,

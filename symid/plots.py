@@ -177,12 +177,12 @@ def start_convergence_plot(outcome: Any, path: str | Path, *, truth: Any = None,
     True
     """
     hist = outcome.history
-    if not hist or "families" not in hist[0]:
-        raise ValueError("this start has no per-family history (only SCR runs keep one)")
-    groups = {f: [h["families"][f] for h in hist] for f in hist[0]["families"]}
+    if not hist or not hist[0].families:
+        raise ValueError("this start has no per-family history (only SCR runs on a frequency response keep one)")
+    groups = {f: [h.families[f] for h in hist] for f in hist[0].families}
     error = None
     if truth is not None:
         t = np.asarray(truth, dtype=float)
-        error = [float(np.linalg.norm(np.asarray(h["theta"]) - t)) for h in hist]
+        error = [float(np.linalg.norm(np.asarray(h.theta) - t)) for h in hist]
     return convergence_plot(groups, path, error=error, error_label="‖θ_k − θ*‖₂",
                             title=title or f"SCR convergence from θ0 = {np.array2string(outcome.start, precision=2)}")

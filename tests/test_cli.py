@@ -235,7 +235,7 @@ def test_internal_error_is_one_line_and_status_3(monkeypatch, capsys):
 
 
 def test_interrupted_identify_writes_the_finished_starts(tmp_path, monkeypatch, capsys):
-    from symid.nlls import frf as nlls_frf
+    from symid.fit.frf import ipopt as nlls_frf
 
     real = nlls_frf.IpoptFRF.run
     calls = {"n": 0}

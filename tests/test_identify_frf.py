@@ -160,7 +160,7 @@ def test_truss_by_least_squares():
 def test_scr_2dof_runs_formulation_4_8_with_lmis(output):
     """Thesis §4-6-2, (4-8)/(4-9): B, C not square, so SCR (not LS) runs, with M, V, K ⪰ 0 as LMIs; from a
     seeded N(0, 1) start it recovers (4-20) for position and acceleration output alike."""
-    from symid.formulations.frf_scr import ScrFRF
+    from symid.fit.frf.scr import ScrFRF
 
     model = two_dof(output)
     frf = si.simulate_frf(model, TRUTH_2DOF, W_2DOF)
@@ -192,7 +192,7 @@ def test_scr_substitutions_with_parameterised_B_and_C(substitution):
 
 def test_scr_weights_per_frequency_and_per_family():
     """Algorithm 3.1's λᵢ, γᵢ, δᵢ, ρᵢ: a vector weighs every family at a frequency, a dict weighs families."""
-    from symid.formulations.frf_scr import ScrFRF
+    from symid.fit.frf.scr import ScrFRF
 
     model = _lead_lag()
     truth = np.array([-2.0, -0.4, 1.5, 0.5])  # chosen here: stable, lightly damped, identifiable
@@ -204,10 +204,10 @@ def test_scr_weights_per_frequency_and_per_family():
     assert weights["psi_dynamics[11]"] == pytest.approx(2.0, rel=1e-12)
     res = si.identify(model, frf, method="scr", x0=truth + 0.1, weights=lam, identifiability_check=False)
     np.testing.assert_allclose(res.theta_vector, truth, rtol=1e-5, atol=1e-6)
-    with pytest.raises(si.ModelError, match="unknown constraint family psi_output; this formulation has "
+    with pytest.raises(si.OptionError, match="unknown constraint family psi_output; this formulation has "
                                             "gamma_dynamics, gamma_output"):
         ScrFRF(model, frf, weights={"psi_output": 2.0})
-    with pytest.raises(si.ModelError, match="12 positive finite numbers"):
+    with pytest.raises(si.OptionError, match="12 positive finite numbers"):
         ScrFRF(model, frf, weights=np.ones(5))
 
 
@@ -238,14 +238,14 @@ def test_compare_reports_scr_and_scr_plus_polish_from_the_same_starts():
         assert "ipopt" not in a.message  # SCR alone: no polish mixed in
     assert pol.best_error < 1e-8 < scr.best_error
     assert "scr+polish" in cmp.table()
-    with pytest.raises(si.ModelError, match="only 'scr\\+polish' is polished"):
+    with pytest.raises(si.OptionError, match="method 'ipopt' has no polish step"):
         si.compare(model, frf, methods=("ipopt+polish",), starts=1)
 
 
 def test_run_polished_hands_over_only_when_the_trial_fits():
-    from symid.formulations.frf_scr import ScrFRF
-    from symid.nlls.frf import IpoptFRF
-    from symid.starts import make_starts
+    from symid.fit.frf.ipopt import IpoptFRF
+    from symid.fit.frf.scr import ScrFRF
+    from symid.fit.starts import make_starts
 
     model = two_dof()
     frf = si.simulate_frf(model, TRUTH_2DOF, W_2DOF)
@@ -255,12 +255,12 @@ def test_run_polished_hands_over_only_when_the_trial_fits():
     # a trial after SCR iteration 1, 2, 4, … reached misfit ≤ 1e-8: SCR stopped there (powers of two only)
     k = int(early.message.split("after ")[1].split(" iteration")[0])
     assert "handed over to ipopt" in early.message and k & (k - 1) == 0
-    assert early.converged and early.cost <= 1e-8 and len(early.history) == k
+    assert early.success and early.cost <= 1e-8 and len(early.history) == k
     np.testing.assert_allclose(early.theta, truth, rtol=1e-6)
     # no trials: SCR runs to its own end, then its final estimate is polished
     late = ScrFRF(model, frf, polish_misfit=None, max_iter=8).run_polished(x0, IpoptFRF(model, frf))
     assert "handed over" not in late.message and len(late.history) == 8
-    with pytest.raises(si.ModelError, match="polish_misfit must be a positive number or None"):
+    with pytest.raises(si.OptionError, match="polish_misfit must be a finite number > 0"):
         ScrFRF(model, frf, polish_misfit=0.0)
 
 
@@ -293,7 +293,7 @@ def test_unknown_method_and_bad_starts():
     frf = si.simulate_frf(model, BELT_TRUTH, W_BELT)
     with pytest.raises(si.ModelError, match="unknown method 'pem'"):
         si.identify(model, frf, method="pem")
-    with pytest.raises(si.ModelError, match="starts must be a positive integer"):
+    with pytest.raises(si.OptionError, match="starts must be an integer between 1 and 100000; got 0"):
         si.identify(model, frf, method="ipopt", starts=0)
 
 
@@ -322,8 +322,8 @@ def test_solver_failure_is_a_result_not_a_traceback():
     res = si.identify(model, frf, method="scr", seed=1, max_iter=2)
     assert not res.success and "maximum number of iterations (2) reached" in res.message
     res = si.identify(model, frf, method="ipopt", seed=1, max_iter=1)
-    assert not res.success and res.message == "Maximum_Iterations_Exceeded"
-    with pytest.raises(si.ModelError, match="backend must be 'admm' or 'cvxpy'"):
+    assert not res.success and res.status == "Maximum_Iterations_Exceeded"
+    with pytest.raises(si.OptionError, match="backend must be one of 'admm', 'cvxpy'; got 'mosek'"):
         si.identify(model, frf, method="scr", backend="mosek")
 
 

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import symid as si
-from symid.formulations.psd_data import spectral_equations, spectral_misfit
-from symid.formulations.psd_scr import ScrPSD
-from symid.nlls.psd import IpoptPSD
-from symid.starts import make_starts
+from symid.fit.spectra.equations import spectral_equations, spectral_misfit
+from symid.fit.spectra.ipopt import IpoptPSD
+from symid.fit.spectra.scr import ScrPSD
+from symid.fit.starts import make_starts
 
 TRUTH_2DOF = {"m1": 1, "m2": 1, "c1": 0.1, "c2": 0.3, "k1": 2, "k2": 1}  # thesis (4-20)
 W_2DOF = np.logspace(np.log10(0.3), np.log10(3), 12)  # rad/s, around both resonances (0.62, 1.62 rad/s)
@@ -68,8 +68,8 @@ def test_bad_spectral_input_is_refused(spec):
         si.identify(two_dof(), few, method="ipopt")
     with pytest.raises(si.ModelError, match="no linear least-squares special case"):
         si.identify(two_dof(), spec, method="ls")
-    with pytest.raises(si.ModelError, match="init_sign must be -1 or 1"):
-        ScrPSD(two_dof(), spec, init_sign=0)
+    with pytest.raises(si.OptionError, match="aux_sign must be -1 or 1"):
+        ScrPSD(two_dof(), spec, aux_sign=0)
 
 
 # -- Algorithm 5.1 -------------------------------------------------------------------------
@@ -80,15 +80,15 @@ def test_scr_recovers_2dof_from_spectra(spec, backend):
     assert res.method == "scr" and res.success, res.message
     # exact spectra of thesis (4-20): the truth to the solver's accuracy
     np.testing.assert_allclose(res.theta_vector, two_dof().theta_vector(TRUTH_2DOF), rtol=1e-6, atol=1e-7)
-    assert all(o.converged for o in res.starts)
+    assert all(o.success for o in res.starts)
     assert res.cost < 1e-12
 
 
 def test_rank_compression_changes_no_iterate(spec):
     """Pᵢ has rank 1 (one input): the compressed sub-problem is the same problem (module notes)."""
     x0 = make_starts(two_dof(), 1, 3)[0]
-    sa = ScrPSD(two_dof(), spec, max_iter=3, rank_tol=1e-10, init="model")
-    sb = ScrPSD(two_dof(), spec, max_iter=3, rank_tol=0.0, init="model")
+    sa = ScrPSD(two_dof(), spec, max_iter=3, rank_tol=1e-10, aux_init="model")
+    sb = ScrPSD(two_dof(), spec, max_iter=3, rank_tol=0.0, aux_init="model")
     assert {S.shape for S in sa._S} == {(1, 1)} and (2, 2) in {S.shape for S in sb._S}  # Pᵢ: rank 1 of 2
     a, b = sa.solve(x0)[1], sb.solve(x0)[1]
     # same optimal values of the sub-problems and same iterates, to Clarabel's accuracy
@@ -105,7 +105,7 @@ def test_random_start_step_equals_a_start_at_Q_equal_Y(spec, monkeypatch):
     solver = ScrPSD(model, spec, max_iter=1)
     monkeypatch.setattr(solver, "initial_Y", lambda x0: -solver.eq.X(theta_a))
     first, _ = solver.solve(make_starts(model, 1, 1)[0])
-    direct = ScrPSD(model, spec, max_iter=1, init="model").solve(theta_a)[1]
+    direct = ScrPSD(model, spec, max_iter=1, aux_init="model").solve(theta_a)[1]
     assert abs(first.iterates[0]["t"]) < 1e-8
     np.testing.assert_allclose(first.iterates[0]["theta"], direct.iterates[0]["theta"], rtol=1e-5, atol=1e-6)
 
@@ -114,14 +114,14 @@ def test_random_start_is_seeded_and_negative_definite(spec):
     solver = ScrPSD(two_dof(), spec)
     x0 = make_starts(two_dof(), 1, 1)[0]
     Y = solver.initial_Y(x0)
-    assert np.all(np.linalg.eigvalsh(Y) < 0)  # init_sign = -1 (module notes)
+    assert np.all(np.linalg.eigvalsh(Y) < 0)  # aux_sign = -1 (module notes)
     np.testing.assert_array_equal(Y, solver.initial_Y(x0.copy()))
     assert not np.allclose(Y, solver.initial_Y(x0 + 1e-3))
 
 
 def test_without_lmis_the_constraints_are_gone(spec):
     with_lmis = ScrPSD(two_dof(), spec)
-    without = ScrPSD(two_dof(), spec, lmis=False, bounds=False)
+    without = ScrPSD(two_dof(), spec, lmis=False, positivity=False)
     assert len(with_lmis.problem.lmis) == 3 + 6 and len(without.problem.lmis) == 0  # M, V, K ⪰ 0 and θ ≥ 0
 
 
@@ -132,7 +132,7 @@ def test_without_lmis_the_constraints_are_gone(spec):
 def test_ipopt_recovers_2dof_from_a_near_start(spec, objective, weighting):
     start = two_dof().theta_vector(TRUTH_2DOF) * 1.2
     out = IpoptPSD(two_dof(), spec, objective=objective, weighting=weighting).run(start)
-    assert out.converged, out.message
+    assert out.success, out.message
     np.testing.assert_allclose(out.theta, two_dof().theta_vector(TRUTH_2DOF), rtol=1e-6, atol=1e-8)
 
 

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 import symid as si
-from symid.comparison import compare
 from symid.errors import DataError
+from symid.fit.compare import compare
+from symid.fit.result import StartOutcome
 from symid.interrupt import Interrupted, interrupt_pending, native_interrupts
-from symid.result import StartOutcome
 from symid.runlog import RunLog, json_safe, write_atomic, write_json_atomic
 
 
@@ -144,7 +144,7 @@ def _chain_model():
 def test_compare_interrupted_keeps_partial_and_resumes_from_its_log(tmp_path, monkeypatch):
     model, truth, frf = _chain_model()
     full = compare(model, frf, methods=("ipopt",), starts=5, seed=3, truth=truth, progress=False)
-    from symid import comparison
+    from symid.fit import compare as comparison
 
     real_prepare = comparison.prepare
     calls = {"n": 0}
@@ -184,7 +184,7 @@ def test_compare_interrupted_keeps_partial_and_resumes_from_its_log(tmp_path, mo
 
 def test_identify_interrupted_before_any_start_is_a_plain_keyboardinterrupt(monkeypatch):
     model, _, frf = _chain_model()
-    from symid.nlls import frf as nlls_frf
+    from symid.fit.frf import ipopt as nlls_frf
 
     def boom(self, x0):
         raise KeyboardInterrupt
@@ -229,8 +229,9 @@ def test_atomic_write_leaves_the_old_file_on_interruption(tmp_path):
 
 
 def test_start_outcome_round_trips_through_its_dict():
-    out = StartOutcome(start=np.array([1.0, 2.0]), theta=np.array([1.5, 2.5]), cost=float("inf"), converged=False,
-                       iterations=7, wall_time=0.25, message="x")
+    out = StartOutcome(start=np.array([1.0, 2.0]), theta=np.array([1.5, 2.5]), cost=float("inf"), success=False,
+                       finished=False, status="max_iter", iterations=7, wall_time=0.25, message="x", fit="y")
     back = StartOutcome.from_dict(json.loads(json.dumps(json_safe(out.to_dict()))))
     np.testing.assert_array_equal(back.theta, out.theta)
-    assert back.cost == float("inf") and back.iterations == 7 and back.message == "x"
+    assert back.cost == float("inf") and back.iterations == 7 and back.message == "x" and back.fit == "y"
+    assert back.status == "max_iter" and not back.success and not back.finished

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import symid as si
-from symid.formulations.psd_scr import ScrPSD
-from symid.starts import make_starts
+from symid.fit.spectra.scr import ScrPSD
+from symid.fit.starts import make_starts
 
 pytestmark = pytest.mark.slow
 

@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 
 import symid as si
-from symid.baselines import SimilarityMisfit
-from symid.formulations.similarity_data import similarity_data
-from symid.formulations.similarity_start import initial_point, least_squares_theta, least_squares_transform
-from symid.identification import prepare
-from symid.misfit import relative_parameter_error
-from symid.starts import make_starts
+from symid.fit.compare import relative_parameter_error
+from symid.fit.registry import prepare
+from symid.fit.similarity.data import similarity_data
+from symid.fit.similarity.objective import SimilarityMisfit
+from symid.fit.similarity.start import initial_point, least_squares_theta, least_squares_transform
+from symid.fit.starts import make_starts
 
 T_SMALL = np.array([[1.0, 0.4], [-0.3, 0.8]])  # an arbitrary invertible basis change
 
@@ -88,7 +88,7 @@ def test_every_method_recovers_the_small_model(method):
     model, truth = small_model()
     bb = transformed(model, truth, T_SMALL)
     # SCR: from seed 0's four starts, three converge in ≤ 14 iterations (the zero start does not)
-    opts = {"backend": "cvxpy", "weight": 1.0, "max_iter": 40} if method == "scr" else {}
+    opts = {"backend": "cvxpy", "weights": 1.0, "max_iter": 40} if method == "scr" else {}
     res = si.identify(model, bb, method=method, starts=4, seed=0, **opts)
     assert res.method == method
     # ALS stops on a relative step of 1e-6 (thesis (6-31)) while still creeping: 6e-6 measured
@@ -100,7 +100,7 @@ def test_every_method_recovers_the_small_model(method):
 def test_scr_returns_an_invertible_transform():
     model, truth = small_model()
     bb = transformed(model, truth, T_SMALL)
-    solver = prepare(model, bb, "scr", {"backend": "cvxpy", "weight": 1.0, "max_iter": 40})
+    solver = prepare(model, bb, "scr", {"backend": "cvxpy", "weights": 1.0, "max_iter": 40})
     sol = solver.solve(make_starts(model, 4, 0)[1])  # a start that converges (see above)
     T, S = solver.transform(sol, original=True)  # the black box as given, not its balanced form
     np.testing.assert_allclose(T @ S, np.eye(2), atol=1e-7)
@@ -111,7 +111,7 @@ def test_compare_runs_the_four_methods_from_identical_starts():
     model, truth = small_model()
     bb = transformed(model, truth, T_SMALL)
     cmp = si.compare(model, bb, methods=("scr", "als", "gb", "ipopt"), starts=4, seed=0, truth=truth,
-                     options={"scr": {"backend": "cvxpy", "weight": 1.0, "max_iter": 40}})
+                     options={"scr": {"backend": "cvxpy", "weights": 1.0, "max_iter": 40}})
     starts = [np.array([o.start for o in s.result.starts]) for s in cmp.stats]
     for s in starts[1:]:
         np.testing.assert_array_equal(s, starts[0])
@@ -122,7 +122,7 @@ def test_compare_runs_the_four_methods_from_identical_starts():
 def test_polish_uses_the_similarity_ipopt():
     model, truth = small_model()
     bb = transformed(model, truth, T_SMALL)
-    res = si.identify(model, bb, method="scr", starts=1, backend="cvxpy", weight=1.0, max_iter=3, polish=True)
+    res = si.identify(model, bb, method="scr", starts=1, backend="cvxpy", weights=1.0, max_iter=3, polish=True)
     assert res.polished is not None
     assert relative_parameter_error(res.polished.theta_vector, model.theta_vector(truth)) < 1e-8
 
@@ -178,7 +178,7 @@ def test_second_order_general_case_scr_from_a_near_start():
     """(7-10) on the 2-DOF system with one actuator and one sensor (no linear special case)."""
     model = two_dof([[1], [0]], [[0, 1]])
     bb = transformed(model, TRUTH_2DOF, np.random.default_rng(4).standard_normal((4, 4)))
-    solver = prepare(model, bb, "scr", {"backend": "cvxpy", "max_iter": 3, "init": "identity"})
+    solver = prepare(model, bb, "scr", {"backend": "cvxpy", "max_iter": 3, "aux_init": "identity"})
     assert solver.problem.n == len(TRUTH_2DOF) + 2 + 2 * 16  # θ, diagonal M⁻¹(τ), T, S
     assert solver.minv_basis.shape == (2, 2, 2)  # M diagonal ⇒ M⁻¹(τ) diagonal (§7-5-1)
     out = solver.run(model.theta_vector(TRUTH_2DOF))
@@ -241,12 +241,14 @@ def test_missing_sample_time():
 def test_data_options_and_methods_are_checked():
     model, truth = small_model()
     bb = transformed(model, truth, T_SMALL)
-    with pytest.raises(si.ModelError, match="horizon is an N4SID option"):
+    with pytest.raises(si.OptionError, match="horizon is an N4SID option"):
         si.identify(model, bb, method="scr", horizon=5)
     with pytest.raises(si.ModelError, match="unknown method 'newton'"):
         si.identify(model, bb, method="newton")
-    with pytest.raises(si.ModelError, match="init must be one of"):
-        si.identify(model, bb, method="gb", init="ones")
+    with pytest.raises(si.OptionError, match="aux_init must be one of"):
+        si.identify(model, bb, method="gb", aux_init="ones")
+    with pytest.raises(si.OptionError, match="no option 'init' \\(did you mean 'aux_init'\\?\\)"):
+        si.identify(model, bb, method="gb", init="random")
     with pytest.raises(si.ModelError, match=r"'ls'.*is for SecondOrderModel"):
         si.identify(model, bb, method="ls")
 

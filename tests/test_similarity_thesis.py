@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 import symid as si
-from symid.formulations.similarity_data import similarity_data
-from symid.formulations.similarity_scr import ScrSimilarity
-from symid.identification import prepare
-from symid.misfit import relative_parameter_error
-from symid.starts import make_starts
+from symid.fit.compare import relative_parameter_error
+from symid.fit.registry import prepare
+from symid.fit.similarity.data import similarity_data
+from symid.fit.similarity.scr import ScrSimilarity
+from symid.fit.starts import make_starts
 
 pytestmark = pytest.mark.slow
 
@@ -34,7 +34,7 @@ def test_enose_zero_start_converges_unlike_the_thesis():
     """Thesis §6-6-2: S, T "initialized as zero matrices ... the method fails". Here it converges (723
     iterations measured): the balanced basis, the scaling α and the implied equalities change the path."""
     entry = si.load_model("enose")
-    solver = prepare(entry.model, entry.data(), "scr", {"init": "zero", "max_iter": 2000})
+    solver = prepare(entry.model, entry.data(), "scr", {"aux_init": "zero", "max_iter": 2000})
     out = solver.run(np.zeros(6))
     assert relative_parameter_error(out.theta, entry.model.theta_vector(entry.truth)) < 1e-3
 

@@ -210,6 +210,7 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
     xs: list[np.ndarray] = []
     status, message = "max_iter", ""
     last_res = np.inf
+    stol = np.inf
     n_iter = max_iter if groups else 1
     for k in range(n_iter):
         t_it, c_it = time.perf_counter(), time.process_time()
@@ -263,6 +264,8 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
         info["rho_final"] = be.rho
     x_final = red.lift(z)
     iterates = tuple(lay.unpack(xk) for xk in xs)
+    # stationary: the last step met the step rule (converged, or stuck at a residual it cannot reduce)
+    info["stationary"] = bool(history) and status in ("converged", "max_iter") and history[-1].step <= stol
     if status == "converged":
         message = ("solved exactly: no bilinear term left after presolve" if not groups else
                    f"bilinear residual {history[-1].residual:.3e} ≤ tol = {tol:g} after {len(history)} iterations")

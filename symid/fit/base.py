@@ -1,0 +1,267 @@
+"""The estimator interface every method implements, and the parts SCR estimators share.
+
+An :class:`Estimator` is one method on one model and data set. It is built once —
+every option is validated then, so nothing bad starts running — and run once per
+start: ``run(x0) -> StartOutcome``. Each data kind (:mod:`symid.fit.frf`,
+:mod:`symid.fit.spectra`, :mod:`symid.fit.similarity`) supplies the data misfit
+(``misfit``, ``residuals``, ``n_data``) in a small base class of its own; each method
+supplies ``run``. What a method may be refined by is declared (:meth:`Estimator.polisher`),
+never probed for.
+
+Naming rules followed by every estimator's options (one vocabulary across data kinds):
+
+=================  ===========================================================================
+``positivity``     keep the parameters declared ``positive=True`` ≥ 0 (default True)
+``max_iter``       the solver's iteration limit
+``tol``            the solver's stopping tolerance
+``seed``           seed of the random starts of auxiliary unknowns (Γ, T, S, Y …)
+``aux_init``       how the auxiliary unknowns start: ``"random"``, ``"model"`` (computed from
+                   the model at the start θ), ``"zero"``, ``"identity"`` (where they apply)
+``weights``        SCR: weights of the nuclear-norm relaxations (λ of the thesis)
+``backend``        SCR: ``"admm"`` or ``"cvxpy"`` (Clarabel)
+``scale``          IPOPT: typical magnitude of each parameter
+=================  ===========================================================================
+"""
+
+from __future__ import annotations
+
+import abc
+import inspect
+import time
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from symid.errors import OptionError
+from symid.fit.options import check_bool, check_choice, check_float, check_int, check_known_names
+from symid.fit.result import ScrIteration, StartOutcome
+from symid.fit.success import fit_test
+
+__all__ = [
+    "Estimator",
+    "ScrEstimator",
+    "identity_coef",
+    "mvk_lmis",
+    "positivity_lmis",
+    "symmetric_map",
+    "theta_coef",
+]
+
+
+class Estimator(abc.ABC):
+    """One estimation method for one model and data set: built once, run per start.
+
+    Subclasses set ``method`` and implement :meth:`run`; a data kind's base class
+    implements :meth:`misfit`, :meth:`residuals`, :meth:`n_data` and sets ``cost_kind``.
+    Options are keyword-only arguments of ``__init__``, validated there (an
+    :class:`~symid.errors.OptionError` names a bad one); :meth:`create` also refuses
+    names ``__init__`` does not take, listing the valid ones.
+
+    Attributes
+    ----------
+    method : str
+        The method name of :func:`symid.identify` (``"scr"``, ``"ipopt"``, ...).
+    cost_kind : str
+        What the data misfit ``cost`` measures.
+    model, data
+        What the estimator was built on.
+    options : dict
+        The options it runs with (after validation and defaults).
+    noise_floor : float or None
+        The relative misfit noise alone leaves, when known (see :mod:`symid.fit.success`).
+    """
+
+    method: ClassVar[str] = ""
+    cost_kind: ClassVar[str] = ""
+
+    model: Any
+    data: Any
+    options: dict[str, Any]
+    noise_floor: float | None = None
+
+    @classmethod
+    def option_names(cls) -> tuple[str, ...]:
+        """The keyword options this estimator takes (from its ``__init__`` signature)."""
+        sig = inspect.signature(cls.__init__)
+        return tuple(p.name for p in sig.parameters.values() if p.kind is inspect.Parameter.KEYWORD_ONLY)
+
+    @classmethod
+    def create(cls, model: Any, data: Any, options: Mapping[str, Any], *, noise_floor: float | None = None,
+               owner: str | None = None) -> Estimator:
+        """Build the estimator after refusing unknown option names (an :class:`OptionError` lists the valid ones)."""
+        check_known_names(owner or f"method {cls.method!r} ({cls.__name__})", options, cls.option_names())
+        est = cls(model, data, **options)
+        est.noise_floor = None if noise_floor is None else check_float("noise_floor", noise_floor, low=0)
+        return est
+
+    # -- the data kind's part ---------------------------------------------------------------
+    @abc.abstractmethod
+    def misfit(self, theta: np.ndarray) -> float:
+        """The data misfit (``cost``) of the model at θ; ``inf`` where it cannot be evaluated."""
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray | None:
+        """Relative residuals ordered by frequency for the whiteness test, or ``None`` (no such test)."""
+        return None
+
+    def n_data(self) -> int:
+        """Number of real data values the misfit sums over."""
+        return 0
+
+    # -- the method's part ------------------------------------------------------------------
+    @abc.abstractmethod
+    def run(self, x0: np.ndarray) -> StartOutcome:
+        """Estimate from the start ``x0`` (a parameter vector); never raises on solver failure."""
+
+    def polisher(self) -> Estimator | None:
+        """The local refinement ``polish=True`` / ``"scr+polish"`` uses after this method, or ``None``."""
+        return None
+
+    def run_polished(self, x0: np.ndarray, polisher: Estimator) -> StartOutcome:
+        """This method from ``x0``, then ``polisher`` from its estimate (kept when it lowers the misfit)."""
+        from symid.fit.polish import polish_outcome
+
+        return polish_outcome(polisher, self.run(x0))
+
+    def outcome(self, x0: np.ndarray, theta: np.ndarray, *, finished: bool, status: str, message: str,
+                iterations: int, wall_time: float, history: tuple[ScrIteration, ...] = ()) -> StartOutcome:
+        """A :class:`StartOutcome` with its cost and the success rule applied (:mod:`symid.fit.success`)."""
+        theta = np.asarray(theta, dtype=float).reshape(-1)
+        finite = bool(np.all(np.isfinite(theta)))
+        cost = self.misfit(theta) if finite else float("inf")
+        res = self.residuals(theta) if finite and np.isfinite(cost) else None
+        test = fit_test(cost, n_data=self.n_data(), n_parameters=int(theta.size), residuals=res,
+                        noise_floor=self.noise_floor)
+        if not finite:
+            message = f"{message}; the estimate is not finite"
+        return StartOutcome(start=np.asarray(x0, dtype=float), theta=theta, cost=cost,
+                            success=bool(finished and test.fits), finished=bool(finished), status=status,
+                            iterations=int(iterations), wall_time=float(wall_time), message=message,
+                            fit=test.text, history=history)
+
+
+# -- SCR ---------------------------------------------------------------------------------------
+
+_BACKENDS = ("admm", "cvxpy")
+_HEURISTICS = ("nuclear", "truncated")
+
+
+def theta_coef(amap: Any) -> np.ndarray:
+    """Coefficient array (r, c, l) of an affine model map, as :class:`symid.scr.Affine` wants it."""
+    return np.moveaxis(amap.Xi, 0, -1)
+
+
+def identity_coef(shape: tuple[int, int]) -> np.ndarray:
+    """Coefficients (r, c, r, c) of the identity map of an (r, c) matrix variable."""
+    r, c = shape
+    return np.eye(r * c).reshape(r, c, r, c)
+
+
+def symmetric_map(amap: Any) -> bool:
+    """Whether X(θ) is symmetric for every θ."""
+    return bool(np.allclose(amap.X0, amap.X0.T) and np.allclose(amap.Xi, np.swapaxes(amap.Xi, 1, 2)))
+
+
+def positivity_lmis(model: Any, theta: Any, which: Callable[[int], bool] | None = None) -> list[Any]:
+    """θₖ ≥ 0 as 1×1 LMIs for the parameters declared positive (and selected by ``which``)."""
+    from symid import scr
+
+    out = []
+    l = model.n_parameters
+    for k, pos in enumerate(model.positive):
+        if pos and (which is None or which(k)):
+            coef = np.zeros((1, 1, l))
+            coef[0, 0, k] = 1.0
+            out.append(scr.Affine(np.zeros((1, 1)), {theta: coef}))
+    return out
+
+
+def mvk_lmis(maps: Any, theta: Any, options: dict[str, Any], names: str = "MVK") -> list[Any]:
+    """M, V, K ⪰ 0 as LMIs in θ for each non-constant symmetric map; a non-symmetric one is
+    skipped and recorded in ``options`` (``lmi_M`` … ``"skipped: not symmetric"``)."""
+    from symid import scr
+
+    out = []
+    for name in names:
+        if maps[name].is_constant:
+            continue
+        if not symmetric_map(maps[name]):
+            options[f"lmi_{name}"] = "skipped: not symmetric"
+            continue
+        out.append(scr.Affine(maps[name].X0, {theta: theta_coef(maps[name])}))
+    return out
+
+
+class ScrEstimator(Estimator):
+    """What every SCR estimator shares: engine options, the compiled problem, finish rule, history.
+
+    A subclass builds its :class:`symid.scr.BilinearProblem` and calls
+    :meth:`_setup_engine` with it; :meth:`engine_solve` then runs the engine from a start.
+    """
+
+    method: ClassVar[str] = "scr"
+
+    def _engine_options(self, *, backend: Any, max_iter: Any, tol: Any, heuristic: Any = "nuclear",
+                        truncate_after: Any = 0, admm: Any = None) -> dict[str, Any]:
+        """Validated options of :func:`symid.scr.solve`."""
+        from symid import scr
+
+        opts = {"backend": check_choice("backend", backend, _BACKENDS),
+                "max_iter": check_int("max_iter", max_iter, low=1, high=10**7),
+                "tol": check_float("tol", tol, low=0, strict_low=True),
+                "heuristic": check_choice("heuristic", heuristic, _HEURISTICS),
+                "truncate_after": check_int("truncate_after", truncate_after, low=0)}
+        if admm is not None:
+            if not isinstance(admm, scr.ADMMOptions):
+                raise OptionError(f"admm must be a symid.scr.ADMMOptions; got {type(admm).__name__}")
+            opts["admm"] = admm
+        return opts
+
+    def _setup_engine(self, problem: Any, solve_options: dict[str, Any], *, presolve: bool = True,
+                      normalize: bool = True) -> None:
+        from symid import scr
+
+        self.problem = problem
+        self.compiled = scr.compile(problem, presolve=check_bool("presolve", presolve),
+                                    normalize=check_bool("normalize", normalize))
+        self._solve_opts = solve_options
+
+    def engine_solve(self, start: Mapping[str, Any], callback: Any = None, compiled: Any = None) -> Any:
+        """The engine's :class:`symid.scr.SCRSolution` from ``start`` (by variable name)."""
+        from symid import scr
+
+        return scr.solve(self.compiled if compiled is None else compiled, start, callback=callback,
+                         **self._solve_opts)
+
+    @staticmethod
+    def engine_finished(sol: Any) -> bool:
+        """SCR finished: it converged, or it stopped moving (stationary, e.g. on noisy data)."""
+        return sol.status == "converged" or bool(sol.info.get("stationary", False))
+
+    @staticmethod
+    def engine_history(sol: Any, *, theta_of: Callable[[dict], Any] | None = None,
+                       families: Mapping[str, list[int]] | None = None, offset: int = 0
+                       ) -> tuple[ScrIteration, ...]:
+        """Typed per-iteration records of an engine solution."""
+        out = []
+        for k, h in enumerate(sol.history):
+            th = None
+            if theta_of is not None and k < len(sol.iterates):
+                th = np.asarray(theta_of(sol.iterates[k]), dtype=float).reshape(-1)
+            fam = None
+            if families:
+                res = np.asarray(h.residuals)
+                fam = {name: float(np.sum(res[idx])) for name, idx in families.items()}
+            out.append(ScrIteration(iteration=offset + k + 1, residual=float(h.residual),
+                                    objective=float(h.objective), relaxation=float(h.relaxation),
+                                    time=float(h.time), theta=th, families=fam))
+        return tuple(out)
+
+    def solved_outcome(self, x0: np.ndarray, theta: np.ndarray, sol: Any, t0: float, *, message: str | None = None,
+                       history: tuple[ScrIteration, ...] | None = None) -> StartOutcome:
+        """The outcome of one SCR start whose engine solution is ``sol`` (started at ``t0``)."""
+        return self.outcome(x0, theta, finished=self.engine_finished(sol), status=sol.status,
+                            message=sol.message if message is None else message,
+                            iterations=sol.iterations if history is None else len(history),
+                            wall_time=time.perf_counter() - t0,
+                            history=self.engine_history(sol) if history is None else history)

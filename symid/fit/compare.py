@@ -1,0 +1,321 @@
+"""``si.compare``: several methods on the same model, data and starts, side by side."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from symid.errors import DataError, ModelError, OptionError
+from symid.fit.options import check_float
+from symid.fit.registry import data_kind, prepare
+from symid.fit.result import IdentificationResult, StartOutcome
+from symid.fit.starts import make_starts
+from symid.interrupt import Interrupted
+from symid.progress import progress_bar
+from symid.runlog import RunLog
+
+__all__ = ["Comparison", "MethodStats", "compare", "relative_parameter_error"]
+
+
+def relative_parameter_error(theta: np.ndarray, truth: np.ndarray) -> float:
+    """‖θ − θ*‖₂ / ‖θ*‖₂ (absolute error when θ* = 0).
+
+    Examples
+    --------
+    >>> from symid.fit.compare import relative_parameter_error
+    >>> relative_parameter_error([1.0, 2.1], [1.0, 2.0]) < 0.05
+    True
+    """
+    theta = np.asarray(theta, dtype=float)
+    truth = np.asarray(truth, dtype=float)
+    den = float(np.linalg.norm(truth))
+    return float(np.linalg.norm(theta - truth) / (den if den > 0 else 1.0))
+
+
+@dataclass(frozen=True)
+class MethodStats:
+    """One method's figures in a comparison.
+
+    Attributes
+    ----------
+    method : str
+        The method asked for (``"scr"``, ``"ipopt"``, ...).
+    ran_as : str
+        The method that actually ran (``"ls"`` when SCR chose the linear special case).
+    n_starts, n_success : int
+        Starts run and starts that succeeded (by the comparison's criterion).
+    success_rate : float
+        ``n_success / n_starts``.
+    median_time : float
+        Median seconds per start (solver time, setup excluded).
+    setup_time : float
+        Seconds to build the method's problem once (shared by all starts).
+    time_to_solution : float
+        (setup + all starts) / successes; ``inf`` without a success.
+    best_cost : float
+        Lowest data misfit over the starts.
+    best_error : float or None
+        Relative parameter error of the best-cost start, when the truth is known.
+    result : IdentificationResult
+        Every start's outcome.
+    """
+
+    method: str
+    ran_as: str
+    n_starts: int
+    n_success: int
+    success_rate: float
+    median_time: float
+    setup_time: float
+    time_to_solution: float
+    best_cost: float
+    best_error: float | None
+    result: IdentificationResult = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form, suitable for JSON."""
+        return {"method": self.method, "ran_as": self.ran_as, "n_starts": self.n_starts,
+                "n_success": self.n_success, "success_rate": self.success_rate, "median_time": self.median_time,
+                "setup_time": self.setup_time, "time_to_solution": self.time_to_solution,
+                "best_cost": self.best_cost, "best_error": self.best_error,
+                "theta": self.result.theta, "starts": [s.to_dict() for s in self.result.starts]}
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """The outcome of :func:`compare`: per method, success rate and time figures.
+
+    A start counts as a success when its relative parameter error ‖θ − θ*‖₂/‖θ*‖₂ is
+    ≤ ``param_tol`` if the truth is known, otherwise when the start's own ``success``
+    holds (the solver finished and the estimate fits the data, :mod:`symid.fit.success`).
+    """
+
+    stats: tuple[MethodStats, ...]
+    n_starts: int
+    seed: int | None
+    criterion: str
+    truth: dict[str, float] | None = None
+
+    def __getitem__(self, method: str) -> MethodStats:
+        for s in self.stats:
+            if s.method == method:
+                return s
+        raise KeyError(method)
+
+    def _rows(self) -> list[list[str]]:
+        rows = []
+        for s in self.stats:
+            name = s.method if s.ran_as == s.method else f"{s.method} (as {s.ran_as})"
+            rows.append([name, f"{s.n_success}/{s.n_starts}", f"{100 * s.success_rate:.0f}%",
+                         f"{1e3 * s.median_time:.1f}", f"{1e3 * s.setup_time:.1f}",
+                         "inf" if not np.isfinite(s.time_to_solution) else f"{s.time_to_solution:.3f}",
+                         f"{s.best_cost:.2e}", "—" if s.best_error is None else f"{s.best_error:.2e}"])
+        return rows
+
+    _HEAD: ClassVar[tuple[str, ...]] = ("method", "successes", "rate", "median ms/start", "setup ms",
+                                         "time to solution s", "best cost", "best rel. error")
+
+    def table(self) -> str:
+        """A plain-text table."""
+        rows = [list(self._HEAD), *self._rows()]
+        widths = [max(len(r[i]) for r in rows) for i in range(len(self._HEAD))]
+        lines = ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
+        lines.insert(1, "  ".join("-" * w for w in widths))
+        return "\n".join([f"{self.n_starts} identical starts (seed {self.seed}); success: {self.criterion}", *lines])
+
+    def to_markdown(self) -> str:
+        """A Markdown table."""
+        lines = ["| " + " | ".join(self._HEAD) + " |", "|" + "---|" * len(self._HEAD)]
+        lines += ["| " + " | ".join(r) + " |" for r in self._rows()]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form, suitable for JSON."""
+        return {"n_starts": self.n_starts, "seed": self.seed, "criterion": self.criterion, "truth": self.truth,
+                "methods": [s.to_dict() for s in self.stats]}
+
+    def __str__(self) -> str:
+        return self.table()
+
+
+def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *, starts: int = 10,
+            seed: int | None = 0, truth: Any = None, x0: Any = None, param_tol: float = 1e-3,
+            progress: bool | None = None, options: dict[str, dict[str, Any]] | None = None,
+            noise_floor: float | None = None, log: RunLog | None = None) -> Comparison:
+    """Run several methods from identical starts and tabulate success and time.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+    data : FrequencyData, SpectralData, BlackBox or IOData
+    methods : sequence of str
+        Methods to compare (see :func:`symid.identify`). ``"<method>+polish"`` runs the
+        method and, from every start, its declared polisher
+        (:meth:`symid.fit.base.Estimator.polisher`, IPOPT); for frequency responses
+        ``"scr+polish"`` hands over as soon as a trial polish from the current SCR
+        estimate fits the data (:meth:`symid.fit.frf.scr.ScrFRF.run_polished`). It is
+        built and run on its own, so its setup and time per start (method + every
+        polish) share nothing with the plain row.
+    starts : int
+        Number of starts; every method gets the same list (:func:`symid.starts.make_starts`).
+    seed : int, optional
+        Seed of the random starts.
+    truth : dict or sequence, optional
+        True parameters; success is then ‖θ − θ*‖₂/‖θ*‖₂ ≤ ``param_tol``.
+    x0 : dict or sequence, optional
+        A start put first in the list.
+    param_tol : float
+        Success threshold on the relative parameter error, with a truth (default 1e-3).
+    progress : bool, optional
+        Progress bar (default: on a terminal).
+    options : dict, optional
+        Per-method options, e.g. ``{"scr": {"backend": "admm"}}``; ``"scr+polish"``
+        uses the options of ``"scr"``.
+    noise_floor : float, optional
+        As in :func:`symid.identify` (judges each start's own ``success``).
+    log : symid.runlog.RunLog, optional
+        Record every start as it ends (JSON Lines, flushed); starts already in the log
+        are read back instead of run, so an interrupted comparison resumes where it
+        stopped. Use :meth:`~symid.runlog.RunLog.scoped` to keep several comparisons in
+        one file. A log written with other starts is refused.
+
+    Returns
+    -------
+    Comparison
+
+    Raises
+    ------
+    symid.interrupt.Interrupted
+        On Ctrl-C after at least one start finished; its ``partial`` is the comparison
+        of the finished starts (an unfinished method's row counts only its finished
+        starts).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> truth = {"m": 2.0, "c": 0.5, "k": 3.0}
+    >>> frf = si.simulate_frf(model, truth, np.linspace(0.5, 2.0, 5))
+    >>> cmp = si.compare(model, frf, methods=("ls", "ipopt"), starts=3, seed=0, truth=truth)
+    >>> cmp["ls"].n_success, cmp["ls"].n_starts
+    (3, 3)
+    """
+    if isinstance(methods, str) or not methods:
+        raise ModelError("compare() needs a sequence of at least one method name")
+    methods = tuple(methods)
+    if len(set(methods)) != len(methods):
+        raise ModelError(f"a method is listed twice in {methods}")
+    kind = data_kind(data)
+    for m in methods:
+        if not isinstance(m, str) or m.removesuffix("+polish") not in kind.methods:
+            raise ModelError(f"unknown method {m!r} for {kind.name} data; choose among "
+                             f"{', '.join(kind.methods)} (each also as '<method>+polish' where it has a polish step)")
+    options = dict(options or {})
+    unknown = set(options) - {m.removesuffix("+polish") for m in methods}
+    if unknown:
+        raise ModelError(f"options given for methods not compared: {', '.join(sorted(unknown))}")
+    param_tol = check_float("param_tol", param_tol, low=0, strict_low=True)
+    truth_vec = None if truth is None else model.theta_vector(truth)
+    x0s = make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+    if log is not None and not isinstance(log, RunLog):
+        raise ModelError(f"log must be a symid.runlog.RunLog; got {type(log).__name__}")
+    criterion = (f"relative parameter error <= {param_tol:g}" if truth_vec is not None
+                 else "the start's own success (solver finished and the estimate fits the data)")
+    stats: list[MethodStats] = []
+
+    def tabulate(method: str, meta: dict[str, Any], outcomes: list[StartOutcome], interrupted: bool = False
+                 ) -> MethodStats:
+        opts = {**meta.get("options", {}), **({"interrupted": True} if interrupted else {})}
+        ran_as = meta.get("ran_as", method)
+        res = IdentificationResult.from_starts(ran_as, model.parameter_names, outcomes,
+                                               cost_kind=meta.get("cost_kind", ""), options=opts)
+        if truth_vec is not None:
+            ok = [relative_parameter_error(o.theta, truth_vec) <= param_tol for o in outcomes]
+            best_err = relative_parameter_error(res.theta_vector, truth_vec)
+        else:
+            ok = [o.success for o in outcomes]
+            best_err = None
+        n_ok = int(sum(ok))
+        setup = float(meta.get("setup_time", 0.0))
+        total = setup + sum(o.wall_time for o in outcomes)
+        return MethodStats(method=method, ran_as=ran_as, n_starts=len(outcomes), n_success=n_ok,
+                           success_rate=n_ok / len(outcomes),
+                           median_time=float(np.median([o.wall_time for o in outcomes])), setup_time=setup,
+                           time_to_solution=total / n_ok if n_ok else float("inf"),
+                           best_cost=res.cost, best_error=best_err, result=res)
+
+    def partial() -> Comparison:
+        return Comparison(stats=tuple(stats), n_starts=len(x0s), seed=seed, criterion=criterion,
+                          truth=None if truth is None else model.theta_dict(truth))
+
+    for method in methods:
+        outcomes: list[StartOutcome] = []
+        meta: dict[str, Any] = {}
+        try:
+            method_options = dict(options.get(method.removesuffix("+polish"), {}))
+            _run_method(model, data, method, method_options, x0s, progress, log, outcomes, meta, noise_floor)
+        except KeyboardInterrupt:
+            if outcomes:
+                stats.append(tabulate(method, meta, outcomes, interrupted=True))
+            if not stats:
+                raise
+            done = ", ".join(f"{s.method} {s.n_starts}/{len(x0s)}" for s in stats)
+            raise Interrupted(f"compare() interrupted (finished starts: {done}); they are in the exception's "
+                              f".partial comparison", partial()) from None
+        stats.append(tabulate(method, meta, outcomes))
+    return partial()
+
+
+def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s: list[np.ndarray],
+                progress: bool | None, log: RunLog | None, outcomes: list[StartOutcome], meta: dict[str, Any],
+                noise_floor: float | None) -> None:
+    """Run one method from every start, appending to ``outcomes`` as each ends.
+
+    ``meta`` receives ``ran_as``, ``options``, ``setup_time`` and ``cost_kind`` as soon as
+    they are known (so an interrupted row is still labelled). Starts found in ``log`` are
+    read back instead of run; each new one is logged as it ends.
+    """
+    base = method.removesuffix("+polish")
+    cached = [None if log is None else log.get(f"{method}/start{i}") for i in range(len(x0s))]
+    for i, (rec, x) in enumerate(zip(cached, x0s, strict=True)):
+        if rec is not None and not np.allclose(rec["start"], x, rtol=1e-12, atol=0):
+            raise DataError(f"the log {log.path} holds start {i} of {method} from another starting point "
+                            f"(another seed, x0 or model?); resume with the same arguments or use a new log")
+    head = None if log is None else log.get(f"{method}/setup")
+    if head is not None and all(rec is not None for rec in cached):  # everything done: nothing to build
+        meta.update(ran_as=str(head["ran_as"]), options=dict(head["options"]), setup_time=float(head["setup_time"]),
+                    cost_kind=str(head["cost_kind"]))
+        outcomes.extend(StartOutcome.from_dict(rec) for rec in cached)
+        return
+    t0 = time.perf_counter()
+    estimator = prepare(model, data, base, options, noise_floor=noise_floor)  # every row builds its own
+    polisher = None
+    if method.endswith("+polish"):
+        polisher = estimator.polisher()
+        if polisher is None:
+            raise OptionError(f"{method!r}: method {estimator.method!r} has no polish step")
+    setup = time.perf_counter() - t0
+    opts = dict(estimator.options)
+    ran_as = estimator.method
+    if polisher is not None:
+        ran_as = f"{estimator.method}+polish"
+        opts["polish"] = polisher.method
+    if head is not None:
+        setup = float(head["setup_time"])  # the first run's setup is the one the figures count
+    elif log is not None:
+        log.append(f"{method}/setup", {"ran_as": ran_as, "options": opts, "setup_time": setup,
+                                       "cost_kind": estimator.cost_kind})
+    meta.update(ran_as=ran_as, options=opts, setup_time=setup, cost_kind=estimator.cost_kind)
+    for i, x in enumerate(progress_bar(x0s, desc=method, enabled=progress)):
+        if cached[i] is not None:
+            outcomes.append(StartOutcome.from_dict(cached[i]))
+            continue
+        out = estimator.run(x) if polisher is None else estimator.run_polished(x, polisher)
+        outcomes.append(out)
+        if log is not None:
+            log.append(f"{method}/start{i}", out.to_dict())

@@ -1,0 +1,156 @@
+"""Linear least squares for frequency responses when a known square matrix can be inverted.
+
+Thesis §4-5-1, (4-10) and (4-11), generalised: the inverted matrix (C or B) must be known
+(free of parameters), square and invertible; everything else may hold parameters, and
+the problem stays linear in θ.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from symid.errors import ModelError
+from symid.fit.frf.misfit import FrfEstimator
+from symid.fit.options import check_choice
+from symid.fit.result import StartOutcome
+
+__all__ = ["LinearFRF", "ls_applicable"]
+
+
+def _known_invertible(amap: Any) -> bool:
+    r, c = amap.shape
+    if r != c or not amap.is_constant:
+        return False
+    return bool(np.linalg.matrix_rank(amap.X0) == r and np.linalg.cond(amap.X0) < 1e12)
+
+
+def ls_applicable(model: Any) -> str | None:
+    """Which linear special case applies: ``"sensors"`` (C known, square, invertible),
+    ``"actuators"`` (B known, square, invertible) or ``None``."""
+    maps = model.maps
+    if "D" in maps and not (maps["D"].is_constant and not np.any(maps["D"].X0)):
+        return None
+    if _known_invertible(maps["C"]):
+        return "sensors"
+    if _known_invertible(maps["B"]):
+        return "actuators"
+    return None
+
+
+def _why_not(model: Any) -> str:
+    reasons = []
+    for name in ("C", "B"):
+        amap = model.maps[name]
+        r, c = amap.shape
+        if r != c:
+            reasons.append(f"{name} is {r}×{c}, not square")
+        elif not amap.is_constant:
+            reasons.append(f"{name} holds parameters")
+        else:
+            reasons.append(f"{name} is singular")
+    if "D" in model.maps and not (model.maps["D"].is_constant and not np.any(model.maps["D"].X0)):
+        reasons.append("D is not zero")
+    return "; ".join(reasons)
+
+
+class LinearFRF(FrfEstimator):
+    """The linear least-squares estimate (thesis (4-10)/(4-11) and their state-space analogue).
+
+    For a second-order model, with Z(ω, θ) = K(θ) − ω²M(θ) + jωV(θ) and Ĥ the
+    measured response divided by 1, jω or −ω² (position, velocity, acceleration):
+
+    - sensors (C known, invertible): Σᵢ ‖Z(ωᵢ, θ) C⁻¹ Ĥᵢ − B(θ)‖²_F  (4-10)
+    - actuators (B known, invertible): Σᵢ ‖Ĥᵢ B⁻¹ Z(ωᵢ, θ) − C(θ)‖²_F  (4-11)
+
+    For a state-space model (D = 0) the same with Z(ω, θ) = jωI − A(θ).
+    Both are linear in θ; real and imaginary parts are stacked and solved by
+    ``numpy.linalg.lstsq``. Exact on noise-free data. Parameters declared positive are
+    not constrained: an estimate with a negative one is reported, but never as a success.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+    data : FrequencyData
+    case : {"sensors", "actuators"}, optional
+        Which known matrix is inverted; default: the one that applies (sensors first).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.frf.ls import LinearFRF
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> frf = si.simulate_frf(model, [2.0, 0.5, 3.0], np.linspace(0.5, 2.0, 5))
+    >>> np.round(LinearFRF(model, frf).run().theta, 6).tolist()
+    [2.0, 0.5, 3.0]
+    """
+
+    method = "ls"
+
+    def __init__(self, model: Any, data: Any, *, case: str | None = None):
+        if case is None:
+            case = ls_applicable(model)
+        if case is None:
+            raise ModelError("the linear least-squares special case needs C or B known (no parameters), square and "
+                             f"invertible, and D = 0; here: {_why_not(model)}. Use method='scr' or 'ipopt'.")
+        case = check_choice("case", case, ("sensors", "actuators"))
+        if case == "sensors" and not _known_invertible(model.maps["C"]):
+            raise ModelError(f"case='sensors' needs C known, square and invertible; here: {_why_not(model)}")
+        if case == "actuators" and not _known_invertible(model.maps["B"]):
+            raise ModelError(f"case='actuators' needs B known, square and invertible; here: {_why_not(model)}")
+        self.model, self.data, self.case = model, data, case
+        self.options = {"case": case}
+        w = np.asarray(data.w, dtype=float)
+        H = np.asarray(data.H, dtype=complex)
+        second = "M" in model.maps
+        out = getattr(model, "output", "position")
+        if out != "position" and np.any(w == 0):
+            raise ModelError(f"{out} output: H is zero at ω = 0 and cannot be divided back; drop ω = 0")
+        factor = {"position": np.ones_like(w, dtype=complex), "velocity": 1j * w, "acceleration": -(w**2) + 0j}[out]
+        Hh = H / factor[:, None, None]
+        maps = model.maps
+        l = model.n_parameters
+        rows0, rowsJ = [], []
+        for i, wi in enumerate(w):
+            if second:
+                Z0 = maps["K"].X0 - wi**2 * maps["M"].X0 + 1j * wi * maps["V"].X0
+                Zi = maps["K"].Xi - wi**2 * maps["M"].Xi + 1j * wi * maps["V"].Xi
+            else:
+                n = maps["A"].shape[0]
+                Z0 = 1j * wi * np.eye(n) - maps["A"].X0
+                Zi = -maps["A"].Xi.astype(complex)
+            if case == "sensors":
+                G = np.linalg.solve(maps["C"].X0, Hh[i])          # C⁻¹ Ĥ = Γ
+                r0 = Z0 @ G - maps["B"].X0
+                rJ = Zi @ G - maps["B"].Xi
+            else:
+                G = Hh[i] @ np.linalg.inv(maps["B"].X0)           # Ĥ B⁻¹ = C Z⁻¹
+                r0 = G @ Z0 - maps["C"].X0
+                rJ = np.einsum("pn,knm->kpm", G, Zi) - maps["C"].Xi
+            rows0.append(r0.reshape(-1))
+            rowsJ.append(rJ.reshape(l, -1).T)
+        r0 = np.concatenate(rows0)
+        J = np.vstack(rowsJ)
+        self._J = np.vstack([J.real, J.imag])
+        self._r0 = np.concatenate([r0.real, r0.imag])
+        rank = np.linalg.matrix_rank(self._J)
+        if rank < l:
+            raise ModelError(f"the linear least-squares problem has rank {rank} < {l} parameters: the data do not "
+                             f"determine θ (add frequencies, or check identifiability)")
+
+    def run(self, x0: np.ndarray | None = None) -> StartOutcome:
+        """Solve the least squares (the start is irrelevant; kept for a uniform signature)."""
+        t0 = time.perf_counter()
+        theta, *_ = np.linalg.lstsq(self._J, -self._r0, rcond=None)
+        start = np.zeros(self.model.n_parameters) if x0 is None else np.asarray(x0, dtype=float)
+        msg = f"linear least squares ({self.case} case)"
+        negative = [n for n, pos, v in zip(self.model.parameter_names, self.model.positive, theta, strict=True)
+                    if pos and v < 0]
+        if negative:
+            msg += f"; parameters declared positive came out negative: {', '.join(negative)}"
+        return self.outcome(start, theta, finished=not negative, status="solved" if not negative else "negative",
+                            message=msg, iterations=1, wall_time=time.perf_counter() - t0)

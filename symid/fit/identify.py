@@ -1,0 +1,139 @@
+"""``si.identify``: one entry point; the data kind picks the package, the method the estimator."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from typing import Any
+
+from symid.errors import OptionError
+from symid.fit.options import check_bool
+from symid.fit.registry import prepare
+from symid.fit.result import IdentificationResult, StartOutcome
+from symid.fit.starts import make_starts
+from symid.interrupt import Interrupted
+from symid.progress import progress_bar
+
+__all__ = ["identify"]
+
+
+def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, starts: int = 1,
+             seed: int | None = None, polish: bool = False, progress: bool | None = None,
+             identifiability_check: bool = True, noise_floor: float | None = None,
+             **options: Any) -> IdentificationResult:
+    """Estimate the parameters of a symbolic model from data.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+        The grey-box model.
+    data : FrequencyData, SpectralData, BlackBox or IOData
+        The measurements. The data kind picks the formulation (:mod:`symid.fit.registry`):
+        a frequency response goes to :mod:`symid.fit.frf` (thesis ch. 3, 4), spectra to
+        :mod:`symid.fit.spectra` (ch. 5), a black box or input/output records (then
+        N4SID and an exact zero-order-hold ``d2c`` first) to
+        :mod:`symid.fit.similarity` (ch. 6, 7).
+    method : str
+        ``"scr"`` (sequential convex relaxation), ``"ipopt"`` (nonlinear least squares
+        with CasADi/IPOPT), ``"ls"`` (a linear special case, where it applies), and for
+        black-box data ``"als"``, ``"gb"``. ``"scr"`` on a second-order model whose C or
+        B is known, square and invertible runs the exact linear least squares instead
+        (reported as method ``"ls"``; ``force_scr=True`` runs SCR anyway).
+    x0 : dict or sequence, optional
+        A start; it becomes the first of ``starts``.
+    starts : int
+        Number of starts (1 … 100 000). Default starts: for a state-space model the
+        first is θ = 0 (thesis ch. 3), then seeded N(0, 1) draws per parameter name
+        (:func:`symid.fit.starts.make_starts`), positive parameters in absolute value.
+        Every method gets the same starts for the same ``seed``.
+    seed : int, optional
+        Seed of the random starts (``None``: a fresh one).
+    polish : bool
+        After the method, refine the best estimate with the method's declared polisher
+        (:meth:`symid.fit.base.Estimator.polisher`, IPOPT; kept only when it lowers the
+        misfit); reported as its own result in ``result.polished`` (method
+        ``"<method>+polish"``, time = all starts + polish). An :class:`OptionError` for a
+        method without one.
+    progress : bool, optional
+        Show a progress bar over the starts (default: when there is more than one start
+        and standard error is a terminal).
+    identifiability_check : bool
+        Before estimating, run the cheap local identifiability test and emit an
+        :class:`~symid.IdentifiabilityWarning` naming the parameters that no data of
+        this kind can determine (default True).
+    noise_floor : float, optional
+        The relative misfit noise alone leaves at the true parameters (ε² for relative
+        noise of level ε); used to judge ``success`` (:mod:`symid.fit.success`). Default:
+        estimated from the residual where the data kind allows it.
+    **options
+        The method's options (see each estimator's docstring and the options table in
+        :mod:`symid.fit.base`); an unknown name or a bad value is an
+        :class:`~symid.errors.OptionError` before anything runs.
+
+    Returns
+    -------
+    IdentificationResult
+        The best start by data misfit, and every start's outcome in ``result.starts``.
+        ``success`` means the solver finished and the estimate fits the data.
+
+    Raises
+    ------
+    symid.interrupt.Interrupted
+        On Ctrl-C after at least one start finished (a ``KeyboardInterrupt``, so a
+        script stops); its ``partial`` is the result of the finished starts, with
+        ``options["interrupted"] = True``. Ctrl-C stops a running start at once (IPOPT
+        and Clarabel within one iteration).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> frf = si.simulate_frf(model, {"m": 2.0, "c": 0.5, "k": 3.0}, np.linspace(0.5, 2.0, 5))
+    >>> res = si.identify(model, frf, method="ls")
+    >>> [round(v, 6) for v in res.theta.values()], res.success
+    ([2.0, 0.5, 3.0], True)
+    """
+    polish = check_bool("polish", polish)
+    identifiability_check = check_bool("identifiability_check", identifiability_check)
+    if progress is not None:
+        progress = check_bool("progress", progress)
+    estimator = prepare(model, data, method, options, noise_floor=noise_floor)
+    polisher = estimator.polisher() if polish else None
+    if polish and polisher is None:
+        raise OptionError(f"method {estimator.method!r} has no polish step (polish=True applies to SCR)")
+    x0s = make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+    if identifiability_check:
+        from symid.structural.analyse import warn_if_not_identifiable
+
+        warn_if_not_identifiable(model, stacklevel=2)
+    if estimator.method == "ls":
+        x0s = x0s[:1]
+    options_used = dict(estimator.options)
+    outcomes: list[StartOutcome] = []
+    try:
+        for x in progress_bar(x0s, desc=f"{estimator.method} starts", enabled=progress):
+            outcomes.append(estimator.run(x))
+    except KeyboardInterrupt:
+        if not outcomes:
+            raise
+        partial = IdentificationResult.from_starts(estimator.method, model.parameter_names, outcomes,
+                                                   cost_kind=estimator.cost_kind,
+                                                   options={**options_used, "interrupted": True})
+        raise Interrupted(f"identify() interrupted after {len(outcomes)} of {len(x0s)} starts; "
+                          f"the finished starts are in the exception's .partial result", partial) from None
+    result = IdentificationResult.from_starts(estimator.method, model.parameter_names, outcomes,
+                                              cost_kind=estimator.cost_kind, options=options_used)
+    if polisher is not None:
+        from symid.fit.polish import polish_outcome
+
+        t0 = time.perf_counter()
+        out = polish_outcome(polisher, result.best_start)
+        # the polished estimate cost every start plus the polish
+        out = dataclasses.replace(out, wall_time=result.wall_time + time.perf_counter() - t0)
+        polished = IdentificationResult.from_starts(f"{estimator.method}+polish", model.parameter_names, [out],
+                                                    cost_kind=estimator.cost_kind,
+                                                    options={"polish": polisher.method})
+        result = dataclasses.replace(result, polished=polished)
+    return result

@@ -1,0 +1,101 @@
+"""Which package estimates from which data: the small registry :func:`symid.identify` dispatches through.
+
+Each data kind is one package of :mod:`symid.fit` with a ``METHODS`` tuple and a
+``prepare(model, data, method, options, noise_floor=...)`` function. The command line
+and :func:`symid.compare` build their method lists from here.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Any
+
+from symid.errors import DataError, ModelError
+from symid.fit.base import Estimator
+
+__all__ = ["DataKind", "all_methods", "data_kind", "data_kinds", "prepare"]
+
+
+@dataclass(frozen=True)
+class DataKind:
+    """One data kind: its name, the data types it takes, its package and methods.
+
+    Attributes
+    ----------
+    name : str
+        ``"frequency response"``, ``"spectra"``, ``"black box"``.
+    data_types : tuple of str
+        Names of the :mod:`symid.data` classes it takes.
+    package : str
+        The :mod:`symid.fit` package.
+    """
+
+    name: str
+    data_types: tuple[str, ...]
+    package: str
+
+    @property
+    def methods(self) -> tuple[str, ...]:
+        """The method names of this kind."""
+        return tuple(importlib.import_module(self.package).METHODS)
+
+    def prepare(self, model: Any, data: Any, method: str, options: dict[str, Any], *,
+                noise_floor: float | None = None) -> Estimator:
+        """Build the estimator of ``method`` (options validated)."""
+        return importlib.import_module(self.package).prepare(model, data, method, options, noise_floor=noise_floor)
+
+
+_KINDS = (
+    DataKind("frequency response", ("FrequencyData",), "symid.fit.frf"),
+    DataKind("spectra", ("SpectralData",), "symid.fit.spectra"),
+    DataKind("black box", ("BlackBox", "IOData"), "symid.fit.similarity"),
+)
+
+
+def data_kinds() -> tuple[DataKind, ...]:
+    """Every data kind symid estimates from."""
+    return _KINDS
+
+
+def data_kind(data: Any) -> DataKind:
+    """The kind of a data object (a :class:`DataError` for anything else).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.registry import data_kind
+    >>> data_kind(si.FrequencyData([1.0, 2.0], np.ones(2))).methods
+    ('scr', 'ipopt', 'ls')
+    """
+    name = type(data).__name__
+    for kind in _KINDS:
+        if name in kind.data_types and type(data).__module__.startswith("symid.data"):
+            return kind
+    known = ", ".join(t for k in _KINDS for t in k.data_types)
+    raise DataError(f"symid estimates from {known}; got {name}")
+
+
+def all_methods() -> tuple[str, ...]:
+    """Every method name of every kind, in a stable order."""
+    out: list[str] = []
+    for kind in _KINDS:
+        out.extend(m for m in kind.methods if m not in out)
+    return tuple(out)
+
+
+def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
+            noise_floor: float | None = None) -> Estimator:
+    """The estimator of ``method`` for this model and data, its options validated."""
+    from symid.secondorder import SecondOrderModel
+    from symid.statespace import StateSpaceModel
+
+    if not isinstance(model, (StateSpaceModel, SecondOrderModel)):
+        raise ModelError(f"model must be a StateSpaceModel or SecondOrderModel; got {type(model).__name__}")
+    if model.n_parameters == 0:
+        raise ModelError("the model has no free parameter: there is nothing to estimate")
+    if not isinstance(method, str):
+        raise ModelError(f"method must be a name (str); got {method!r}")
+    # the kind's package refuses an unknown method, with advice where a known one does not apply
+    return data_kind(data).prepare(model, data, method, dict(options), noise_floor=noise_floor)

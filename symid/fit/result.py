@@ -1,0 +1,250 @@
+"""Result types shared by every estimation method, so methods compare like for like.
+
+``success`` means the same thing everywhere: the solver finished (reached its own
+stopping rule) **and** the estimate fits the data (:mod:`symid.fit.success`). The
+solver's own verdict is kept apart, in ``status`` and ``message``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["IdentificationResult", "ScrIteration", "StartOutcome"]
+
+
+def _best_index(starts: tuple[StartOutcome, ...] | list[StartOutcome]) -> int:
+    """Index of the lowest data misfit (non-finite costs rank last; the first on ties)."""
+    return int(np.argmin([s.cost if np.isfinite(s.cost) else np.inf for s in starts]))
+
+
+@dataclass(frozen=True)
+class ScrIteration:
+    """One SCR iteration of one start, as the estimators record it.
+
+    Attributes
+    ----------
+    iteration : int
+        1, 2, …
+    residual : float
+        Largest normalised bilinear residual after the iteration (the engine's stopping measure).
+    objective : float
+        The convex objective f(x) (0 without one).
+    relaxation : float
+        The value of the relaxed sub-problem's objective.
+    time : float
+        Seconds spent on the iteration.
+    theta : numpy.ndarray or None
+        The parameter iterate, when the formulation estimates θ directly.
+    families : dict of str to float or None
+        Summed residual per constraint family (thesis Figure 3-2), when the formulation has them.
+    """
+
+    iteration: int
+    residual: float
+    objective: float
+    relaxation: float
+    time: float
+    theta: np.ndarray | None = field(default=None, repr=False)
+    families: dict[str, float] | None = field(default=None, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form, suitable for JSON."""
+        return {"iteration": self.iteration, "residual": self.residual, "objective": self.objective,
+                "relaxation": self.relaxation, "time": self.time,
+                "theta": None if self.theta is None else np.asarray(self.theta, dtype=float).tolist(),
+                "families": None if self.families is None else dict(self.families)}
+
+
+@dataclass(frozen=True)
+class StartOutcome:
+    """What one start of one method produced.
+
+    Attributes
+    ----------
+    start : numpy.ndarray
+        The initial parameter vector (in ``parameter_names`` order).
+    theta : numpy.ndarray
+        The estimate.
+    cost : float
+        The data misfit of the estimate; what it measures depends on the data kind
+        (``IdentificationResult.cost_kind``).
+    success : bool
+        ``finished`` and the estimate fits the data (:mod:`symid.fit.success`).
+    finished : bool
+        The solver reached its own stopping rule (converged, or stationary).
+    status : str
+        The solver's own status word (IPOPT's return status, SCR's ``"converged"``,
+        ``"max_iter"``, ...).
+    iterations : int
+        Solver iterations.
+    wall_time : float
+        Seconds spent on this start.
+    message : str
+        The solver's final word.
+    fit : str
+        How the misfit compares with the noise floor (why it fits or not).
+    history : tuple of ScrIteration
+        Per-iteration records, when the method keeps them (SCR does).
+    """
+
+    start: np.ndarray
+    theta: np.ndarray
+    cost: float
+    success: bool
+    finished: bool
+    status: str
+    iterations: int
+    wall_time: float
+    message: str = ""
+    fit: str = ""
+    history: tuple[ScrIteration, ...] = field(default=(), repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form (lists and floats), suitable for JSON (the history is left out)."""
+        return {"start": np.asarray(self.start).tolist(), "theta": np.asarray(self.theta).tolist(),
+                "cost": float(self.cost), "success": bool(self.success), "finished": bool(self.finished),
+                "status": self.status, "iterations": int(self.iterations), "wall_time": float(self.wall_time),
+                "message": self.message, "fit": self.fit}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> StartOutcome:
+        """Rebuild an outcome written by :meth:`to_dict` (without its history).
+
+        A cost written as ``None`` (JSON has no NaN or infinity) reads back as ``inf``.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from symid.fit.result import StartOutcome
+        >>> out = StartOutcome(np.zeros(2), np.ones(2), 1e-12, True, True, "converged", 3, 0.1)
+        >>> StartOutcome.from_dict(out.to_dict()).status
+        'converged'
+        """
+        cost = d.get("cost")
+        return cls(start=np.asarray(d["start"], dtype=float), theta=np.asarray(d["theta"], dtype=float),
+                   cost=float("inf") if cost is None else float(cost), success=bool(d["success"]),
+                   finished=bool(d["finished"]), status=str(d["status"]), iterations=int(d["iterations"]),
+                   wall_time=float(d["wall_time"]), message=str(d.get("message", "")), fit=str(d.get("fit", "")))
+
+
+@dataclass(frozen=True)
+class IdentificationResult:
+    """The outcome of :func:`symid.identify`: the best start, and every start's outcome.
+
+    Attributes
+    ----------
+    method : str
+        ``"scr"``, ``"ipopt"``, ``"ls"``, ...
+    parameter_names : tuple of str
+        The order of θ.
+    theta : dict of str to float
+        Best estimate (lowest misfit over the starts).
+    theta_vector : numpy.ndarray
+        The same as a vector.
+    cost : float
+        Data misfit of ``theta``.
+    cost_kind : str
+        What ``cost`` measures for this data kind (e.g. the relative FRF misfit).
+    success : bool
+        The best start's solver finished and its estimate fits the data.
+    status : str
+        The solver's own status on the best start.
+    iterations : int
+        Iterations of the best start.
+    wall_time : float
+        Total seconds over all starts.
+    message : str
+        The solver's final word on the best start.
+    fit : str
+        The noise-floor test on the best start (why it fits or not).
+    starts : tuple of StartOutcome
+        Every start's outcome, in the order they ran.
+    polished : IdentificationResult or None
+        With ``polish=True``: SCR followed by a local refinement, reported separately.
+    options : dict
+        The options the method ran with.
+    """
+
+    method: str
+    parameter_names: tuple[str, ...]
+    theta: dict[str, float]
+    theta_vector: np.ndarray
+    cost: float
+    cost_kind: str
+    success: bool
+    status: str
+    iterations: int
+    wall_time: float
+    message: str
+    fit: str
+    starts: tuple[StartOutcome, ...]
+    polished: IdentificationResult | None = None
+    options: dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def from_starts(cls, method: str, parameter_names: tuple[str, ...], starts: list[StartOutcome], *,
+                    cost_kind: str, options: dict[str, Any] | None = None,
+                    polished: IdentificationResult | None = None) -> IdentificationResult:
+        """Pick the best start by data misfit (non-finite costs rank last)."""
+        if not starts:
+            raise ValueError("no start outcome to report")
+        best = starts[_best_index(starts)]
+        return cls(method=method, parameter_names=tuple(parameter_names),
+                   theta=dict(zip(parameter_names, np.asarray(best.theta, dtype=float).tolist(), strict=True)),
+                   theta_vector=np.asarray(best.theta, dtype=float), cost=float(best.cost), cost_kind=cost_kind,
+                   success=bool(best.success), status=best.status, iterations=int(best.iterations),
+                   wall_time=float(sum(s.wall_time for s in starts)), message=best.message, fit=best.fit,
+                   starts=tuple(starts), polished=polished, options=dict(options or {}))
+
+    @property
+    def best_start(self) -> StartOutcome:
+        """The start whose outcome is reported (lowest data misfit)."""
+        return self.starts[_best_index(self.starts)]
+
+    @property
+    def n_starts(self) -> int:
+        """Number of starts run."""
+        return len(self.starts)
+
+    def summary(self, truth: dict[str, float] | None = None) -> str:
+        """A readable table of the estimate (against ``truth`` when given)."""
+        n_ok = sum(s.success for s in self.starts)
+        lines = [f"method: {self.method}   starts: {self.n_starts}   successful: {n_ok}/{self.n_starts}",
+                 f"best: success {self.success}   cost {self.cost:.3e} ({self.cost_kind})",
+                 f"  fit: {self.fit}",
+                 f"  solver: {self.status}, {self.iterations} iterations; {self.message}",
+                 f"total time {self.wall_time:.3f} s"]
+        if self.options.get("interrupted"):
+            lines.append("INTERRUPTED: only the finished starts are reported")
+        head = f"{'parameter':>12s} {'estimate':>14s}"
+        if truth is not None:
+            head += f" {'truth':>14s} {'rel. error':>11s}"
+        lines.append(head)
+        for name in self.parameter_names:
+            row = f"{name:>12s} {self.theta[name]:>14.6g}"
+            if truth is not None and name in truth:
+                t = float(truth[name])
+                err = abs(self.theta[name] - t) / (abs(t) if t != 0 else 1.0)
+                row += f" {t:>14.6g} {err:>11.2e}"
+            lines.append(row)
+        if self.polished is not None:
+            lines.append("")
+            lines.append("after polish:")
+            lines.append(self.polished.summary(truth))
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.summary()
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form, suitable for JSON."""
+        return {"method": self.method, "parameter_names": list(self.parameter_names), "theta": dict(self.theta),
+                "cost": float(self.cost), "cost_kind": self.cost_kind, "success": bool(self.success),
+                "status": self.status, "iterations": int(self.iterations), "wall_time": float(self.wall_time),
+                "message": self.message, "fit": self.fit, "starts": [s.to_dict() for s in self.starts],
+                "polished": None if self.polished is None else self.polished.to_dict(),
+                "options": {k: (v if isinstance(v, (int, float, str, bool, type(None))) else repr(v))
+                            for k, v in self.options.items()}}

@@ -1,0 +1,104 @@
+"""IPOPT on the similarity misfit (6-9): min over θ and T of ‖T𝔸 − A(θ)T‖² + ‖T𝔹 − B(θ)‖² + ‖ℂ − C(θ)T‖²."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from symid.engine.ipopt import IpoptSolver, casadi_matrices, positivity_bounds
+from symid.fit.options import check_bool, check_choice, check_float, check_int, check_seed
+from symid.fit.result import StartOutcome
+from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
+from symid.fit.similarity.objective import SimilarityMisfit
+from symid.fit.similarity.start import INITS, initial_point
+
+__all__ = ["IpoptSimilarity", "IpoptSimilarityFRF"]
+
+
+class IpoptSimilarity(SimilarityEstimator):
+    """Nonlinear least squares (6-9) over z = (θ, vec T) with CasADi/IPOPT (exact Hessian).
+
+    The objective is F(θ, T) / (‖𝔸‖² + ‖𝔹‖² + ‖ℂ‖²), the scaled misfit of
+    :class:`~symid.fit.similarity.objective.SimilarityMisfit` (+ ‖𝔻 − D(θ)‖² when D holds parameters).
+    Like ALS and GB it does not keep T invertible.
+
+    Parameters
+    ----------
+    model : StateSpaceModel
+    data : SimilarityData
+    aux_init : {"random", "model", "zero", "identity"}
+    seed : int
+    positivity : bool
+        Bound parameters declared positive below by 0 (default True).
+    max_iter : int
+        IPOPT iteration limit (default 3000).
+    tol : float
+        IPOPT tolerance (default 1e-12).
+    """
+
+    method = "ipopt"
+
+    def __init__(self, model: Any, data: SimilarityData, *, aux_init: str = "random", seed: int = 0,
+                 positivity: bool = True, max_iter: int = 3000, tol: float = 1e-12):
+        self.init = check_choice("aux_init", aux_init, INITS)
+        self.seed = check_seed("seed", seed)
+        positivity = check_bool("positivity", positivity)
+        max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
+        tol = check_float("tol", tol, low=0, strict_low=True)
+        self.model, self.data, self.frf = model, data, data.frf
+        self.misfit_F = SimilarityMisfit(model.maps, data.blackbox)
+        self.options = {"aux_init": aux_init, "seed": seed, "positivity": positivity, "max_iter": max_iter,
+                        "tol": tol, "black_box": data.source}
+        bb = data.blackbox
+        l, n = model.n_parameters, bb.n_states
+        z = ca.MX.sym("z", l + n * n)
+        theta = z[:l]
+        T = ca.reshape(z[l:], n, n).T  # row-major vec T
+        mats = casadi_matrices(model, theta)
+        f = (ca.sumsqr(T @ ca.DM(bb.A) - mats["A"] @ T) + ca.sumsqr(T @ ca.DM(bb.B) - mats["B"])
+             + ca.sumsqr(ca.DM(bb.C) - mats["C"] @ T))
+        if self.misfit_F.with_d:
+            f = f + ca.sumsqr(ca.DM(bb.D) - mats["D"])
+        lb, ub = positivity_bounds(model.positive, positivity, np.ones(l))
+        self._solver = IpoptSolver("symid_ipopt_similarity", z, f / self.misfit_F.scale,
+                                   lbz=np.concatenate([lb, np.full(n * n, -np.inf)]),
+                                   ubz=np.concatenate([ub, np.full(n * n, np.inf)]), max_iter=max_iter, tol=tol,
+                                   hessian="exact")
+
+    def run(self, x0: np.ndarray) -> StartOutcome:
+        """Solve from the start x₀; never raises on solver failure."""
+        x0 = np.asarray(x0, dtype=float)
+        theta0, T0, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
+        run = self._solver.solve(self.misfit_F.join(theta0, T0))
+        theta, T = self.misfit_F.split(run.z)
+        return self.transform_outcome(x0, theta, T, finished=run.finished, status=run.status,
+                                      message=f"IPOPT: {run.status}", iterations=run.iterations,
+                                      wall_time=run.seconds)
+
+
+class IpoptSimilarityFRF(SimilarityEstimator):
+    """IPOPT on the black box's frequency response (a second-order model), ranked by the black-box misfit.
+
+    The second-order models of chapter 7 are not affine in state-space form, so (6-9)
+    does not apply; nonlinear least squares on the black box's response on the misfit
+    grid (:class:`~symid.fit.frf.ipopt.IpoptFRF`, with its options) does.
+    """
+
+    method = "ipopt"
+
+    def __init__(self, model: Any, data: SimilarityData, *, scale: Any = None, positivity: bool = True,
+                 hessian: str = "exact", max_iter: int = 3000, tol: float = 1e-12):
+        from symid.fit.frf.ipopt import IpoptFRF
+
+        self.model, self.data, self.frf = model, data, data.frf
+        self.inner = IpoptFRF(model, data.frf, scale=scale, positivity=positivity, hessian=hessian,
+                              max_iter=max_iter, tol=tol)
+        self.options = {**self.inner.options, "black_box": data.source, "data": "black-box frequency response"}
+
+    def run(self, x0: np.ndarray) -> StartOutcome:
+        """IPOPT from x₀ on the black box's response; the outcome judged by the black-box misfit."""
+        out = self.inner.run(x0)
+        return self.outcome(x0, out.theta, finished=out.finished, status=out.status, message=out.message,
+                            iterations=out.iterations, wall_time=out.wall_time)

@@ -1,0 +1,39 @@
+"""Estimation from output and input power spectra (thesis chapter 5).
+
+=======  ==============================================================  =============================
+method   what it solves                                                  module
+=======  ==============================================================  =============================
+scr      Algorithm 5.1 with M, V, K ⪰ 0 (full set of known sensors)      :mod:`~symid.fit.spectra.scr`
+ipopt    nonlinear least squares on (5-13)                               :mod:`~symid.fit.spectra.ipopt`
+=======  ==============================================================  =============================
+
+Spectra have no linear least-squares special case (Φyy = H Φuu Hᴴ is quadratic in H).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from symid.errors import ModelError
+from symid.fit.base import Estimator
+
+__all__ = ["METHODS", "prepare"]
+
+METHODS = ("scr", "ipopt")
+
+
+def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
+            noise_floor: float | None = None) -> Estimator:
+    """The estimator of ``method`` for a second-order model and spectra, its options checked."""
+    if method == "scr":
+        from symid.fit.spectra.scr import ScrPSD
+
+        return ScrPSD.create(model, data, options, noise_floor=noise_floor)
+    if method == "ipopt":
+        from symid.fit.spectra.ipopt import IpoptPSD
+
+        return IpoptPSD.create(model, data, options, noise_floor=noise_floor)
+    if method == "ls":
+        raise ModelError("spectral data have no linear least-squares special case (Φyy = H Φuu Hᴴ is quadratic "
+                         "in H); use method='scr' or 'ipopt'")
+    raise ModelError(f"unknown method {method!r} for spectral data; choose one of {', '.join(METHODS)}")

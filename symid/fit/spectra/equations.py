@@ -1,0 +1,207 @@
+"""Spectral data for a second-order model: the checks, the equations (5-6)/(5-8) and the misfit.
+
+For a full set of sensors (C square, invertible and known) the relation (5-3)
+Φyy = H Φuu Hᴴ with H = C X⁻¹ B and X(θ, ω) = −ω²M(θ) + jωV(θ) + K(θ) (5-7) is
+equivalent to the quadratic matrix equalities of thesis (5-6)/(5-8)::
+
+    X(θ, ωᵢ) Pᵢ X(θ, ωᵢ)ᴴ = Qᵢ,   Pᵢ = C⁻¹ Φyy(ωᵢ) C⁻ᴴ / |fᵢ|²,   Qᵢ = B Φuu(ωᵢ) Bᴴ,
+
+where fᵢ = 1, jωᵢ or −ωᵢ² for position, velocity or acceleration outputs (y = fᵢ C q).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from symid.errors import DataError, ModelError
+from symid.fit.base import Estimator
+from symid.secondorder import SecondOrderModel
+
+__all__ = ["SpectraEstimator", "SpectralEquations", "check_spectral", "model_spectra", "spectral_equations",
+           "spectral_misfit", "spectral_residuals"]
+
+
+@dataclass(frozen=True)
+class SpectralEquations:
+    """The data of (5-8): Pᵢ, Qᵢ and the affine X(θ, ωᵢ) = X0ᵢ + Σₖ θₖ Xᵢₖ.
+
+    Attributes
+    ----------
+    w : numpy.ndarray, shape (s,)
+        Angular frequencies (rad/s).
+    P : numpy.ndarray, shape (s, n, n)
+        C⁻¹ Φyy C⁻ᴴ / |fᵢ|², Hermitian.
+    Q : numpy.ndarray, shape (s, n, n)
+        B Φuu Bᴴ, Hermitian.
+    X0 : numpy.ndarray, shape (s, n, n)
+        Constant part of X(θ, ωᵢ).
+    Xc : numpy.ndarray, shape (s, n, n, l)
+        Coefficient of each parameter in X(θ, ωᵢ).
+    """
+
+    w: np.ndarray
+    P: np.ndarray
+    Q: np.ndarray
+    X0: np.ndarray
+    Xc: np.ndarray
+
+    def X(self, theta: np.ndarray) -> np.ndarray:
+        """X(θ, ωᵢ) for every frequency, shape (s, n, n)."""
+        return self.X0 + self.Xc @ np.asarray(theta, dtype=float)
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        """‖X Pᵢ Xᴴ − Qᵢ‖_F per frequency."""
+        X = self.X(theta)
+        R = X @ self.P @ np.conj(np.swapaxes(X, 1, 2)) - self.Q
+        return np.linalg.norm(R, axis=(1, 2))
+
+
+def check_spectral(model: Any, data: Any) -> None:
+    """Refuse a model that is not second order, or spectra of the wrong size or too few frequencies."""
+    if not isinstance(model, SecondOrderModel):
+        raise ModelError(f"spectral identification (thesis ch. 5) needs a SecondOrderModel; got "
+                         f"{type(model).__name__}")
+    p, m = data.n_outputs, data.n_inputs
+    if (p, m) != (model.n_outputs, model.n_inputs):
+        raise DataError(f"the spectra have {p} output(s) (Phi_yy {p}×{p}) and {m} input(s) (Phi_uu {m}×{m}); "
+                        f"the model has {model.n_outputs} output(s) and {model.n_inputs} input(s)")
+    s, l = data.n_frequencies, model.n_parameters
+    if s * p * p < l:  # a Hermitian p×p spectrum holds p² real numbers
+        need = -(-l // (p * p))
+        raise DataError(f"{s} frequencies give {s * p * p} real equations (p² = {p * p} per Hermitian p×p "
+                        f"spectrum) for {l} unknown parameters: at least {need} frequencies are needed")
+
+
+def spectral_equations(model: Any, data: Any) -> SpectralEquations:
+    """Build (5-8) from a model and spectra, refusing what Algorithm 5.1 cannot treat.
+
+    Parameters
+    ----------
+    model : SecondOrderModel
+        With a known (parameter-free) square invertible C and a known B.
+    data : SpectralData
+
+    Returns
+    -------
+    SpectralEquations
+
+    Raises
+    ------
+    ModelError
+        Not a second-order model; C not square, singular or parameterised (the full
+        sensor set of thesis §5-3/§5-5 is required); B parameterised.
+    DataError
+        Spectra of the wrong size, or too few frequencies.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[2]])
+    >>> spec = si.simulate_spectra(model, [1.0, 0.5, 4.0], [1.0, 2.0, 3.0], Phi_uu=3.0)
+    >>> from symid.fit.spectra.equations import spectral_equations
+    >>> eq = spectral_equations(model, spec)
+    >>> bool(np.allclose(eq.residuals([1.0, 0.5, 4.0]), 0))   # X P Xᴴ = Q at the truth
+    True
+    """
+    check_spectral(model, data)
+    maps = model.maps
+    n, p = model.n_dof, model.n_outputs
+    if not maps["C"].is_constant:
+        raise ModelError("Algorithm 5.1 needs a full set of known sensors (thesis §5-5, Pᵢ = C⁻¹ Φyy C⁻ᴴ): "
+                         "C must hold no parameter")
+    if p != n:
+        raise ModelError(f"Algorithm 5.1 needs a full set of sensors (thesis §5-3/§5-5, Pᵢ = C⁻¹ Φyy C⁻ᴴ): "
+                         f"C must be square and invertible, p = n = {n}; this model has C of shape {p}×{n}")
+    C = maps["C"].X0
+    cond = np.linalg.cond(C)
+    if not np.isfinite(cond) or cond > 1e12:
+        raise ModelError(f"Algorithm 5.1 needs a full set of sensors (thesis §5-5, Pᵢ = C⁻¹ Φyy C⁻ᴴ): C must "
+                         f"be invertible; this {n}×{n} C is singular (condition number {cond:.3g})")
+    if not maps["B"].is_constant:
+        raise ModelError("Algorithm 5.1 needs a known input matrix B (Qᵢ = B Φuu Bᴴ would be quadratic in θ): "
+                         "B must hold no parameter")
+    w = np.asarray(data.w, dtype=float)
+    Ci = np.linalg.inv(C)
+    f2 = {"position": np.ones_like(w), "velocity": w**2, "acceleration": w**4}[model.output]
+    P = Ci @ np.asarray(data.Phi_yy, dtype=complex) @ Ci.conj().T / f2[:, None, None]
+    B = maps["B"].X0
+    Q = B @ np.asarray(data.Phi_uu, dtype=complex) @ B.conj().T
+    P = 0.5 * (P + np.conj(np.swapaxes(P, 1, 2)))
+    Q = 0.5 * (Q + np.conj(np.swapaxes(Q, 1, 2)))
+    coef = {k: np.moveaxis(maps[k].Xi, 0, -1) for k in "MVK"}  # (n, n, l)
+    W = w[:, None, None]
+    X0 = -(W**2) * maps["M"].X0 + 1j * W * maps["V"].X0 + maps["K"].X0
+    Xc = (-(W[..., None] ** 2) * coef["M"] + 1j * W[..., None] * coef["V"] + coef["K"])
+    return SpectralEquations(w, P, Q, X0, Xc)
+
+
+def model_spectra(model: Any, theta: Any, w: Any, Phi_uu: np.ndarray) -> np.ndarray:
+    """Φyy(ωᵢ) = H(ωᵢ, θ) Φuu(ωᵢ) H(ωᵢ, θ)ᴴ (thesis (5-3)), shape (s, p, p); Φuu of shape (s, m, m)."""
+    H = np.asarray(model.frequency_response(theta, w))
+    return H @ Phi_uu @ np.conj(np.swapaxes(H, 1, 2))
+
+
+def _model_spectra_or_none(model: Any, data: Any, theta: Any) -> np.ndarray | None:
+    try:
+        with np.errstate(all="ignore"):
+            Pm = model_spectra(model, theta, data.w, np.asarray(data.Phi_uu))
+    except (ModelError, np.linalg.LinAlgError, FloatingPointError):
+        return None
+    return Pm if np.all(np.isfinite(Pm)) else None
+
+
+def spectral_misfit(model: Any, data: Any, theta: Any) -> float:
+    """Relative squared misfit Σᵢ‖Φyyᵢ − H Φuuᵢ Hᴴ‖²_F / Σᵢ‖Φyyᵢ‖²_F (the objective of (5-13), normalised).
+
+    Returns ``inf`` when the model cannot be evaluated at θ.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> spec = si.simulate_spectra(model, [1.0, 0.5, 4.0], [1.0, 2.0, 3.0], Phi_uu=1.0)
+    >>> from symid.fit.spectra.equations import spectral_misfit
+    >>> spectral_misfit(model, spec, [1.0, 0.5, 4.0]) < 1e-30
+    True
+    """
+    Phi = np.asarray(data.Phi_yy)
+    Pm = _model_spectra_or_none(model, data, theta)
+    if Pm is None:
+        return float("inf")
+    den = float(np.sum(np.abs(Phi) ** 2))
+    return float(np.sum(np.abs(Phi - Pm) ** 2) / (den if den > 0 else 1.0))
+
+
+def spectral_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:
+    """(Φyyᵢ − H Φuuᵢ Hᴴ) / ‖Φyyᵢ‖_F per frequency, frequency first; ``None`` if not evaluable."""
+    Phi = np.asarray(data.Phi_yy)
+    Pm = _model_spectra_or_none(model, data, theta)
+    if Pm is None:
+        return None
+    nrm = np.linalg.norm(Phi, axis=(1, 2))[:, None, None]
+    return np.where(nrm > 0, (Phi - Pm) / np.where(nrm > 0, nrm, 1.0), 0.0)
+
+
+class SpectraEstimator(Estimator):
+    """Base of the spectral methods: their data misfit (relative, squared, on Φyy)."""
+
+    cost_kind = "relative spectral misfit Σ‖Φyyᵢ − H Φuuᵢ Hᴴ‖²_F / Σ‖Φyyᵢ‖²_F"
+
+    def misfit(self, theta: np.ndarray) -> float:
+        """:func:`spectral_misfit` of the model at θ."""
+        return spectral_misfit(self.model, self.data, theta)
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray | None:
+        """:func:`spectral_residuals` at θ."""
+        return spectral_residuals(self.model, self.data, theta)
+
+    def n_data(self) -> int:
+        """s·p² real values (a Hermitian p×p spectrum per frequency)."""
+        Phi = np.asarray(self.data.Phi_yy)
+        return int(Phi.shape[0] * Phi.shape[1] ** 2)
