@@ -17,7 +17,8 @@ zero start first, as thesis ch. 3):
   estimate is polished. Built and run on its own (nothing shared with the ``scr`` row);
   time per start = SCR + every polish, trials included;
 - ``ipopt``: CasADi ``nlpsol`` with exact Hessian, objective normalised by Σ‖Hᵢ‖², bounds
-  θ ≥ 0 on parameters declared positive, tolerance 1e-12 (scr-lessons 3 and 11). Other
+  θ ≥ 0 on parameters declared positive, tolerance 1e-12 (the normalised objective keeps
+  IPOPT from stopping early on a small raw objective). Other
   IPOPT configurations (L-BFGS, no bounds, parameter scaling, looser tolerance) run from
   the same starts too, to show the default is IPOPT at its best here.
 
@@ -25,7 +26,7 @@ Success: ‖θ̂ − θ*‖₂/‖θ*‖₂ ≤ 1e-3. Time to solution: (setup +
 Also measured: SCR's wall time from the all-zero start to ‖θ̂ − θ*‖₂ ≤ 1e-6 on the belt
 drive, with the import and model setup excluded but the problem construction included.
 
-Run (one BLAS thread per process, scr-lessons 12)::
+Run (one BLAS thread per process: threaded BLAS slows the many small solves on 2 cores)::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/frf.py [--starts 20] [--seed 0]
 

@@ -11,7 +11,7 @@ shared; absolute times move with its load, which is recorded):
    cold start). Also the iterations and time each needs to bring the bilinear residual
    below 1e-5 and 1e-7, and the mean time per iteration over those runs (ADMM sub-problems
    need more inner steps as the tolerance tightens with the residual). With presolve the
-   product solves this problem exactly (scr-lessons 7); this is the thesis's formulation.
+   product solves this problem exactly (the known rows fix every Γᵢ); this is the thesis's formulation.
 2. **Scaling in s and block size b** (synthetic stand-in for (3-15)): s blocks, one per
    frequency, A(θ)Γᵢ = jωᵢΓᵢ − b(θ) with θ ∈ R⁴ shared, Γᵢ ∈ C^{b×1} private, random dense
    coefficients so nothing is presolved away. ADMM runs exactly 50 inner iterations per
@@ -20,7 +20,8 @@ shared; absolute times move with its load, which is recorded):
 3. **Growth**: the exponent k of time per SCR iteration ∝ s^k, fitted per block size on
    process CPU time (wall time on a shared 2-core machine moves by 2–3× with other jobs).
 
-Run (one BLAS thread, scr-lessons 12)::
+Run (one BLAS thread: with threaded BLAS the many small solves of the ADMM back end run
+slower on this 2-core machine)::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/scr_engine.py
 

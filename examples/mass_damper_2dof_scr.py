@@ -12,7 +12,7 @@ Asserts (thesis Figure 4-5: 6 of 10 within 200 iterations, 8 eventually):
 - with acceleration output (4-9) instead of position, the same starts recover the same θ
   (best estimates agree to 1e-3 relative, and at least 8 of 10 succeed).
 The zero start is reported, not asserted (the thesis gets stuck at m1 = k1 = c1 = 0;
-scr-lessons 9: its fate depends on the solver).
+its fate depends on the sub-problem solver).
 """
 
 from __future__ import annotations

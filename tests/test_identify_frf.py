@@ -130,7 +130,7 @@ def test_compare_same_starts_for_two_methods():
 
 def test_scr_belt_drive_from_zeros():
     """Thesis §3-6: from the all-zero start ‖θ̂ − θ*‖₂ ≤ 1e-6 (thesis (3-21): 3.5e-7). With C and the first
-    two rows of A known, presolve turns (3-10) into linear equalities that fix every Γᵢ (scr-lessons 7)."""
+    two rows of A known, presolve turns (3-10) into linear equalities that fix every Γᵢ."""
     entry = si.load_model("belt_drive")
     res = si.identify(entry.model, entry.data(), method="scr")
     assert res.method == "scr" and res.success, res.message

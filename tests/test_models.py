@@ -17,7 +17,7 @@ TRUTH_2DOF = {"m1": 1, "m2": 1, "c1": 0.1, "c2": 0.3, "k1": 2, "k2": 1}  # thesi
 
 
 def two_dof(output="position"):
-    """The 2-DOF mass-damper of thesis (4-19), with the parameter names of design.md."""
+    """The 2-DOF mass-damper of thesis (4-19), with the parameter names of the README tour."""
     m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
     return si.SecondOrderModel(
         M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]], K=[[k1 + k2, -k2], [-k2, k2]],

@@ -105,7 +105,7 @@ def test_presolve_splits_constant_rows_and_solves_belt_drive_exactly():
     red = presolve(prob, split=False)
     assert len(red.terms) == 10 and red.terms[0].dims == (6, 6, 6, 2)  # whole complex 3×3 block, (2-8)
     red = presolve(prob)
-    # scr-lessons 7: known rows of A and the output equation fix every Γ_i; the last row is then
+    # known rows of A and the output equation fix every Γ_i; the last row is then
     # linear in θ and, with 10 frequencies, fixes θ too: no unknown is left, no SCR iteration needed
     assert red.terms == [] and red.nz == 0 and red.info["fixed"] == 64
     for backend in ("admm", "cvxpy"):
@@ -333,7 +333,7 @@ def test_admm_warm_start_and_tightening():
     # warm start across SCR iterations: the cold first sub-problem costs far more ADMM steps than the next ones
     assert inner[0] > 10 * np.median(inner[1:10])
     # with loose ADMM tolerances the reachable bilinear residual is capped near them, unless the
-    # tolerances are tightened to the residual as SCR converges (ADMMOptions.tighten, scr-lessons 8)
+    # tolerances are tightened to the residual as SCR converges (ADMMOptions.tighten)
     loose = {"eps_rel": 1e-4, "eps_abs": 1e-5}
     capped = scr.solve(prob, x0=x0, admm=scr.ADMMOptions(tighten=None, **loose), **opts)
     tightened = scr.solve(prob, x0=x0, admm=scr.ADMMOptions(**loose), **opts)

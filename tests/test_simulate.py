@@ -22,7 +22,7 @@ def siso():
 
 @pytest.fixture(scope="module")
 def two_mass():
-    # the two-mass chain of design.md "Public API"
+    # the two-mass chain of thesis (4-19), as in the README tour
     m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
     truth = {"m1": 1, "m2": 1, "c1": 0.1, "c2": 0.3, "k1": 2, "k2": 1}
 

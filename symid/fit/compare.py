@@ -91,6 +91,19 @@ class Comparison:
     A start counts as a success when its relative parameter error ‖θ − θ*‖₂/‖θ*‖₂ is
     ≤ ``param_tol`` if the truth is known, otherwise when the start's own ``success``
     holds (the solver finished and the estimate fits the data, :mod:`symid.fit.success`).
+
+    Attributes
+    ----------
+    stats : tuple of MethodStats
+        One row per method, in the order asked (``cmp["scr"]`` picks one by name).
+    n_starts : int
+        Starts per method (identical for every method).
+    seed : int or None
+        Seed of the starts.
+    criterion : str
+        What counted as a success.
+    truth : dict or None
+        The true parameters, when given.
     """
 
     stats: tuple[MethodStats, ...]

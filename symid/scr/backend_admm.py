@@ -23,13 +23,14 @@ over-relaxation α (Boyd et al. 2011, §3.4.3):
   ρ‖u‖ times the RMS column norm of 𝒜 rather than by ‖𝒜ᵀΛ‖, which vanishes at the
   optimum of a feasibility problem;
 * the tolerances shrink with the last bilinear residual (``tighten``), so the reachable
-  SCR residual is not capped by the ADMM tolerance (scr-lessons 8);
+  SCR residual is not capped by the ADMM tolerance (with fixed loose tolerances the
+  bilinear residual stalls near them: tests/test_scr_problem.py shows it);
 * ρ is rebalanced from the ratio of the normalised residuals (residual balancing, as in
   OSQP) when they differ by more than a factor 5; the KKT matrix is then refactorised.
 
 No Python loop runs over blocks: only over the few groups of equal-shape blocks. The state
 (z, the scaled duals) is kept between SCR iterations (warm start); the inner-iteration
-budget is raised by the SCR loop when the residual stalls (scr-lessons 8).
+budget is raised by the SCR loop when the residual stalls.
 """
 
 from __future__ import annotations
@@ -211,7 +212,7 @@ class ADMMBackend:
         self.taus = [g.weight / self.rho for g in groups]
 
     def on_stall(self) -> None:
-        """Double the inner-iteration cap if the last sub-problem hit it (scr-lessons 8)."""
+        """Double the inner-iteration cap if the last sub-problem hit it."""
         if self.hit_cap:
             self.inner = min(2 * self.inner, self.opt.inner_max)
 

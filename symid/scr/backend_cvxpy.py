@@ -3,8 +3,9 @@
 M_t(z) = m0_t + G_t z[idx_t] (2-6) depends on Q, R only through the numbers m0_t and
 G_t, which are cvxpy ``Parameter``s, one pair per block, multiplying the block's own
 entries of z. Parameter × variable is DPP, and no product of two parameters appears
-(scr-lessons 10), so cvxpy compiles the problem once per ``solve`` and every SCR
-iteration only refreshes the parameter values and re-solves. Per-block parameters keep
+(such a product is not DPP and would force a new compilation), so cvxpy compiles the
+problem once per ``solve`` and every SCR iteration only refreshes the parameter values
+and re-solves. Per-block parameters keep
 the compiled parameter tensor linear in the number of blocks (slicing one long
 parameter vector per block made compilation quadratic).
 """

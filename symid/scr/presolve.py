@@ -1,4 +1,4 @@
-"""Presolve: keep bilinear only what is bilinear (scr-lessons 1 and 7), go real, normalise.
+"""Presolve: keep bilinear only what is bilinear, go real, normalise.
 
 1. For every bilinear term, rows of A(x) that are constant make the same rows of
    A(x) P B(x) − C(x) affine, and so do constant columns of B(x): those rows and columns

@@ -54,6 +54,13 @@ class Bilinear:
 class SumSquares:
     """Objective term ``weight * ||F(x)||_F^2`` for an affine (possibly complex) map F.
 
+    Parameters
+    ----------
+    F : Affine or sympy matrix
+        The affine map F(x).
+    weight : float, optional
+        Its weight (default 1).
+
     Examples
     --------
     >>> import numpy as np

@@ -63,7 +63,7 @@ def implied_equalities(T: scr.Variable, S: scr.Variable, bbA: np.ndarray, Bb: np
     A(θ) or C(θ), or a column of A(θ) or B(θ), holds no parameter, the matching rows of
     T𝔸 = A(θ)T and ℂ = C(θ)T, or columns of 𝔸S = SA(θ) and 𝔹 = SB(θ), are linear in T
     or S. Adding them changes no solution but tightens every convex sub-problem, and
-    the engine's presolve eliminates what they determine (scr-lessons 1 and 7; thesis
+    the engine's presolve eliminates what they determine (:mod:`symid.scr.presolve`; thesis
     §7-7-1 suggests the same reduction for chapter 7, where (7-12a, b) fix half of T).
 
     ``A``, ``B``, ``C`` are (constant part, coefficients (l, r, c)) of the model maps; ``B``
