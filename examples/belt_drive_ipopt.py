@@ -21,7 +21,8 @@ import symid as si
 from symid.fit.compare import relative_parameter_error
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
+    """Run the comparison (about 2 s; ``argv`` is accepted for a uniform interface and ignored)."""
     entry = si.load_model("belt_drive")
     model, data = entry.model, entry.data()
     truth = model.theta_vector(entry.truth)  # thesis (3-18)
@@ -42,7 +43,8 @@ def main() -> None:
             print(f"  {method}: {ok}/{len(starts)} succeed")
             if method == "scr":
                 assert ok == len(starts), (label, ok)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

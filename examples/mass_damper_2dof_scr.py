@@ -17,6 +17,7 @@ its fate depends on the sub-problem solver).
 
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -34,36 +35,43 @@ def run(model, data, starts, truth):
     return rows
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
+    """Run the example; with ``--quick`` (in ``argv``) 3 starts, position output only, at least 2 succeed."""
+    quick = "--quick" in (sys.argv[1:] if argv is None else argv)
     entry = si.load_model("mass_damper_2dof")
     model = entry.model
     truth = model.theta_vector(entry.truth)  # thesis (4-20)
     rng = np.random.default_rng(0)
-    random_starts = [rng.standard_normal(model.n_parameters) for _ in range(10)]
+    n_random = 3 if quick else 10
+    random_starts = [rng.standard_normal(model.n_parameters) for _ in range(n_random)]
     zero = np.zeros(model.n_parameters)
     names = ", ".join(model.parameter_names)
     best = {}
-    for output in ("position", "acceleration"):
+    for output in ("position",) if quick else ("position", "acceleration"):
         mats = model.symbolic
         m = si.SecondOrderModel(M=mats["M"], V=mats["V"], K=mats["K"], B=mats["B"], C=mats["C"], output=output,
                                 parameters=model.parameters)
         data = si.simulate_frf(m, truth, entry.extra["w"])
-        print(f"\n{output} output: SCR from 10 N(0, 1) starts (seed 0) and from zero; θ = ({names})")
+        print(f"\n{output} output: SCR from {n_random} N(0, 1) starts (seed 0) and from zero; θ = ({names})")
         rows = run(m, data, [*random_starts, zero], truth)
         for x0, res, err, wall in rows:
             est = np.array2string(res.theta_vector, precision=3)
             print(f"  θ0 = {np.array2string(x0, precision=2, suppress_small=True):>44s}  rel. error {err:8.1e}  "
                   f"iterations {res.iterations:4d}  {wall:6.1f} s  θ̂ = {est}")
-        ok = sum(err <= 1e-3 for _, _, err, _ in rows[:10])
-        x0, res, err, _ = rows[10]
-        print(f"  random starts: {ok}/10 reach relative error ≤ 1e-3 (thesis: 6 within 200 iterations, 8 eventually)")
+        ok = sum(err <= 1e-3 for _, _, err, _ in rows[:n_random])
+        x0, res, err, _ = rows[n_random]
+        print(f"  random starts: {ok}/{n_random} reach relative error ≤ 1e-3 (thesis: 6 of 10 within 200 iterations, "
+              "8 eventually)")
         print(f"  zero start: relative error {err:.1e} after {res.iterations} iterations; {res.message}")
-        assert ok >= 8, ok
-        best[output] = min(rows[:10], key=lambda r: r[1].cost)[1].theta_vector
+        assert ok >= (2 if quick else 8), ok
+        best[output] = min(rows[:n_random], key=lambda r: r[1].cost)[1].theta_vector
+    if quick:
+        return 0
     agree = relative_parameter_error(best["acceleration"], best["position"])
     print(f"\nbest estimates, acceleration vs position output: relative difference {agree:.1e}")
     assert agree <= 1e-3, agree
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -1,6 +1,10 @@
 """Output-only identification of M, V, K from estimated power spectra (thesis ch. 5, issue 6 item 4).
 
-Run: python examples/psd_output_only.py [--out DIR] [--seed S] [--backend admm|cvxpy] [--repeat K]
+Run: python examples/psd_output_only.py [--out DIR] [--seed S] [--backend admm|cvxpy] [--repeat K] [--quick]
+
+``--quick`` is the reduced variant the test suite runs: 30 s of record, nperseg 1024, SCR
+only, and every parameter asserted within ``QUICK_TOL`` (shorter records and segments
+give larger errors; see the module notes on Welch settings).
 
 The experiment
 --------------
@@ -83,6 +87,7 @@ PHI = 1.0  # force intensity, N²·s
 DT = 1e-3  # s
 BAND = (23.0, 370.0)  # rad/s: 0.3 ω1 to 2 ω2
 TOL = 0.05  # issue 6 item 4: M, V, K within 5 % relative error
+QUICK_TOL = 0.15  # --quick: 3 × the worst Cramér–Rao std. of a 30 s record (c1: 5.0 %); seeds 0–2 gave ≤ 7.4 %
 BURN_IN = 2.0  # s of start-up discarded
 
 
@@ -230,15 +235,17 @@ def single_run(args: argparse.Namespace, model: si.SecondOrderModel) -> None:
 
     scr = si.identify(model, spec, method="scr", backend=args.backend, starts=args.starts, seed=args.seed)
     scr_err = report(f"SCR (Algorithm 5.1, {args.backend})", model, scr)
-    ipopt = si.identify(model, spec, method="ipopt", starts=args.starts, seed=args.seed)
-    report("IPOPT on (5-13), the same starts (for comparison, not asserted)", model, ipopt)
+    if not args.quick:
+        ipopt = si.identify(model, spec, method="ipopt", starts=args.starts, seed=args.seed)
+        report("IPOPT on (5-13), the same starts (for comparison, not asserted)", model, ipopt)
 
     path = plot_spectra(model, spec, si.estimate_spectra(y, dt=DT, Phi_uu=PHI, nperseg=args.nperseg),
                         scr.theta_vector, out / "spectra.png",
                         f"Output-only 2-DOF frame: Welch estimate of {args.duration:g} s (nperseg {args.nperseg}) "
                         f"against the model spectra; SCR max. rel. error {scr_err[:6].max():.2%}")
     print(f"\nplot: {path}   total time {time.perf_counter() - t0:.1f} s")
-    assert np.all(scr_err <= TOL), f"SCR misses the 5 % target (issue 6 item 4): {scr_err}"
+    tol = QUICK_TOL if args.quick else TOL
+    assert np.all(scr_err <= tol), f"SCR misses the {tol:.0%} target: {scr_err}"
 
 
 def repeated_runs(args: argparse.Namespace, model: si.SecondOrderModel) -> None:
@@ -265,7 +272,8 @@ def repeated_runs(args: argparse.Namespace, model: si.SecondOrderModel) -> None:
     print(f"records with every parameter within {TOL:.0%}: {inside}/{len(E)}")
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
+    """Run the example with command-line arguments ``argv`` (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="./psd-output-only/", help="directory of the PNG (default %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the force and of the starts")
@@ -276,13 +284,18 @@ def main() -> None:
     parser.add_argument("--zoh", action="store_true", help="pass the held force's exact spectrum φ·sinc²(ω dt/2)")
     parser.add_argument("--repeat", type=int, default=0,
                         help="instead: SCR on this many seeded records, print the error distribution")
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true",
+                        help="reduced variant: 30 s record, nperseg 1024, SCR only (what the tests run)")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.duration, args.nperseg = 30.0, 1024
     model = frame_model()
     if args.repeat:
         repeated_runs(args, model)
     else:
         single_run(args, model)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())
