@@ -144,7 +144,7 @@ def check_scale(name: str, value: Any, size: int) -> np.ndarray:
     bad = ~np.isfinite(arr) | (arr <= 0)
     if bad.any():
         k = int(np.argmax(bad))
-        raise OptionError(f"{name}[{k}] = {arr[k]!r}; every entry must be a positive finite number")
+        raise OptionError(f"{name}[{k}] = {float(arr[k])!r}; every entry must be a positive finite number")
     return arr.copy()
 
 

@@ -19,6 +19,8 @@ def check_frf(model: Any, data: Any) -> None:
     if (p, m) != (model.n_outputs, model.n_inputs):
         raise DataError(f"data H has {p} output(s) × {m} input(s) per frequency; the model has "
                         f"{model.n_outputs} output(s) × {model.n_inputs} input(s)")
+    if not np.any(np.asarray(data.H)):
+        raise DataError("the frequency response H is zero at every frequency: there is nothing to fit")
     equations = 2 * s * p * m
     if equations < model.n_parameters:
         need = math.ceil(model.n_parameters / (2 * p * m))
@@ -32,6 +34,15 @@ def _model_response(model: Any, data: Any, theta: Any) -> np.ndarray | None:
     except (ModelError, np.linalg.LinAlgError, FloatingPointError):
         return None
     return Hm if np.all(np.isfinite(Hm)) else None
+
+
+def _relative(H: np.ndarray, Hm: np.ndarray) -> float:
+    """Σ|H − Hm|² / Σ|H|², computed on H / max|H| so that neither sum under- or overflows."""
+    scale = float(np.max(np.abs(H)))
+    if scale == 0.0 or not np.isfinite(scale):
+        return 0.0 if not np.any(Hm) else float("inf")
+    den = float(np.sum(np.abs(H / scale) ** 2))
+    return float(np.sum(np.abs((H - Hm) / scale) ** 2) / den)
 
 
 def relative_misfit(model: Any, data: Any, theta: Any) -> float:
@@ -51,12 +62,8 @@ def relative_misfit(model: Any, data: Any, theta: Any) -> float:
     >>> relative_misfit(model, frf, [2.0, 0.5, 3.0])
     0.0
     """
-    H = np.asarray(data.H)
     Hm = _model_response(model, data, theta)
-    if Hm is None:
-        return float("inf")
-    den = float(np.sum(np.abs(H) ** 2))
-    return float(np.sum(np.abs(H - Hm) ** 2) / (den if den > 0 else 1.0))
+    return float("inf") if Hm is None else _relative(np.asarray(data.H), Hm)
 
 
 def relative_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:

@@ -76,8 +76,10 @@ class SimilarityData:
             return float("inf")
         if not np.all(np.isfinite(Hm)):
             return float("inf")
-        den = np.maximum(np.sum(np.abs(H) ** 2, axis=(1, 2)), 1e-300)
-        return float(np.mean(np.sum(np.abs(H - Hm) ** 2, axis=(1, 2)) / den))
+        scale = np.max(np.abs(H), axis=(1, 2), keepdims=True)  # per frequency: no under- or overflow
+        scale = np.where(scale > 0, scale, 1.0)
+        den = np.maximum(np.sum(np.abs(H / scale) ** 2, axis=(1, 2)), 1e-300)
+        return float(np.mean(np.sum(np.abs((H - Hm) / scale) ** 2, axis=(1, 2)) / den))
 
 
 def _model_has_feedthrough(model: Any) -> bool:

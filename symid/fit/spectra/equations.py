@@ -68,6 +68,11 @@ def check_spectral(model: Any, data: Any) -> None:
     if (p, m) != (model.n_outputs, model.n_inputs):
         raise DataError(f"the spectra have {p} output(s) (Phi_yy {p}×{p}) and {m} input(s) (Phi_uu {m}×{m}); "
                         f"the model has {model.n_outputs} output(s) and {model.n_inputs} input(s)")
+    if not np.any(np.asarray(data.Phi_yy)):
+        raise DataError("the output spectrum Phi_yy is zero at every frequency: there is nothing to fit")
+    if not np.any(np.asarray(data.Phi_uu)):
+        raise DataError("the input spectrum Phi_uu is zero at every frequency: the outputs carry no information "
+                        "about the model (Phi_yy = H Phi_uu H^H)")
     s, l = data.n_frequencies, model.n_parameters
     if s * p * p < l:  # a Hermitian p×p spectrum holds p² real numbers
         need = -(-l // (p * p))
@@ -174,8 +179,10 @@ def spectral_misfit(model: Any, data: Any, theta: Any) -> float:
     Pm = _model_spectra_or_none(model, data, theta)
     if Pm is None:
         return float("inf")
-    den = float(np.sum(np.abs(Phi) ** 2))
-    return float(np.sum(np.abs(Phi - Pm) ** 2) / (den if den > 0 else 1.0))
+    scale = float(np.max(np.abs(Phi)))  # sums on Φ / max|Φ|: no under- or overflow
+    if scale == 0.0:
+        return 0.0 if not np.any(Pm) else float("inf")
+    return float(np.sum(np.abs((Phi - Pm) / scale) ** 2) / np.sum(np.abs(Phi / scale) ** 2))
 
 
 def spectral_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:

@@ -1,0 +1,189 @@
+"""The estimator interface (issue 13): options validated at construction, one error type, ``success``
+that means the data fit for every method, starts tied to parameter names."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import symid as si
+from symid.fit.registry import all_methods, data_kind, data_kinds
+from symid.fit.starts import make_starts
+from symid.fit.success import CEILING, EXACT_FIT, fit_test, whiteness
+
+TRUTH_2DOF = {"m1": 1, "m2": 1, "c1": 0.1, "c2": 0.3, "k1": 2, "k2": 1}  # thesis (4-20)
+
+
+def chain(order=("m1", "m2", "c1", "c2", "k1", "k2")):
+    s = dict(zip(("m1", "m2", "c1", "c2", "k1", "k2"), si.parameters("m1 m2 c1 c2 k1 k2", positive=True),
+                 strict=True))
+    return si.SecondOrderModel(M=[[s["m1"], 0], [0, s["m2"]]], V=[[s["c1"] + s["c2"], -s["c2"]], [-s["c2"], s["c2"]]],
+                               K=[[s["k1"] + s["k2"], -s["k2"]], [-s["k2"], s["k2"]]], B=[[1], [0]], C=[[1, 0]],
+                               parameters=[s[n] for n in order])
+
+
+@pytest.fixture(scope="module")
+def frf():
+    return si.simulate_frf(chain(), TRUTH_2DOF, np.logspace(np.log10(0.5), np.log10(2), 30))
+
+
+# -- options ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize(("method", "options", "match"), [
+    ("scr", {"max_iters": 5}, r"no option 'max_iters' \(did you mean 'max_iter'\?\); its options are: .*max_iter"),
+    ("ipopt", {"bounds": False}, r"no option 'bounds'.*positivity"),
+    ("scr", {"seed": -1}, "seed must be an integer between 0 and"),
+    ("scr", {"seed": 1.5}, "seed must be an integer between 0 and"),
+    ("scr", {"seed": "abc"}, "seed must be an integer between 0 and"),
+    ("ipopt", {"max_iter": -5}, "max_iter must be an integer between 1 and 10000000; got -5"),
+    ("ipopt", {"max_iter": True}, "max_iter must be an integer"),
+    ("ipopt", {"tol": -1}, "tol must be a finite number > 0"),
+    ("ipopt", {"tol": float("nan")}, "tol must be a finite number > 0"),
+    ("scr", {"tol": "x"}, "tol must be a number"),
+    ("ipopt", {"scale": [1.0, 2.0]}, r"scale must be a positive number or 6 positive numbers.*shape \(2,\)"),
+    ("ipopt", {"scale": [1, 1, 1, 0, 1, 1]}, r"scale\[3\] = 0.0"),
+    ("scr", {"backend": "mosek"}, "backend must be one of 'admm', 'cvxpy'; got 'mosek'"),
+    ("scr", {"aux_init": "models"}, "did you mean 'model'"),
+    ("ipopt", {"hessian": "bfgs"}, "hessian must be one of"),
+    ("scr", {"positivity": 1}, "positivity must be True or False"),
+])
+def test_bad_options_are_one_error_type_before_anything_runs(frf, method, options, match, capsys):
+    with pytest.raises(si.OptionError, match=match):
+        si.identify(chain(), frf, method=method, identifiability_check=False, **options)
+    assert capsys.readouterr().out == ""  # nothing from IPOPT's option help on standard output
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"starts": 10**9}, "starts must be an integer between 1 and 100000"),
+    ({"starts": 2.0}, "starts must be an integer"),
+    ({"seed": -3}, "seed must be an integer between 0"),
+    ({"x0": [1.0, 2.0]}, "x0: .*6"),
+    ({"x0": [1, 1, 1, float("nan"), 1, 1]}, "x0: "),
+    ({"polish": "yes"}, "polish must be True or False"),
+    ({"noise_floor": -1.0}, "noise_floor must be a finite number ≥ 0"),
+])
+def test_bad_run_arguments(frf, kwargs, match):
+    with pytest.raises(si.OptionError, match=match):
+        si.identify(chain(), frf, method="ipopt", identifiability_check=False, **kwargs)
+
+
+def test_scr_options_are_not_dropped_when_the_linear_case_runs():
+    # C = I: the linear least squares applies to "scr"; SCR options given are refused, not silently ignored
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    data = si.simulate_frf(model, [2.0, 0.5, 3.0], np.linspace(0.5, 2.0, 5))
+    with pytest.raises(si.OptionError, match="backend, max_iter, tol are SCR options, but the linear least squares"):
+        si.identify(model, data, method="scr", backend="mosek", max_iter=-3, tol="x")
+    with pytest.raises(si.OptionError, match="backend must be one of"):  # with force_scr the values are checked
+        si.identify(model, data, method="scr", backend="mosek", force_scr=True)
+    with pytest.raises(si.OptionError, match="are SCR options, but the linear least squares"):
+        si.identify(model, data, method="scr", max_iter=3)
+    res = si.identify(model, data, method="scr", force_scr=True, max_iter=50)
+    assert res.method == "scr"
+
+
+def test_polish_is_declared_not_probed(frf):
+    with pytest.raises(si.OptionError, match="method 'ipopt' has no polish step"):
+        si.identify(chain(), frf, method="ipopt", polish=True, identifiability_check=False)
+    with pytest.raises(si.OptionError, match="method 'ipopt' has no polish step"):
+        si.compare(chain(), frf, methods=("ipopt+polish",), starts=1)
+
+
+def test_registry_builds_method_lists():
+    assert [k.name for k in data_kinds()] == ["frequency response", "spectra", "black box"]
+    assert data_kind(si.FrequencyData([1.0, 2.0], np.ones(2))).methods == ("scr", "ipopt", "ls")
+    assert set(all_methods()) == {"scr", "ipopt", "ls", "als", "gb"}
+    with pytest.raises(si.DataError, match="symid estimates from FrequencyData"):
+        data_kind(np.ones(3))
+
+
+# -- success ----------------------------------------------------------------------------------
+
+def test_fit_test_rules():
+    # source of the bounds: symid.fit.success (χ² 99.9 % quantile, whiteness limit 3, ceiling 1e-2)
+    assert fit_test(EXACT_FIT, n_data=60, n_parameters=4).rule == "exact"
+    assert fit_test(1.5e-4, n_data=60, n_parameters=4, noise_floor=1e-4).fits  # χ²_{56}(0.999)/60 = 1.55
+    assert not fit_test(1.7e-4, n_data=60, n_parameters=4, noise_floor=1e-4).fits
+    rng = np.random.default_rng(0)
+    noise = rng.standard_normal(200) + 1j * rng.standard_normal(200)
+    assert fit_test(1e-4, n_data=400, n_parameters=4, residuals=noise).fits
+    smooth = np.exp(1j * np.linspace(0, 2, 200))
+    assert not fit_test(1e-4, n_data=400, n_parameters=4, residuals=smooth).fits
+    assert not fit_test(2 * CEILING, n_data=400, n_parameters=4, residuals=noise).fits
+    assert not fit_test(1e-4, n_data=400, n_parameters=4).fits  # no floor, no residuals: exact only
+    assert not fit_test(float("inf"), n_data=4, n_parameters=1).fits
+
+
+def test_whiteness_of_noise_is_standard_normal():
+    # the scaled lag-1 autocorrelation of independent noise is ~N(0, 1): P(z > 3) = 0.13 %; 2000 records
+    rng = np.random.default_rng(1)
+    z = np.array([whiteness(rng.standard_normal((50, 1, 1)) + 1j * rng.standard_normal((50, 1, 1)))
+                  for _ in range(2000)])
+    assert abs(z.mean()) < 0.1 and 0.85 < z.std() < 1.15  # 2000 draws: standard errors 0.02 and 0.016
+    assert np.mean(z > 3) < 0.01
+
+
+def test_success_means_the_data_fit_for_every_method():
+    warnings.simplefilter("ignore", si.IdentifiabilityWarning)
+    belt = si.load_model("belt_drive")
+    # IPOPT from θ = 0 stops at a stationary point with misfit 0.48: its status says success, symid does not
+    res = si.identify(belt.model, belt.data(), method="ipopt", x0=np.zeros(4), identifiability_check=False)
+    assert res.status == "Solve_Succeeded" and not res.success and res.cost > 0.4
+    # H scaled by 1e-200: the misfit is computed without underflow and the fit is not exact
+    tiny = si.FrequencyData(belt.data().w, belt.data().H * 1e-200)
+    res = si.identify(belt.model, tiny, method="ipopt", x0=np.zeros(4), identifiability_check=False)
+    assert not res.success and res.cost > 0.4
+    with pytest.raises(si.DataError, match="zero at every frequency"):
+        si.identify(belt.model, si.FrequencyData(belt.data().w, 0 * belt.data().H), method="ipopt")
+
+
+def test_noisy_data_fit_by_scr_and_ipopt_is_a_success_for_both():
+    model = chain()
+    noisy = si.simulate_frf(model, TRUTH_2DOF, np.logspace(np.log10(0.5), np.log10(2), 30), noise=0.01, seed=1)
+    for method in ("scr", "ipopt"):
+        res = si.identify(model, noisy, method=method, starts=3, seed=0, identifiability_check=False)
+        assert res.success, (method, res.status, res.fit)
+        assert 2e-5 < res.cost < 2e-4  # ε² = 1e-4 times (N − l)/N, within the spread of one record
+    # with the noise floor given, a floor 100 times too small makes the same estimate fail
+    res = si.identify(model, noisy, method="ipopt", starts=3, seed=0, identifiability_check=False, noise_floor=1e-4)
+    assert res.success and "noise floor" in res.fit
+    res = si.identify(model, noisy, method="ipopt", starts=3, seed=0, identifiability_check=False, noise_floor=1e-6)
+    assert not res.success and res.status == "Solve_Succeeded"
+
+
+def test_spectra_with_zero_input_are_refused():
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    spec = si.simulate_spectra(model, [1.0, 0.5, 4.0], np.linspace(0.5, 3, 8), Phi_uu=1.0)
+    with pytest.raises(si.DataError, match="input spectrum Phi_uu is zero"):
+        si.identify(model, si.SpectralData(spec.w, spec.Phi_yy, 0 * spec.Phi_uu), method="ipopt")
+
+
+def test_cost_kind_and_typed_history(frf):
+    res = si.identify(chain(), frf, method="scr", seed=1, max_iter=5, identifiability_check=False)
+    assert res.cost_kind.startswith("relative FRF misfit")
+    h = res.best_start.history
+    assert [it.iteration for it in h] == list(range(1, len(h) + 1)) and h[0].theta.shape == (6,)
+    assert set(h[0].families) == {"[M V K] P Γ = B", "H = f C Γ"}
+
+
+# -- starts -----------------------------------------------------------------------------------
+
+def test_starts_follow_names_not_declaration_order(frf):
+    fwd, rev = chain(), chain(order=("k2", "k1", "c2", "c1", "m2", "m1"))
+    a, b = make_starts(fwd, 5, seed=7), make_starts(rev, 5, seed=7)
+    for sa, sb in zip(a, b, strict=True):
+        np.testing.assert_array_equal(fwd.theta_dict(sa) and [fwd.theta_dict(sa)[n] for n in fwd.parameter_names],
+                                      [rev.theta_dict(sb)[n] for n in fwd.parameter_names])
+    ra = si.identify(fwd, frf, method="ipopt", starts=4, seed=7, identifiability_check=False)
+    rb = si.identify(rev, frf, method="ipopt", starts=4, seed=7, identifiability_check=False)
+    assert [s.success for s in ra.starts] == [s.success for s in rb.starts]
+    assert all(s >= 0 for st in a for s in st)  # declared positive: drawn in absolute value
+
+
+def test_huge_start_does_not_overflow_the_auxiliary_seed(frf):
+    x0 = dict(TRUTH_2DOF, k1=1e13)
+    res = si.identify(chain(), frf, method="scr", x0=x0, max_iter=2, identifiability_check=False)
+    assert res.n_starts == 1 and np.all(np.isfinite(res.theta_vector))
