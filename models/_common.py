@@ -72,11 +72,11 @@ def symmetric_truth(value: np.ndarray, prefix: str = "theta", start: int = 1) ->
 def balanced_realisation(A, B, C) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Balanced realisation (T A T⁻¹, T B, C T⁻¹) of a stable, minimal system (MATLAB ``balreal``).
 
-    The transform is :func:`symid.realisation.balanced_realisation` (square-root method,
+    The transform is :func:`symid.signal.realisation.balanced_realisation` (square-root method,
     both Gramians equal to diag(Hankel singular values), sign of each state fixed by the
     first clearly nonzero entry of its row of T B).
     """
-    from symid.realisation import balanced_realisation as balancing  # lazy: scipy only when a recipe runs
+    from symid.signal.realisation import balanced_realisation as balancing  # lazy: scipy only when a recipe runs
 
     A, B, C = (np.asarray(X, dtype=float) for X in (A, B, C))
     T, Tinv = balancing(A, B, C)

@@ -40,7 +40,7 @@ W = np.logspace(np.log10(0.4), np.log10(0.6), 10)  # rad/s (the thesis's "Hz" ar
 
 def _make_data(model, truth, noise=None, seed=None):
     """FRF of the truth at the 10 log-spaced frequencies in 0.4–0.6 rad/s."""
-    from symid.simulate import simulate_frf
+    from symid.signal.simulate import simulate_frf
 
     return simulate_frf(model, truth, W, noise=noise, seed=seed)
 

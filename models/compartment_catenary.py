@@ -56,7 +56,7 @@ W = np.logspace(np.log10(0.05), np.log10(5), 20)  # rad/s; our choice, the thesi
 
 def _make_data(model, truth, noise=None, seed=None):
     """FRF of the truth at 20 log-spaced frequencies in 0.05–5 rad/s."""
-    from symid.simulate import simulate_frf
+    from symid.signal.simulate import simulate_frf
 
     return simulate_frf(model, truth, W, noise=noise, seed=seed)
 

@@ -49,7 +49,7 @@ V_ESTIMATE_PRINTED = np.array([[0.40, -0.10], [-0.10, 0.10]])  # thesis (4-22): 
 
 def _make_data(model, truth, noise=None, seed=None):
     """FRF of the truth at 30 log-spaced frequencies in 0.5–2 rad/s."""
-    from symid.simulate import simulate_frf
+    from symid.signal.simulate import simulate_frf
 
     return simulate_frf(model, truth, W, noise=noise, seed=seed)
 

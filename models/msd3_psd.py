@@ -66,7 +66,7 @@ F_PRINTED = np.array([[1.0], [0.0], [0.0]])  # thesis (5-10), input matrix
 
 def _make_data(model, truth, noise=None, seed=None):
     """Output spectra for the pink input ω^-0.5 at 170 log-spaced frequencies in 0.1–100 rad/s."""
-    from symid.simulate import simulate_spectra
+    from symid.signal.simulate import simulate_spectra
 
     return simulate_spectra(model, truth, W, PHI_UU, noise=noise, seed=seed)
 

@@ -105,7 +105,7 @@ def _input() -> np.ndarray:
 
 def _make_data(model, truth, noise=None, seed=None):
     """I/O data: N = 5000 samples at dt = 0.001 s for a seeded white Gaussian input."""
-    from symid.simulate import simulate_io
+    from symid.signal.simulate import simulate_io
 
     return simulate_io(model, truth, _input(), DT, noise=noise, seed=seed)
 

@@ -87,7 +87,7 @@ K_PRINTED = np.array([  # thesis (4-15)
 
 def _make_data(model, truth, noise=None, seed=None):
     """FRF (8 x 8) of the truth at 20 log-spaced frequencies in 5–25 rad/s."""
-    from symid.simulate import simulate_frf
+    from symid.signal.simulate import simulate_frf
 
     return simulate_frf(model, truth, W, noise=noise, seed=seed)
 

@@ -21,20 +21,20 @@ from symid.errors import (
     SymidError,
 )
 from symid.fit.result import IdentificationResult, StartOutcome
-from symid.parametric import StateSpaceMatrices
-from symid.secondorder import SecondOrderModel
-from symid.statespace import StateSpaceModel
+from symid.model.lti import StateSpaceMatrices
+from symid.model.secondorder import SecondOrderModel
+from symid.model.statespace import StateSpaceModel
 from symid.symbols import parameters
 from symid.zoo import ZooEntry, list_models, load_model
 
 if TYPE_CHECKING:
     from symid.fit.compare import Comparison, MethodStats, compare
     from symid.fit.identify import identify
-    from symid.simulate import simulate_frf, simulate_io, simulate_spectra
-    from symid.spectra import estimate_spectra
+    from symid.signal.simulate import simulate_frf, simulate_io, simulate_spectra
+    from symid.signal.spectra import estimate_spectra
+    from symid.signal.subspace import n4sid
+    from symid.signal.zoh import d2c
     from symid.structural import IdentifiabilityReport, identifiability
-    from symid.subspace import n4sid
-    from symid.zoh import d2c
 
 __version__ = "0.1.0"
 
@@ -42,13 +42,13 @@ _LAZY = {
     "Comparison": "symid.fit.compare",
     "MethodStats": "symid.fit.compare",
     "compare": "symid.fit.compare",
-    "d2c": "symid.zoh",
-    "n4sid": "symid.subspace",
+    "d2c": "symid.signal.zoh",
+    "n4sid": "symid.signal.subspace",
     "identify": "symid.fit.identify",
-    "simulate_frf": "symid.simulate",
-    "simulate_io": "symid.simulate",
-    "simulate_spectra": "symid.simulate",
-    "estimate_spectra": "symid.spectra",
+    "simulate_frf": "symid.signal.simulate",
+    "simulate_io": "symid.signal.simulate",
+    "simulate_spectra": "symid.signal.simulate",
+    "estimate_spectra": "symid.signal.spectra",
     "IdentifiabilityReport": "symid.structural",
     "identifiability": "symid.structural",
 }

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import symid as si
-from symid.statespace import frequency_response_ss
+from symid.model.statespace import frequency_response_ss
 
 TRUTH_2DOF = {"m1": 1, "m2": 1, "c1": 0.1, "c2": 0.3, "k1": 2, "k2": 1}  # thesis (4-20)
 

@@ -8,7 +8,7 @@ import scipy.signal
 
 import symid as si
 from symid.errors import DataError, ModelError
-from symid.simulate import zoh_discretize
+from symid.signal.simulate import zoh_discretize
 
 W = np.logspace(-1, 1, 40)
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import symid as si
-from symid.simulate import zoh_discretize
-from symid.subspace import DiscreteStateSpace
+from symid.signal.simulate import zoh_discretize
+from symid.signal.subspace import DiscreteStateSpace
 
 
 def random_stable(rng, n, m, p, margin=0.3):

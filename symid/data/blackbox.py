@@ -10,8 +10,7 @@ import numpy as np
 from symid.data import _checks, _files
 from symid.data._base import DataContainer, naming_file
 from symid.errors import DataError
-from symid.parametric import StateSpaceMatrices
-from symid.statespace import as_frequencies, frequency_response_ss
+from symid.model.lti import StateSpaceMatrices, as_frequencies, frequency_response_ss
 
 __all__ = ["BlackBox"]
 
@@ -45,7 +44,7 @@ class BlackBox(DataContainer):
     Notes
     -----
     ``BlackBox(*ss)`` and ``BlackBox.from_state_space(ss)`` accept a
-    :class:`~symid.parametric.StateSpaceMatrices` tuple (from ``model.state_space(θ)``).
+    :class:`~symid.model.lti.StateSpaceMatrices` tuple (from ``model.state_space(θ)``).
 
     CSV layout (see :meth:`to_csv`), one entry per line in long form::
 
@@ -111,7 +110,7 @@ class BlackBox(DataContainer):
 
     @classmethod
     def from_state_space(cls, ss: StateSpaceMatrices | tuple[Any, Any, Any, Any]) -> Self:
-        """Build from a :class:`~symid.parametric.StateSpaceMatrices` (or any (A, B, C, D) tuple).
+        """Build from a :class:`~symid.model.lti.StateSpaceMatrices` (or any (A, B, C, D) tuple).
 
         Examples
         --------
@@ -130,7 +129,7 @@ class BlackBox(DataContainer):
         return cls(A, B, C, D)
 
     def state_space(self) -> StateSpaceMatrices:
-        """The matrices as a :class:`~symid.parametric.StateSpaceMatrices` of writable copies."""
+        """The matrices as a :class:`~symid.model.lti.StateSpaceMatrices` of writable copies."""
         return StateSpaceMatrices(self.A.copy(), self.B.copy(), self.C.copy(), self.D.copy())
 
     # -- properties -----------------------------------------------------------------

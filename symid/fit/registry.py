@@ -88,8 +88,8 @@ def all_methods() -> tuple[str, ...]:
 def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
             noise_floor: float | None = None) -> Estimator:
     """The estimator of ``method`` for this model and data, its options validated."""
-    from symid.secondorder import SecondOrderModel
-    from symid.statespace import StateSpaceModel
+    from symid.model.secondorder import SecondOrderModel
+    from symid.model.statespace import StateSpaceModel
 
     if not isinstance(model, (StateSpaceModel, SecondOrderModel)):
         raise ModelError(f"model must be a StateSpaceModel or SecondOrderModel; got {type(model).__name__}")

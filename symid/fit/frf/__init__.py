@@ -36,7 +36,7 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     from symid.fit.frf.ipopt import IpoptFRF
     from symid.fit.frf.ls import LinearFRF, ls_applicable
     from symid.fit.frf.scr import ScrFRF
-    from symid.secondorder import SecondOrderModel
+    from symid.model.secondorder import SecondOrderModel
 
     check_frf(model, data)
     if method == "ls":

@@ -30,7 +30,7 @@ from symid.errors import ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.options import check_bool, check_known_names
 from symid.fit.similarity.data import similarity_data
-from symid.secondorder import SecondOrderModel
+from symid.model.secondorder import SecondOrderModel
 
 __all__ = ["DATA_OPTIONS", "METHODS", "prepare"]
 

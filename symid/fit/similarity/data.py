@@ -30,7 +30,7 @@ from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.options import check_bool, check_int
 from symid.fit.result import ScrIteration, StartOutcome
-from symid.realisation import balanced_realisation, not_minimal
+from symid.signal.realisation import balanced_realisation, not_minimal
 
 __all__ = ["SimilarityData", "SimilarityEstimator", "similarity_data"]
 
@@ -140,7 +140,7 @@ def similarity_data(model: Any, data: Any, *, horizon: int | None = None, allow_
     if horizon is not None:
         horizon = check_int("horizon", horizon, low=1)
     if isinstance(data, IOData):
-        from symid.subspace import n4sid
+        from symid.signal.subspace import n4sid
 
         _check_sizes(model, model.n_states, data.n_inputs, data.n_outputs, "the I/O data")
         dss = n4sid(data, model.n_states, horizon=horizon, feedthrough=_model_has_feedthrough(model))

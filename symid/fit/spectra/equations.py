@@ -18,7 +18,7 @@ import numpy as np
 
 from symid.errors import DataError, ModelError
 from symid.fit.base import Estimator
-from symid.secondorder import SecondOrderModel
+from symid.model.secondorder import SecondOrderModel
 
 __all__ = ["SpectraEstimator", "SpectralEquations", "check_spectral", "model_spectra", "spectral_equations",
            "spectral_misfit", "spectral_residuals"]

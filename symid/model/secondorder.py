@@ -9,8 +9,8 @@ import numpy as np
 import sympy as sp
 
 from symid.errors import ModelError
-from symid.parametric import ParametricModel, StateSpaceMatrices, Theta
-from symid.statespace import as_frequencies
+from symid.model.lti import StateSpaceMatrices, as_frequencies
+from symid.model.parametric import ParametricModel, Theta
 from symid.symbols import as_symbolic_matrix
 
 __all__ = ["OUTPUT_KINDS", "SecondOrderModel"]

@@ -3,7 +3,7 @@
 All three simulators take the model, the parameter vector θ (a dict of names or a
 sequence in ``model.parameter_names`` order) and the experiment, and return the
 matching data container. A :class:`~symid.data.BlackBox` (or a
-:class:`~symid.parametric.StateSpaceMatrices` tuple) may be given as the model with
+:class:`~symid.model.lti.StateSpaceMatrices` tuple) may be given as the model with
 ``theta=None``.
 
 Noise is relative and optional (``noise=None`` or ``0`` gives exact data); ``seed``
@@ -21,7 +21,8 @@ import scipy.linalg
 
 from symid.data import BlackBox, FrequencyData, IOData, SpectralData, _checks
 from symid.errors import DataError, ModelError
-from symid.parametric import ParametricModel, StateSpaceMatrices, Theta
+from symid.model.lti import StateSpaceMatrices
+from symid.model.parametric import ParametricModel, Theta
 
 __all__ = ["simulate_frf", "simulate_io", "simulate_spectra", "zoh_discretize"]
 

@@ -8,34 +8,12 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from symid.errors import DataError, ModelError
-from symid.parametric import ParametricModel, StateSpaceMatrices, Theta
+from symid.errors import ModelError
+from symid.model.lti import StateSpaceMatrices, as_frequencies, frequency_response_ss
+from symid.model.parametric import ParametricModel, Theta
 from symid.symbols import as_symbolic_matrix
 
-__all__ = ["StateSpaceModel", "as_frequencies"]
-
-
-def as_frequencies(w: Any, name: str = "w") -> np.ndarray:
-    """Validate angular frequencies (rad/s): a finite, real 1-D array (a scalar becomes length 1)."""
-    if w is None:
-        raise DataError(f"{name} is missing (got None); give angular frequencies in rad/s")
-    try:
-        arr = np.asarray(w)
-    except (TypeError, ValueError):
-        raise DataError(f"{name} must be a 1-D sequence of numbers; got a ragged or non-numeric sequence") from None
-    if np.iscomplexobj(arr):
-        raise DataError(f"{name} must be real angular frequencies in rad/s; got complex values")
-    try:
-        arr = np.atleast_1d(arr.astype(float))
-    except (TypeError, ValueError):
-        raise DataError(f"{name} must hold numbers; got dtype {arr.dtype}") from None
-    if arr.ndim != 1:
-        raise DataError(f"{name} must be 1-D (one frequency per sample); got shape {arr.shape}")
-    if arr.size == 0:
-        raise DataError(f"{name} is empty")
-    if not np.all(np.isfinite(arr)):
-        raise DataError(f"{name} holds NaN or inf at index {int(np.flatnonzero(~np.isfinite(arr))[0])}")
-    return arr
+__all__ = ["StateSpaceModel"]
 
 
 class StateSpaceModel(ParametricModel):
@@ -178,16 +156,3 @@ class StateSpaceModel(ParametricModel):
         """Parameters and matrices as readable text."""
         head = f"StateSpaceModel{' ' + repr(self.name) if self.name else ''}: {self._shape_text()}"
         return f"{head}\nparameters: {', '.join(self.parameter_names) or '(none)'}\n{self._matrix_text()}"
-
-
-def frequency_response_ss(ss: StateSpaceMatrices, w: np.ndarray) -> np.ndarray:
-    """H(ω) = C (jωI − A)⁻¹ B + D for numeric matrices, shape (len(w), p, m)."""
-    A, B, C, D = ss
-    n = A.shape[0]
-    Z = 1j * w[:, None, None] * np.eye(n) - A
-    try:
-        X = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
-    except np.linalg.LinAlgError:
-        bad = [float(x) for x in w if abs(np.linalg.det(1j * x * np.eye(n) - A)) < 1e-300]
-        raise ModelError(f"jωI − A is singular at ω = {bad[:3]} (a pole on the imaginary axis)") from None
-    return C @ X + D

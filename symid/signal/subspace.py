@@ -87,7 +87,7 @@ class DiscreteStateSpace:
 
     def to_continuous(self) -> BlackBox:
         """The exact zero-order-hold continuous-time equivalent (:func:`symid.d2c`)."""
-        from symid.zoh import d2c
+        from symid.signal.zoh import d2c
 
         return d2c(self.A, self.B, self.C, self.D, self.dt)
 

@@ -35,7 +35,7 @@ class AffineMap:
     Examples
     --------
     >>> import sympy as sp
-    >>> from symid.affine import affine_map
+    >>> from symid.model.affine import affine_map
     >>> a, b = sp.symbols("a b", real=True)
     >>> amap = affine_map(sp.Matrix([[a + 1, 2 * b]]), (a, b), "X")
     >>> amap([1.0, 2.0])

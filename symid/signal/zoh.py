@@ -5,7 +5,7 @@ The zero-order-hold (ZOH) discretisation of ``x' = A x + B u`` over a sample tim
 
     expm([[A, B], [0, 0]] dt) = [[Ad, Bd], [0, I]]
 
-(:func:`symid.simulate.zoh_discretize`). The inverse is the matrix logarithm of the
+(:func:`symid.signal.simulate.zoh_discretize`). The inverse is the matrix logarithm of the
 same block matrix, ``[[A, B], [0, 0]] = logm([[Ad, Bd], [0, I]]) / dt`` (the method of
 MATLAB's ``d2c``). We use :func:`scipy.linalg.logm` (inverse scaling and squaring,
 Al-Mohy & Higham 2012) on the augmented matrix: it is exact up to rounding and keeps

@@ -3,40 +3,19 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 import sympy as sp
 
-from symid.affine import AffineMap, affine_map, order_parameters
 from symid.errors import ModelError
+from symid.model.affine import AffineMap, affine_map, order_parameters
 
-__all__ = ["ParametricModel", "StateSpaceMatrices", "Theta"]
+__all__ = ["ParametricModel", "Theta"]
 
 Theta = Mapping[str, float] | Mapping[sp.Symbol, float] | Sequence[float] | np.ndarray
 
 
-class StateSpaceMatrices(NamedTuple):
-    """Numeric continuous-time state-space matrices (x' = A x + B u, y = C x + D u).
-
-    A named tuple, so ``A, B, C, D = model.state_space(theta)`` unpacks it.
-
-    Attributes
-    ----------
-    A : numpy.ndarray
-        State matrix, shape (n, n).
-    B : numpy.ndarray
-        Input matrix, shape (n, m).
-    C : numpy.ndarray
-        Output matrix, shape (p, n).
-    D : numpy.ndarray
-        Feedthrough, shape (p, m).
-    """
-
-    A: np.ndarray
-    B: np.ndarray
-    C: np.ndarray
-    D: np.ndarray
 
 
 def _unify_symbols(mats: list[tuple[str, sp.Matrix]]) -> list[tuple[str, sp.Matrix]]:
