@@ -7,7 +7,7 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from symid.data import _checks, _files
+from symid.data import _files, checks
 from symid.data._base import DataContainer, naming_file
 from symid.errors import DataError
 from symid.model.lti import StateSpaceMatrices, as_frequencies, frequency_response_ss
@@ -77,36 +77,36 @@ class BlackBox(DataContainer):
     _npz_keys: ClassVar[tuple[str, ...]] = _NAMES
 
     def __init__(self, A: Any, B: Any, C: Any, D: Any | None = None):
-        A_ = _checks.as_array(A, "A", complex_ok=False)
+        A_ = checks.as_array(A, "A", complex_ok=False)
         if A_.ndim != 2 or A_.shape[0] != A_.shape[1] or A_.shape[0] < 1:
             raise DataError(f"A must be a square matrix of shape (n, n) with n >= 1; "
-                            f"got shape {_checks.shape_text(A_.shape)}")
+                            f"got shape {checks.shape_text(A_.shape)}")
         n = A_.shape[0]
-        B_ = _checks.as_array(B, "B", complex_ok=False)
+        B_ = checks.as_array(B, "B", complex_ok=False)
         if B_.ndim == 1 and B_.size == n:
             B_ = B_.reshape(n, 1)
         if B_.ndim != 2 or B_.shape[0] != n or B_.shape[1] < 1:
             raise DataError(f"B must have shape (n, m) = ({n}, m) to match A, or ({n},) for one input; "
-                            f"got shape {_checks.shape_text(B_.shape)}")
-        C_ = _checks.as_array(C, "C", complex_ok=False)
+                            f"got shape {checks.shape_text(B_.shape)}")
+        C_ = checks.as_array(C, "C", complex_ok=False)
         if C_.ndim == 1 and C_.size == n:
             C_ = C_.reshape(1, n)
         if C_.ndim != 2 or C_.shape[1] != n or C_.shape[0] < 1:
             raise DataError(f"C must have shape (p, n) = (p, {n}) to match A, or ({n},) for one output; "
-                            f"got shape {_checks.shape_text(C_.shape)}")
+                            f"got shape {checks.shape_text(C_.shape)}")
         p, m = C_.shape[0], B_.shape[1]
         if D is None:
             D_ = np.zeros((p, m))
         else:
-            D_ = _checks.as_array(D, "D", complex_ok=False)
+            D_ = checks.as_array(D, "D", complex_ok=False)
             if D_.ndim == 0 and p == m == 1:
                 D_ = D_.reshape(1, 1)
             if D_.shape != (p, m):
                 raise DataError(f"D must have shape (p, m) = ({p}, {m}) to match C and B; "
-                                f"got shape {_checks.shape_text(D_.shape)}")
+                                f"got shape {checks.shape_text(D_.shape)}")
         for name, arr in zip(_NAMES, (A_, B_, C_, D_), strict=True):
-            _checks.check_finite(arr, name)
-            object.__setattr__(self, name, _checks.frozen(arr))
+            checks.check_finite(arr, name)
+            object.__setattr__(self, name, checks.frozen(arr))
 
     @classmethod
     def from_state_space(cls, ss: StateSpaceMatrices | tuple[Any, Any, Any, Any]) -> Self:

@@ -7,7 +7,7 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from symid.data import _checks, _files
+from symid.data import _files, checks
 from symid.data._base import DataContainer, naming_file
 from symid.errors import DataError
 
@@ -68,22 +68,22 @@ class FrequencyData(DataContainer):
     _npz_keys: ClassVar[tuple[str, ...]] = ("w", "H")
 
     def __init__(self, w: Any, H: Any):
-        w_ = _checks.frequencies(w, "w")
+        w_ = checks.frequencies(w, "w")
         s = w_.size
-        H_ = _checks.as_array(H, "H", complex_ok=True)
+        H_ = checks.as_array(H, "H", complex_ok=True)
         if H_.ndim == 1:
             H_ = H_.reshape(-1, 1, 1)
         elif H_.ndim != 3:
             raise DataError(f"H must have shape (s, p, m) = (len(w), outputs, inputs), or (s,) for a SISO FRF; "
-                            f"got shape {_checks.shape_text(H_.shape)}")
+                            f"got shape {checks.shape_text(H_.shape)}")
         if H_.shape[0] != s:
-            raise DataError(f"H has {H_.shape[0]} frequencies (shape {_checks.shape_text(H_.shape)}) but w has {s}; "
+            raise DataError(f"H has {H_.shape[0]} frequencies (shape {checks.shape_text(H_.shape)}) but w has {s}; "
                             f"expected H of shape ({s}, p, m)")
         if H_.shape[1] < 1 or H_.shape[2] < 1:
-            raise DataError(f"H must have at least one output and one input; got shape {_checks.shape_text(H_.shape)}")
-        _checks.check_finite(H_, "H")
+            raise DataError(f"H must have at least one output and one input; got shape {checks.shape_text(H_.shape)}")
+        checks.check_finite(H_, "H")
         object.__setattr__(self, "w", w_)
-        object.__setattr__(self, "H", _checks.frozen(H_))
+        object.__setattr__(self, "H", checks.frozen(H_))
 
     # -- properties -----------------------------------------------------------------
     @property

@@ -7,7 +7,7 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from symid.data import _checks, _files
+from symid.data import _files, checks
 from symid.data._base import DataContainer, naming_file
 from symid.errors import DataError
 
@@ -15,15 +15,15 @@ __all__ = ["IOData"]
 
 
 def _signal(x: Any, name: str, width: str) -> np.ndarray:
-    arr = _checks.as_array(x, name, complex_ok=False)
+    arr = checks.as_array(x, name, complex_ok=False)
     if arr.ndim == 1:
         arr = arr.reshape(-1, 1)
     elif arr.ndim != 2:
         raise DataError(f"{name} must have shape (N, {width}) (one row per sample), or (N,) for a single "
-                        f"channel; got shape {_checks.shape_text(arr.shape)}")
+                        f"channel; got shape {checks.shape_text(arr.shape)}")
     if arr.shape[1] < 1:
-        raise DataError(f"{name} must have at least one channel; got shape {_checks.shape_text(arr.shape)}")
-    _checks.check_finite(arr, name)
+        raise DataError(f"{name} must have at least one channel; got shape {checks.shape_text(arr.shape)}")
+    checks.check_finite(arr, name)
     return arr
 
 
@@ -85,20 +85,20 @@ class IOData(DataContainer):
         y_ = _signal(y, "y", "p")
         if u_.shape[0] != y_.shape[0]:
             raise DataError(f"u and y must have the same number of samples N: u has {u_.shape[0]} "
-                            f"(shape {_checks.shape_text(u_.shape)}), y has {y_.shape[0]} "
-                            f"(shape {_checks.shape_text(y_.shape)})")
+                            f"(shape {checks.shape_text(u_.shape)}), y has {y_.shape[0]} "
+                            f"(shape {checks.shape_text(y_.shape)})")
         if u_.shape[0] < 2:
             raise DataError(f"u and y must hold at least 2 samples (rows); got N = {u_.shape[0]}")
         for label, arr in (("u", u_), ("y", y_)):
             if arr.shape[1] > arr.shape[0]:
-                raise DataError(f"{label} has shape {_checks.shape_text(arr.shape)}: {arr.shape[1]} channels but only "
+                raise DataError(f"{label} has shape {checks.shape_text(arr.shape)}: {arr.shape[1]} channels but only "
                                 f"{arr.shape[0]} samples; arrays are (samples, channels), one row per sample "
                                 f"(pass {label}.T if you have one row per channel)")
         if dt is None:
             raise DataError("dt is missing: IOData(u, y, dt) needs the sample time in seconds")
-        dt_ = _checks.check_positive_scalar(dt, "dt")
-        object.__setattr__(self, "u", _checks.frozen(u_))
-        object.__setattr__(self, "y", _checks.frozen(y_))
+        dt_ = checks.check_positive_scalar(dt, "dt")
+        object.__setattr__(self, "u", checks.frozen(u_))
+        object.__setattr__(self, "y", checks.frozen(y_))
         object.__setattr__(self, "dt", dt_)
 
     @classmethod

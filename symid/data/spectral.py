@@ -7,7 +7,7 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from symid.data import _checks, _files
+from symid.data import _files, checks
 from symid.data._base import DataContainer, naming_file
 from symid.errors import DataError
 
@@ -15,21 +15,21 @@ __all__ = ["SpectralData"]
 
 
 def _spectrum(x: Any, name: str, s: int, size: str) -> np.ndarray:
-    arr = _checks.as_array(x, name, complex_ok=True)
+    arr = checks.as_array(x, name, complex_ok=True)
     if arr.ndim == 1:
         arr = arr.reshape(-1, 1, 1)
     elif arr.ndim != 3:
         raise DataError(f"{name} must have shape (s, {size}, {size}), or (s,) for a single channel; "
-                        f"got shape {_checks.shape_text(arr.shape)}")
+                        f"got shape {checks.shape_text(arr.shape)}")
     if arr.shape[0] != s:
-        raise DataError(f"{name} has {arr.shape[0]} frequencies (shape {_checks.shape_text(arr.shape)}) but w has "
+        raise DataError(f"{name} has {arr.shape[0]} frequencies (shape {checks.shape_text(arr.shape)}) but w has "
                         f"{s}; expected {name} of shape ({s}, {size}, {size})")
     if arr.shape[1] != arr.shape[2] or arr.shape[1] < 1:
         raise DataError(f"{name} must hold square matrices, shape (s, {size}, {size}); "
-                        f"got shape {_checks.shape_text(arr.shape)}")
-    _checks.check_finite(arr, name)
-    _checks.check_hermitian(arr, name)
-    return _checks.frozen(arr)
+                        f"got shape {checks.shape_text(arr.shape)}")
+    checks.check_finite(arr, name)
+    checks.check_hermitian(arr, name)
+    return checks.frozen(arr)
 
 
 @dataclass(frozen=True, init=False, eq=False, repr=False)
@@ -87,7 +87,7 @@ class SpectralData(DataContainer):
     _npz_keys: ClassVar[tuple[str, ...]] = ("w", "Phi_yy", "Phi_uu")
 
     def __init__(self, w: Any, Phi_yy: Any, Phi_uu: Any):
-        w_ = _checks.frequencies(w, "w")
+        w_ = checks.frequencies(w, "w")
         object.__setattr__(self, "w", w_)
         object.__setattr__(self, "Phi_yy", _spectrum(Phi_yy, "Phi_yy", w_.size, "p"))
         object.__setattr__(self, "Phi_uu", _spectrum(Phi_uu, "Phi_uu", w_.size, "m"))

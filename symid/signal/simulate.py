@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from symid.data import BlackBox, FrequencyData, IOData, SpectralData, _checks
+from symid.data import BlackBox, FrequencyData, IOData, SpectralData, checks
 from symid.errors import DataError, ModelError
 from symid.model.lti import StateSpaceMatrices
 from symid.model.parametric import ParametricModel, Theta
@@ -135,7 +135,7 @@ def simulate_frf(model: Model, theta: Theta | None, w: Any, *, noise: float | No
     array([0.324324-0.054054j, 0.      -1.j      ])
     """
     sys, th = _system(model, theta)
-    w_ = _checks.frequencies(w, "w")
+    w_ = checks.frequencies(w, "w")
     level, rng = _noise_level(noise), _generator(seed)
     H = _response(sys, th, w_)
     if level > 0:
@@ -146,20 +146,20 @@ def simulate_frf(model: Model, theta: Theta | None, w: Any, *, noise: float | No
 # -- spectra -----------------------------------------------------------------------------
 
 def _spectrum_block(value: Any, m: int, where: str) -> np.ndarray:
-    arr = _checks.as_array(value, where, complex_ok=True)
+    arr = checks.as_array(value, where, complex_ok=True)
     if arr.ndim == 0:
         return arr * np.eye(m)
     if arr.shape == (m, m):
         return arr
     raise DataError(f"{where} must be a scalar (times the identity) or an (m, m) = ({m}, {m}) matrix; "
-                    f"got shape {_checks.shape_text(arr.shape)}")
+                    f"got shape {checks.shape_text(arr.shape)}")
 
 
 def _input_spectrum(Phi_uu: Any, w: np.ndarray, m: int) -> np.ndarray:
     """Φuu as an (s, m, m) complex array, checked finite and Hermitian."""
     out = _input_spectrum_array(Phi_uu, w, m)
-    _checks.check_finite(out, "Phi_uu")
-    _checks.check_hermitian(out, "Phi_uu")
+    checks.check_finite(out, "Phi_uu")
+    checks.check_hermitian(out, "Phi_uu")
     return out
 
 
@@ -168,7 +168,7 @@ def _input_spectrum_array(Phi_uu: Any, w: np.ndarray, m: int) -> np.ndarray:
     if callable(Phi_uu):
         fn: Callable[[float], Any] = Phi_uu
         return np.stack([_spectrum_block(fn(float(wi)), m, f"Phi_uu({float(wi):.6g})") for wi in w])
-    arr = _checks.as_array(Phi_uu, "Phi_uu", complex_ok=True)
+    arr = checks.as_array(Phi_uu, "Phi_uu", complex_ok=True)
     if arr.ndim == 0:
         return np.broadcast_to(arr * np.eye(m), (s, m, m)).copy()
     if arr.ndim == 1 and arr.size == s:
@@ -179,7 +179,7 @@ def _input_spectrum_array(Phi_uu: Any, w: np.ndarray, m: int) -> np.ndarray:
         return arr
     raise DataError(f"Phi_uu must be a scalar, a callable of ω, or an array of shape (s, m, m) = ({s}, {m}, {m}), "
                     f"(s,) = ({s},) (a scalar per frequency) or (m, m) = ({m}, {m}) (the same at every "
-                    f"frequency); got shape {_checks.shape_text(arr.shape)}")
+                    f"frequency); got shape {checks.shape_text(arr.shape)}")
 
 
 def _hermitian_noise(rng: np.random.Generator, Phi: np.ndarray, level: float) -> np.ndarray:
@@ -240,7 +240,7 @@ def simulate_spectra(model: Model, theta: Theta | None, w: Any, Phi_uu: Any, *, 
     array([0.216216, 2.      ])
     """
     sys, th = _system(model, theta)
-    w_ = _checks.frequencies(w, "w")
+    w_ = checks.frequencies(w, "w")
     level, rng = _noise_level(noise), _generator(seed)
     H = _response(sys, th, w_)
     Puu = _input_spectrum(Phi_uu, w_, H.shape[2])
@@ -275,18 +275,18 @@ def zoh_discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray,
 
 
 def _input_series(u: Any, m: int) -> np.ndarray:
-    arr = _checks.as_array(u, "u", complex_ok=False)
+    arr = checks.as_array(u, "u", complex_ok=False)
     if arr.ndim == 1:
         if m != 1:
             raise DataError(f"u of shape (N,) is only accepted for a single-input model; this model has {m} inputs, "
-                            f"so u must have shape (N, {m}); got shape {_checks.shape_text(arr.shape)}")
+                            f"so u must have shape (N, {m}); got shape {checks.shape_text(arr.shape)}")
         arr = arr.reshape(-1, 1)
     if arr.ndim != 2 or arr.shape[1] != m:
         raise DataError(f"u must have shape (N, m) = (N, {m}) (one row per sample); "
-                        f"got shape {_checks.shape_text(arr.shape)}")
+                        f"got shape {checks.shape_text(arr.shape)}")
     if arr.shape[0] < 2:
         raise DataError(f"u must hold at least 2 samples (rows); got N = {arr.shape[0]}")
-    _checks.check_finite(arr, "u")
+    checks.check_finite(arr, "u")
     return arr
 
 
@@ -346,16 +346,16 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
     A, B, C, D = _matrices(sys, th)
     n, m = B.shape
     u_ = _input_series(u, m)
-    dt_ = _checks.check_positive_scalar(dt, "dt")
+    dt_ = checks.check_positive_scalar(dt, "dt")
     level, rng = _noise_level(noise), _generator(seed)
     if x0 is None:
         x = np.zeros(n)
     else:
-        x = _checks.as_array(x0, "x0", complex_ok=False)
+        x = checks.as_array(x0, "x0", complex_ok=False)
         if x.shape not in ((n,), (n, 1)):
             raise DataError(f"x0 must have shape (n,) = ({n},), the state of the first-order form; "
-                            f"got shape {_checks.shape_text(x.shape)}")
-        _checks.check_finite(x, "x0")
+                            f"got shape {checks.shape_text(x.shape)}")
+        checks.check_finite(x, "x0")
         x = x.reshape(n)
     Ad, Bd = zoh_discretize(A, B, dt_)
     N = u_.shape[0]

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 import scipy.signal
 
-from symid.data import IOData, SpectralData, _checks
+from symid.data import IOData, SpectralData, checks
 from symid.errors import DataError
 
 __all__ = ["estimate_spectra"]
@@ -69,19 +69,19 @@ def _given_input(Phi_uu: Any, w: np.ndarray, m: int | None) -> np.ndarray:
                 raise DataError(f"Phi_uu must be finite: Phi_uu({float(wi):.6g}) = {v.tolist()!r}")
         out = np.stack([v * np.eye(m or 1) if v.ndim == 0 else v for v in vals])
     else:
-        arr = _checks.as_array(Phi_uu, "Phi_uu", complex_ok=True)
-        _checks.check_finite(arr.reshape(-1), "Phi_uu")
+        arr = checks.as_array(Phi_uu, "Phi_uu", complex_ok=True)
+        checks.check_finite(arr.reshape(-1), "Phi_uu")
         if arr.ndim == 0:
             arr = arr * np.eye(m or 1)
         if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
             raise DataError(f"Phi_uu must be a scalar (white noise intensity), a square (m, m) matrix or a "
-                            f"callable of ω; got shape {_checks.shape_text(arr.shape)}")
+                            f"callable of ω; got shape {checks.shape_text(arr.shape)}")
         out = np.broadcast_to(arr, (w.size, *arr.shape)).copy()
     if out.ndim != 3 or out.shape[1] != out.shape[2] or (m is not None and out.shape[1] != m):
         want = "square matrices" if m is None else f"{m}×{m} matrices (one row per input of u)"
-        raise DataError(f"Phi_uu must give {want}; got shape {_checks.shape_text(out.shape[1:])}")
-    _checks.check_finite(out, "Phi_uu")
-    _checks.check_hermitian(out, "Phi_uu")
+        raise DataError(f"Phi_uu must give {want}; got shape {checks.shape_text(out.shape[1:])}")
+    checks.check_finite(out, "Phi_uu")
+    checks.check_hermitian(out, "Phi_uu")
     lam = np.linalg.eigvalsh(0.5 * (out + np.conj(np.swapaxes(out, 1, 2))))
     bad = np.flatnonzero(lam[:, 0] < -_PSD_RTOL * np.maximum(np.abs(lam).max(axis=1), np.finfo(float).tiny))
     if bad.size:
@@ -202,23 +202,23 @@ def estimate_spectra(data: Any, *, dt: float | None = None, Phi_uu: Any = None, 
     if detrend not in _DETRENDS:  # (False == 0: a 0 is read as False)
         raise DataError(f"detrend must be 'constant', 'linear' or False; got {detrend!r}")
     if isinstance(data, IOData):
-        if dt is not None and not np.isclose(_checks.check_positive_scalar(dt, "dt"), data.dt, rtol=1e-12, atol=0):
+        if dt is not None and not np.isclose(checks.check_positive_scalar(dt, "dt"), data.dt, rtol=1e-12, atol=0):
             raise DataError(f"dt = {dt!r} contradicts the IOData's sample time {data.dt!r}; leave dt out")
         y, u, dt_ = np.asarray(data.y, dtype=float), np.asarray(data.u, dtype=float), float(data.dt)
     else:
-        arr = _checks.as_array(data, "outputs", complex_ok=False)
+        arr = checks.as_array(data, "outputs", complex_ok=False)
         if arr.ndim == 1:
             arr = arr.reshape(-1, 1)
         if arr.ndim != 2 or arr.shape[0] < arr.shape[1]:
             raise DataError(f"outputs must have shape (N, p), one row per sample; got shape "
-                            f"{_checks.shape_text(arr.shape)}")
-        _checks.check_finite(arr, "outputs")
+                            f"{checks.shape_text(arr.shape)}")
+        checks.check_finite(arr, "outputs")
         if dt is None:
             raise DataError("output-only data need the sample time: pass dt= (seconds)")
         if Phi_uu is None:
             raise DataError("output-only data need the input spectrum: pass Phi_uu= (e.g. the intensity φ of a "
                             "white-noise input)")
-        y, u, dt_ = arr, None, _checks.check_positive_scalar(dt, "dt")
+        y, u, dt_ = arr, None, checks.check_positive_scalar(dt, "dt")
     N = y.shape[0]
     if N < 8:
         raise DataError(f"the record has N = {N} samples; Welch's method needs at least 8")

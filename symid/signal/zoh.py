@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from symid.data import BlackBox, _checks
+from symid.data import BlackBox, checks
 from symid.errors import DataError
 
 __all__ = ["d2c"]
@@ -42,12 +42,12 @@ _ROUND_TRIP_TOL = 1e-8
 
 def _matrix(x: Any, name: str, *, row: bool = False) -> np.ndarray:
     """A finite real matrix; a 1-D array is a column (or a row with ``row=True``)."""
-    arr = _checks.as_array(x, name, complex_ok=False)
+    arr = checks.as_array(x, name, complex_ok=False)
     if arr.ndim == 1:
         arr = arr.reshape(1, -1) if row else arr.reshape(-1, 1)
     if arr.ndim != 2:
-        raise DataError(f"{name} must be a matrix; got shape {_checks.shape_text(arr.shape)}")
-    _checks.check_finite(arr, name)
+        raise DataError(f"{name} must be a matrix; got shape {checks.shape_text(arr.shape)}")
+    checks.check_finite(arr, name)
     return arr.astype(float)
 
 
@@ -89,17 +89,17 @@ def d2c(A: Any, B: Any, C: Any, D: Any = None, dt: Any = None) -> BlackBox:
     """
     if dt is None:
         raise DataError("d2c needs the sample time dt (seconds) of the discrete-time model; got none")
-    dt_ = _checks.check_positive_scalar(dt, "dt")
+    dt_ = checks.check_positive_scalar(dt, "dt")
     Ad = _matrix(A, "A")
     n = Ad.shape[0]
     if Ad.shape != (n, n):
-        raise DataError(f"A must be square; got shape {_checks.shape_text(Ad.shape)}")
+        raise DataError(f"A must be square; got shape {checks.shape_text(Ad.shape)}")
     Bd = _matrix(B, "B")
     if Bd.shape[0] != n:
-        raise DataError(f"B must have {n} rows to match A; got shape {_checks.shape_text(Bd.shape)}")
+        raise DataError(f"B must have {n} rows to match A; got shape {checks.shape_text(Bd.shape)}")
     Cd = _matrix(C, "C", row=True)
     if Cd.shape[1] != n:
-        raise DataError(f"C must have {n} columns to match A; got shape {_checks.shape_text(Cd.shape)}")
+        raise DataError(f"C must have {n} columns to match A; got shape {checks.shape_text(Cd.shape)}")
     ev = np.linalg.eigvals(Ad)
     scale = max(1.0, float(np.abs(ev).max(initial=0.0)))
     bad = ev[(ev.real <= _AXIS_TOL * scale) & (np.abs(ev.imag) <= _AXIS_TOL * scale)]
@@ -132,5 +132,5 @@ def d2c(A: Any, B: Any, C: Any, D: Any = None, dt: Any = None) -> BlackBox:
         D_ = _matrix(D, "D")
         if D_.shape != (Cd.shape[0], m):
             raise DataError(f"D must have shape (p, m) = ({Cd.shape[0]}, {m}); got shape "
-                            f"{_checks.shape_text(D_.shape)}")
+                            f"{checks.shape_text(D_.shape)}")
     return BlackBox(L[:n, :n], L[:n, n:], Cd, D_)

@@ -1,4 +1,4 @@
-"""Shared validation of the data containers (private).
+"""Validation of arrays shared by the data containers and the signal layer (simulation, spectra, d2c).
 
 Every helper raises :class:`symid.errors.DataError` with a message naming the array and
 what was expected; none lets a numpy exception through. Arrays returned are fresh,
