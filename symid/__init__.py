@@ -54,7 +54,14 @@ _LAZY = {
 }
 
 
+_LAZY_MODULES = {"scr": "symid.engine.scr"}  # ``from symid import scr``: the SCR engine
+
+
 def __getattr__(name: str) -> Any:
+    if name in _LAZY_MODULES:
+        value = importlib.import_module(_LAZY_MODULES[name])
+        globals()[name] = value
+        return value
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'symid' has no attribute {name!r}")
@@ -64,7 +71,7 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted(set(globals()) | set(_LAZY) | set(_LAZY_MODULES))
 
 
 __all__ = [

@@ -94,12 +94,12 @@ def test_every_public_name_has_a_docstring(module, name):
 def _top_level_api() -> list[tuple[str, str]]:
     from symid import scr
 
-    return [("symid", n) for n in symid.__all__] + [("symid.scr", n) for n in scr.__all__]
+    return [("symid", n) for n in symid.__all__] + [("symid.engine.scr", n) for n in scr.__all__]
 
 
 @pytest.mark.parametrize(("module", "name"), _top_level_api())
 def test_top_level_api_has_numpydoc_sections(module, name):
-    """``symid.__all__`` and ``symid.scr.__all__``: functions document Parameters, Returns and Examples;
+    """``symid.__all__`` and ``symid.engine.scr.__all__``: functions document Parameters, Returns and Examples;
     classes their Parameters or Attributes; errors at least say what they mean."""
     obj = getattr(importlib.import_module(module), name)
     if _is_value(obj):

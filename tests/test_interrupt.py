@@ -84,7 +84,7 @@ def test_clarabel_subproblem_stops_within_an_iteration():
     # one SDP whose solve takes ~6 s (7 interior-point iterations of ~0.9 s each, measured)
     code = """
     import time, numpy as np, cvxpy as cp
-    from symid.scr.clarabel_solver import INTERRUPTIBLE_CLARABEL
+    from symid.engine.scr.clarabel_solver import INTERRUPTIBLE_CLARABEL
     from symid.interrupt import native_interrupts
     n = 40
     X = cp.Variable((n, n), symmetric=True)
@@ -107,7 +107,7 @@ def test_interruptible_clarabel_solves_exactly_as_cvxpy_clarabel():
     # the custom solver must hand Clarabel the very data cvxpy's interface does
     import cvxpy as cp
 
-    from symid.scr.clarabel_solver import INTERRUPTIBLE_CLARABEL
+    from symid.engine.scr.clarabel_solver import INTERRUPTIBLE_CLARABEL
 
     assert INTERRUPTIBLE_CLARABEL is not None
     rng = np.random.default_rng(1)

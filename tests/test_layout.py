@@ -39,7 +39,7 @@ def _under(name: str, package: str) -> bool:
     return name == package or name.startswith(package + ".")
 
 
-@pytest.mark.parametrize("module", sorted(m for m in MODULES if _under(m, "symid.engine") or _under(m, "symid.scr")))
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if _under(m, "symid.engine")))
 def test_engines_import_no_fit_package(module):
     bad = [m for m, _ in MODULES[module] if _under(m, "symid.fit")]
     assert not bad, f"{module} imports {bad}"

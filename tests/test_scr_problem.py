@@ -9,8 +9,8 @@ import pytest
 import sympy as sp
 
 from symid import scr
+from symid.engine.scr.presolve import presolve
 from symid.errors import ModelError, NonAffineError
-from symid.scr.presolve import presolve
 
 x, y, a = sp.symbols("x y a")
 
@@ -167,7 +167,7 @@ def test_cvxpy_backend_is_dpp_and_compiles_once(monkeypatch):
     import cvxpy as cp
     from cvxpy.reductions.chain import Chain
 
-    from symid.scr.backend_cvxpy import CvxpyBackend
+    from symid.engine.scr.backend_cvxpy import CvxpyBackend
 
     problems: list[cp.Problem] = []
     init = CvxpyBackend.__init__
@@ -283,7 +283,7 @@ def test_bad_problem_input_is_named():
 
 def test_admm_kkt_sparse_and_dense_factorisations_agree():
     # the z-update of appendix B (B-9): [[N, Dᵀ], [D, 0]] [z; ν] = [b; d], with an arrow-shaped N
-    from symid.scr.backend_admm import _KKT
+    from symid.engine.scr.backend_admm import _KKT
 
     rng = np.random.default_rng(3)
     n_shared, blocks, size = 3, 40, 4
@@ -355,7 +355,7 @@ def test_rank_deficient_P_is_compressed_without_changing_the_iterates(monkeypatc
     exact = {"admm": scr.ADMMOptions(eps_abs=1e-11, eps_rel=1e-11, inner_max=100_000), "cvxpy": None}
     opts = {b: {"backend": b, "admm": exact[b], "max_iter": 3, "tol": 1e-12} for b in exact}
     got = {b: scr.solve(padded(), x0={x: -1.9, y: 2}, **o) for b, o in opts.items()}
-    import symid.scr.presolve as pre
+    import symid.engine.scr.presolve as pre
 
     monkeypatch.setattr(pre, "_compress", lambda A, P, B: (A, P, B))
     assert presolve(padded()).terms[0].dims == (1, 2, 2, 1)

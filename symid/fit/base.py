@@ -147,7 +147,7 @@ _HEURISTICS = ("nuclear", "truncated")
 
 
 def theta_coef(amap: Any) -> np.ndarray:
-    """Coefficient array (r, c, l) of an affine model map, as :class:`symid.scr.Affine` wants it."""
+    """Coefficient array (r, c, l) of an affine model map, as :class:`symid.engine.scr.Affine` wants it."""
     return np.moveaxis(amap.Xi, 0, -1)
 
 
@@ -195,7 +195,7 @@ def mvk_lmis(maps: Any, theta: Any, options: dict[str, Any], names: str = "MVK")
 class ScrEstimator(Estimator):
     """What every SCR estimator shares: engine options, the compiled problem, finish rule, history.
 
-    A subclass builds its :class:`symid.scr.BilinearProblem` and calls
+    A subclass builds its :class:`symid.engine.scr.BilinearProblem` and calls
     :meth:`_setup_engine` with it; :meth:`engine_solve` then runs the engine from a start.
     """
 
@@ -203,7 +203,7 @@ class ScrEstimator(Estimator):
 
     def _engine_options(self, *, backend: Any, max_iter: Any, tol: Any, heuristic: Any = "nuclear",
                         truncate_after: Any = 0, admm: Any = None) -> dict[str, Any]:
-        """Validated options of :func:`symid.scr.solve`."""
+        """Validated options of :func:`symid.engine.scr.solve`."""
         from symid import scr
 
         opts = {"backend": check_choice("backend", backend, _BACKENDS),
@@ -213,7 +213,7 @@ class ScrEstimator(Estimator):
                 "truncate_after": check_int("truncate_after", truncate_after, low=0)}
         if admm is not None:
             if not isinstance(admm, scr.ADMMOptions):
-                raise OptionError(f"admm must be a symid.scr.ADMMOptions; got {type(admm).__name__}")
+                raise OptionError(f"admm must be a symid.engine.scr.ADMMOptions; got {type(admm).__name__}")
             opts["admm"] = admm
         return opts
 
@@ -227,7 +227,7 @@ class ScrEstimator(Estimator):
         self._solve_opts = solve_options
 
     def engine_solve(self, start: Mapping[str, Any], callback: Any = None, compiled: Any = None) -> Any:
-        """The engine's :class:`symid.scr.SCRSolution` from ``start`` (by variable name)."""
+        """The engine's :class:`symid.engine.scr.SCRSolution` from ``start`` (by variable name)."""
         from symid import scr
 
         return scr.solve(self.compiled if compiled is None else compiled, start, callback=callback,

@@ -86,7 +86,7 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         ``"psi_output"`` (ρ) for a state-space model and ``"dynamics"``, ``"output"``
         for a second-order one, each a number or one number per frequency (missing
         families weigh 1). Default: 1 everywhere, as the thesis's examples. The engine
-        first equilibrates every term (:mod:`symid.scr.presolve`), so a weight means the
+        first equilibrates every term (:mod:`symid.engine.scr.presolve`), so a weight means the
         same whatever the units of H.
     lmis : bool, optional
         Second-order models: M, V, K ⪰ 0 (default True; thesis §5-7 shows they are decisive).
@@ -116,8 +116,8 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         equalities and eliminate what they fix (default True; ``False`` relaxes every
         equation, as the thesis posed (3-15)).
     heuristic : {"nuclear", "truncated"}
-        Rank surrogate of the engine (:func:`symid.scr.solve`).
-    admm : symid.scr.ADMMOptions, optional
+        Rank surrogate of the engine (:func:`symid.engine.scr.solve`).
+    admm : symid.engine.scr.ADMMOptions, optional
         Options of the ADMM back end. Default: the engine's, except ``eps_rel=1e-2`` for
         second-order models (sub-problems solved to 1% while the bilinear residual is
         large, to the residual's level once it is smaller, through the engine's
@@ -309,7 +309,7 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         return start
 
     def solve(self, x0: np.ndarray, callback: Any = None) -> scr.SCRSolution:
-        """The raw engine solution from the start ``x0`` (parameter vector); ``callback`` as :func:`symid.scr.solve`."""
+        """The raw engine solution from the start ``x0``; ``callback`` as :func:`symid.engine.scr.solve`."""
         return self.engine_solve(self._aux_start(np.asarray(x0, dtype=float)), callback=callback)
 
     def family_residuals(self, sol: scr.SCRSolution) -> dict[str, list[float]]:

@@ -63,7 +63,7 @@ def implied_equalities(T: scr.Variable, S: scr.Variable, bbA: np.ndarray, Bb: np
     A(θ) or C(θ), or a column of A(θ) or B(θ), holds no parameter, the matching rows of
     T𝔸 = A(θ)T and ℂ = C(θ)T, or columns of 𝔸S = SA(θ) and 𝔹 = SB(θ), are linear in T
     or S. Adding them changes no solution but tightens every convex sub-problem, and
-    the engine's presolve eliminates what they determine (:mod:`symid.scr.presolve`; thesis
+    the engine's presolve eliminates what they determine (:mod:`symid.engine.scr.presolve`; thesis
     §7-7-1 suggests the same reduction for chapter 7, where (7-12a, b) fix half of T).
 
     ``A``, ``B``, ``C`` are (constant part, coefficients (l, r, c)) of the model maps; ``B``
@@ -135,7 +135,7 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
     backend : {"admm", "cvxpy"}
         Engine back end (default ``"admm"``).
     max_iter, tol, heuristic, truncate_after, admm
-        Passed to :func:`symid.scr.solve` (defaults 1000, 1e-8, ``"nuclear"``, 0, None).
+        Passed to :func:`symid.engine.scr.solve` (defaults 1000, 1e-8, ``"nuclear"``, 0, None).
     """
 
     def __init__(self, model: Any, data: SimilarityData, *, weights: float = 1.0, aux_init: str = "random",

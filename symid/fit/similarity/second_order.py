@@ -240,7 +240,7 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
     transform_scale : float, optional
         The α of the scaled unknowns T/α, αS; default ‖ℂ‖/‖C₀‖ (the known output map).
     backend, max_iter, tol, admm
-        Passed to :func:`symid.scr.solve` (defaults ``"admm"``, 2000, 1e-8).
+        Passed to :func:`symid.engine.scr.solve` (defaults ``"admm"``, 2000, 1e-8).
     """
 
     method = "scr"

@@ -90,7 +90,7 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         0 keeps every eigenvalue).
     normalize : bool
         Let the engine equilibrate each term (default False, see the module notes).
-    admm : symid.scr.ADMMOptions, optional
+    admm : symid.engine.scr.ADMMOptions, optional
         Options of the ADMM back end.
 
     Examples

@@ -21,7 +21,7 @@ of one problem (multi-start), :func:`compile` prepares it once (presolve, blocks
 compiled SDP) and :func:`solve` reuses the :class:`CompiledProblem`.
 
 Scaling, so that one weight λ means the same in every problem (``solve(normalize=True)``,
-the default; details in :mod:`symid.scr.presolve`): every bilinear equation is
+the default; details in :mod:`symid.engine.scr.presolve`): every bilinear equation is
 equilibrated without changing its solutions — P divided by its spectral norm (C with it),
 each row of the equation divided by the largest coefficient of that row of A(x) and C(x),
 each column by the largest coefficient of that column of B(x) and C(x) — and a complex
@@ -32,13 +32,13 @@ iterates unchanged. LMIs are divided by their largest coefficient. The stopping 
 is that of the equilibrated terms; ``sol.history[k].residuals`` are the user's, unscaled.
 """
 
-from symid.scr.backend_admm import ADMMOptions
-from symid.scr.compiled import INCONSISTENT_TOL, CompiledProblem, compile
-from symid.scr.maps import Affine
-from symid.scr.problem import Bilinear, BilinearProblem, SumSquares
-from symid.scr.result import Iteration, SCRSolution
-from symid.scr.solve import solve
-from symid.scr.variables import Layout, Variable
+from symid.engine.scr.backend_admm import ADMMOptions
+from symid.engine.scr.compiled import INCONSISTENT_TOL, CompiledProblem, compile
+from symid.engine.scr.maps import Affine
+from symid.engine.scr.problem import Bilinear, BilinearProblem, SumSquares
+from symid.engine.scr.result import Iteration, SCRSolution
+from symid.engine.scr.solve import solve
+from symid.engine.scr.variables import Layout, Variable
 
 __all__ = [
     "INCONSISTENT_TOL",

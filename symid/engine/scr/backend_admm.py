@@ -7,7 +7,7 @@ One SCR sub-problem, for fixed Q, R, is
 
 (W_t = 0 for the plain nuclear norm). All blocks Y_t and S_e are stacked in one vector
 y = 𝒜 z + c, with 𝒜 a sparse matrix assembled once per SCR iteration from the batched
-blocks of :mod:`symid.scr.blocks`. Scaled-form ADMM with one shared ρ and
+blocks of :mod:`symid.engine.scr.blocks`. Scaled-form ADMM with one shared ρ and
 over-relaxation α (Boyd et al. 2011, §3.4.3):
 
 * z-update: the equality-constrained least squares of appendix B (B-9), solved from one
@@ -43,9 +43,9 @@ import scipy.linalg.lapack as lapack
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
+from symid.engine.scr.blocks import LMIGroup, TermGroup
+from symid.engine.scr.presolve import Reduced
 from symid.errors import ModelError
-from symid.scr.blocks import LMIGroup, TermGroup
-from symid.scr.presolve import Reduced
 
 __all__ = ["ADMMBackend", "ADMMOptions"]
 

@@ -1,9 +1,9 @@
 """A bilinear problem prepared once for many SCR solves (multi-start).
 
-The presolve (:mod:`symid.scr.presolve`), the grouping of terms into blocks
-(:mod:`symid.scr.blocks`) and, for the cvxpy back end, the compiled SDP depend on the
+The presolve (:mod:`symid.engine.scr.presolve`), the grouping of terms into blocks
+(:mod:`symid.engine.scr.blocks`) and, for the cvxpy back end, the compiled SDP depend on the
 problem only, not on the start. :func:`compile` does this work once and returns a
-:class:`CompiledProblem`; :func:`symid.scr.solve` accepts it in place of the problem and
+:class:`CompiledProblem`; :func:`symid.engine.scr.solve` accepts it in place of the problem and
 reuses everything in it. A solve from a compiled problem gives the same iterates as a
 solve of the bare problem: every SCR step overwrites all parameters of the compiled
 SDP, and Clarabel is started from a new solver object on every sub-problem (cvxpy's
@@ -18,11 +18,11 @@ import time
 from collections.abc import Mapping
 from typing import Any
 
+from symid.engine.scr.blocks import LMIGroup, TermGroup, group_lmis, group_terms
+from symid.engine.scr.presolve import Reduced
+from symid.engine.scr.presolve import presolve as _presolve
+from symid.engine.scr.problem import BilinearProblem
 from symid.errors import ModelError
-from symid.scr.blocks import LMIGroup, TermGroup, group_lmis, group_terms
-from symid.scr.presolve import Reduced
-from symid.scr.presolve import presolve as _presolve
-from symid.scr.problem import BilinearProblem
 
 __all__ = ["INCONSISTENT_TOL", "CompiledProblem", "compile"]
 
@@ -41,7 +41,7 @@ class CompiledProblem:
     problem : BilinearProblem
         The problem it was compiled from.
     presolve, normalize : bool
-        The options it was compiled with (see :func:`symid.scr.solve`).
+        The options it was compiled with (see :func:`symid.engine.scr.solve`).
     reduced : Reduced
         The presolved problem.
     groups : list of TermGroup
@@ -68,7 +68,7 @@ class CompiledProblem:
 
         Unhashable solver options give a new back end every call (no reuse).
         """
-        from symid.scr.backend_cvxpy import CvxpyBackend
+        from symid.engine.scr.backend_cvxpy import CvxpyBackend
 
         try:
             key = tuple(sorted((solver_options or {}).items()))
@@ -86,18 +86,18 @@ class CompiledProblem:
 
 
 def compile(problem: BilinearProblem, *, presolve: bool = True, normalize: bool = True) -> CompiledProblem:
-    """Presolve and group a bilinear problem once, for many :func:`symid.scr.solve` calls.
+    """Presolve and group a bilinear problem once, for many :func:`symid.engine.scr.solve` calls.
 
     Parameters
     ----------
     problem : BilinearProblem
     presolve, normalize : bool, optional
-        As in :func:`symid.scr.solve` (both default ``True``).
+        As in :func:`symid.engine.scr.solve` (both default ``True``).
 
     Returns
     -------
     CompiledProblem
-        Pass it to :func:`symid.scr.solve` in place of ``problem``; every solve then
+        Pass it to :func:`symid.engine.scr.solve` in place of ``problem``; every solve then
         reuses the presolve, the blocks and (cvxpy back end) the compiled SDP, with the
         same iterates as a solve of ``problem`` itself.
 

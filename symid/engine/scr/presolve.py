@@ -30,8 +30,8 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 from scipy.sparse.csgraph import connected_components
 
-from symid.scr.maps import LocalMap, _clean
-from symid.scr.problem import BilinearProblem, CompiledTerm
+from symid.engine.scr.maps import LocalMap, _clean
+from symid.engine.scr.problem import BilinearProblem, CompiledTerm
 
 __all__ = ["RealTerm", "Reduced", "presolve"]
 

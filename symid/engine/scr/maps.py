@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from symid.engine.scr.variables import Layout
 from symid.errors import ModelError, NonAffineError
-from symid.scr.variables import Layout
 
 __all__ = ["Affine", "LocalMap", "as_map", "compile_sympy", "stack_index", "stack_maps"]
 

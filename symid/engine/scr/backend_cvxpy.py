@@ -18,11 +18,11 @@ import warnings
 import cvxpy as cp
 import numpy as np
 
+from symid.engine.scr.blocks import LMIGroup, TermGroup
+from symid.engine.scr.clarabel_solver import INTERRUPTIBLE_CLARABEL
+from symid.engine.scr.presolve import Reduced
 from symid.errors import ModelError
 from symid.interrupt import native_interrupts
-from symid.scr.blocks import LMIGroup, TermGroup
-from symid.scr.clarabel_solver import INTERRUPTIBLE_CLARABEL
-from symid.scr.presolve import Reduced
 
 __all__ = ["CvxpyBackend"]
 

@@ -60,7 +60,7 @@ def _jsonable(v: Any) -> Any:
 
 @dataclass(frozen=True)
 class SCRSolution:
-    """Outcome of :func:`symid.scr.solve`, in the spirit of scipy's ``OptimizeResult``.
+    """Outcome of :func:`symid.engine.scr.solve`, in the spirit of scipy's ``OptimizeResult``.
 
     Attributes
     ----------

@@ -13,8 +13,8 @@ from functools import cached_property
 
 import numpy as np
 
-from symid.scr.maps import LocalMap, stack_index, stack_maps
-from symid.scr.presolve import RealTerm
+from symid.engine.scr.maps import LocalMap, stack_index, stack_maps
+from symid.engine.scr.presolve import RealTerm
 
 __all__ = ["LMIGroup", "TermGroup", "group_lmis", "group_terms"]
 

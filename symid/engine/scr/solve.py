@@ -8,14 +8,14 @@ from typing import Any
 
 import numpy as np
 
+from symid.engine.scr.backend_admm import ADMMBackend, ADMMOptions
+from symid.engine.scr.blocks import TermGroup
+from symid.engine.scr.compiled import INCONSISTENT_TOL, CompiledProblem
+from symid.engine.scr.compiled import compile as _compile
+from symid.engine.scr.presolve import Reduced
+from symid.engine.scr.problem import BilinearProblem
+from symid.engine.scr.result import Iteration, SCRSolution
 from symid.errors import ModelError
-from symid.scr.backend_admm import ADMMBackend, ADMMOptions
-from symid.scr.blocks import TermGroup
-from symid.scr.compiled import INCONSISTENT_TOL, CompiledProblem
-from symid.scr.compiled import compile as _compile
-from symid.scr.presolve import Reduced
-from symid.scr.problem import BilinearProblem
-from symid.scr.result import Iteration, SCRSolution
 
 __all__ = ["solve"]
 
@@ -76,7 +76,7 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
     Parameters
     ----------
     prob : BilinearProblem or CompiledProblem
-        A problem, or one prepared by :func:`symid.scr.compile` for many solves
+        A problem, or one prepared by :func:`symid.engine.scr.compile` for many solves
         (multi-start): its presolve, blocks and compiled SDP are then reused, with the
         same iterates as a solve of the bare problem.
     x0 : dict, optional
@@ -102,7 +102,7 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
         Plain nuclear-norm iterations before the truncated ones start.
     presolve : bool, optional
         Move the affine rows/columns of the bilinear terms to linear equalities and
-        eliminate variables they determine (default ``True``); see :mod:`symid.scr.presolve`.
+        eliminate variables they determine (default ``True``); see :mod:`symid.engine.scr.presolve`.
         For a :class:`CompiledProblem` it is fixed at compilation (leave it ``None``).
     normalize : bool, optional
         Equilibrate each term so one λ means the same across problems (default ``True``):

@@ -10,9 +10,9 @@ import numpy as np
 import scipy.sparse as sps
 import sympy as sp
 
+from symid.engine.scr.maps import LocalMap, as_map, stack_index, stack_maps
+from symid.engine.scr.variables import Layout, Variable
 from symid.errors import ModelError
-from symid.scr.maps import LocalMap, as_map, stack_index, stack_maps
-from symid.scr.variables import Layout, Variable
 
 __all__ = ["Bilinear", "BilinearProblem", "SumSquares"]
 
@@ -30,7 +30,7 @@ class Bilinear:
         Constant nonzero matrix (real or complex).
     weight : float, optional
         Weight λ of the term's nuclear-norm relaxation (default 1). See
-        :func:`symid.scr.solve` for how terms are normalised.
+        :func:`symid.engine.scr.solve` for how terms are normalised.
     name : str, optional
         Name used in messages and in ``sol.history`` (default ``"bilinear[i]"``).
 
