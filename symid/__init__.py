@@ -24,7 +24,7 @@ from symid.fit.result import IdentificationResult, StartOutcome
 from symid.model.lti import StateSpaceMatrices
 from symid.model.secondorder import SecondOrderModel
 from symid.model.statespace import StateSpaceModel
-from symid.symbols import parameters
+from symid.model.symbols import parameters
 from symid.zoo import ZooEntry, list_models, load_model
 
 if TYPE_CHECKING:

@@ -49,7 +49,7 @@ def test_engines_import_no_fit_package(module):
 def test_data_layer_does_not_import_symbolic_models(module):
     bad = [m for m, _ in MODULES[module]
            if (_under(m, "symid.model") and m != "symid.model.lti") or _under(m, "symid.fit")
-           or m in ("symid.symbols", "sympy") or _under(m, "symid.signal")]
+           or m in ("symid.model.symbols", "sympy") or _under(m, "symid.signal")]
     assert not bad, f"{module} imports {bad}"
 
 

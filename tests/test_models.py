@@ -253,8 +253,8 @@ def test_string_entries_keep_pi_functions_and_powers():
 
 
 @pytest.mark.parametrize("text, phrase", [
-    ("a if b else c", "Python keyword 'if'"), ("lambda", "Python keyword 'lambda'"), ("a +", "cannot be parsed"),
-    ("(a", "cannot be parsed"), ("", "cannot be parsed"), ("'a'", "is not an expression")])
+    ("a if b else c", "is not allowed: if/else"), ("lambda", "cannot be parsed"), ("a +", "cannot be parsed"),
+    ("(a", "cannot be parsed"), ("", "cannot be parsed"), ("'a'", "is not allowed: a str constant")])
 def test_bad_string_entries(text, phrase):
     with pytest.raises(si.ModelError, match=re.escape(phrase)):
         si.StateSpaceModel(A=[[text]], B=[[1]], C=[[1]])

@@ -1,6 +1,6 @@
 """Symbolic models: parameters, exact affine maps, state-space and second-order models.
 
-* :mod:`symid.symbols` — :func:`~symid.symbols.parameters` and safe parsing of matrix entries;
+* :mod:`symid.model.symbols` — :func:`~symid.model.symbols.parameters` and safe parsing of matrix entries;
 * :mod:`symid.model.affine` — exact affine maps X(θ) = X0 + Σ θi Xi;
 * :mod:`symid.model.parametric` — the base of the model classes;
 * :mod:`symid.model.statespace`, :mod:`symid.model.secondorder` — the two model kinds;

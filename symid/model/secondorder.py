@@ -11,7 +11,7 @@ import sympy as sp
 from symid.errors import ModelError
 from symid.model.lti import StateSpaceMatrices, as_frequencies
 from symid.model.parametric import ParametricModel, Theta
-from symid.symbols import as_symbolic_matrix
+from symid.model.symbols import as_symbolic_matrix
 
 __all__ = ["OUTPUT_KINDS", "SecondOrderModel"]
 
@@ -30,7 +30,7 @@ class SecondOrderModel(ParametricModel):
     M, V, K : array_like or sympy.Matrix
         Mass, damping and stiffness matrices, each (n, n), affine in the parameters.
         Entries are numbers, sympy expressions or strings
-        (:func:`symid.symbols.parse_entry`).
+        (:func:`symid.model.symbols.parse_entry`).
     B : array_like or sympy.Matrix
         Input matrix (n, m).
     C : array_like or sympy.Matrix

@@ -11,7 +11,7 @@ import sympy as sp
 from symid.errors import ModelError
 from symid.model.lti import StateSpaceMatrices, as_frequencies, frequency_response_ss
 from symid.model.parametric import ParametricModel, Theta
-from symid.symbols import as_symbolic_matrix
+from symid.model.symbols import as_symbolic_matrix
 
 __all__ = ["StateSpaceModel"]
 
@@ -25,7 +25,7 @@ class StateSpaceModel(ParametricModel):
     ----------
     A, B, C : array_like or sympy.Matrix
         System matrices of shapes (n, n), (n, m), (p, n). Entries are numbers, sympy
-        expressions or strings (:func:`symid.symbols.parse_entry`: every bare name in
+        expressions or strings (:func:`symid.model.symbols.parse_entry`: every bare name in
         a string is a real parameter, ``pi`` excepted), each affine in the parameters.
         A scalar is a 1 x 1 matrix; a 1-D sequence is refused as ambiguous.
     D : array_like or sympy.Matrix, optional

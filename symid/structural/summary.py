@@ -53,7 +53,12 @@ def rational(value: object) -> sp.Rational:
         return sp.Rational(repr(float(value)))
     if isinstance(value, float):
         return sp.Rational(repr(value))
-    out = sp.sympify(value)
+    if isinstance(value, (str, bytes)):
+        raise ModelError(f"expected a real number, got the text {value!r}")
+    try:
+        out = sp.sympify(value, strict=True)  # strict: never parses text
+    except (sp.SympifyError, TypeError, ValueError):
+        raise ModelError(f"expected a real number, got {value!r}") from None
     if out.is_Rational:
         return out
     if out.is_Float:

@@ -17,8 +17,10 @@ import sympy as sp
 
 from symid.engine.scr.variables import Layout
 from symid.errors import ModelError, NonAffineError
+from symid.model.expressions import parse_expression
 
-__all__ = ["Affine", "LocalMap", "as_map", "compile_sympy", "stack_index", "stack_maps"]
+__all__ = ["Affine", "LocalMap", "as_map", "compile_sympy", "stack_index", "stack_maps", "sympy_entry",
+           "variable_names"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -175,16 +177,52 @@ class Affine:
         return _clean(np.concatenate(idxs), np.concatenate(cols, axis=2), self.const)
 
 
-def _sympy_matrix(value: Any, name: str) -> sp.Matrix:
-    if isinstance(value, sp.MatrixBase):
-        return sp.Matrix(value)
-    if isinstance(value, sp.Expr) or isinstance(value, (int, float, complex, str)):
-        return sp.Matrix([[sp.sympify(value)]])
+def variable_names(layout: Layout) -> dict[str, sp.Expr]:
+    """What a name in a text entry means for a problem: its scalar variables and their symbols."""
+    out: dict[str, sp.Expr] = {str(s): s for s in layout.symbol_index}
+    for v in layout.variables:
+        if v.symbol is not None:
+            out[v.name] = v.symbol
+    return out
+
+
+def sympy_entry(value: Any, where: str, layout: Layout) -> sp.Expr:
+    """One entry as a sympy expression: text through the safe grammar (:mod:`symid.model.expressions`),
+    with names resolved to the problem's variables; anything else through ``sympify(strict=True)``,
+    which never parses text."""
+    if isinstance(value, str):
+        return parse_expression(value, where, symbol=variable_names(layout))
+    if isinstance(value, (bytes, bytearray)):
+        raise ModelError(f"{where} is bytes; write it as text (str), a number or a sympy expression")
     try:
-        m = sp.Matrix(value)
-    except (TypeError, ValueError, sp.SympifyError) as exc:
-        raise ModelError(f"{name} cannot be read as a matrix: {exc}") from None
-    return m
+        out = sp.sympify(value, strict=True)
+    except (sp.SympifyError, TypeError, ValueError) as exc:
+        raise ModelError(f"{where} = {value!r} is not a number or a sympy expression ({exc})") from None
+    if isinstance(out, sp.Basic) and out.has(sp.oo, -sp.oo, sp.zoo, sp.nan):
+        raise ModelError(f"{where} = {out} is not finite")
+    return out
+
+
+def _sympy_matrix(value: Any, name: str, layout: Layout) -> sp.Matrix:
+    if isinstance(value, sp.MatrixBase):
+        rows = value.tolist()
+    elif isinstance(value, (sp.Basic, int, float, complex, str, np.number)):
+        rows = [[value]]
+    else:
+        try:
+            arr = np.asarray(value, dtype=object)
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"{name} cannot be read as a matrix: {exc}") from None
+        if arr.ndim == 0:
+            rows = [[arr.item()]]
+        elif arr.ndim == 1:  # a column, as sympy.Matrix reads a flat list
+            rows = [[x] for x in arr]
+        elif arr.ndim == 2:
+            rows = arr.tolist()
+        else:
+            raise ModelError(f"{name} must be a matrix; got {arr.ndim} dimensions")
+    return sp.Matrix([[sympy_entry(x, f"{name}[{i}, {j}]", layout) for j, x in enumerate(r)]
+                      for i, r in enumerate(rows)])
 
 
 def compile_sympy(value: Any, layout: Layout, name: str) -> LocalMap:
@@ -197,7 +235,7 @@ def compile_sympy(value: Any, layout: Layout, name: str) -> LocalMap:
     ModelError
         If an entry holds a symbol that is not a variable of the problem.
     """
-    mat = _sympy_matrix(value, name)
+    mat = _sympy_matrix(value, name, layout)
     rows, cols = mat.shape
     index = layout.symbol_index
     syms = set(index)
@@ -206,7 +244,7 @@ def compile_sympy(value: Any, layout: Layout, name: str) -> LocalMap:
     ent: list[tuple[int, int, complex]] = []
     for i in range(rows):
         for j in range(cols):
-            expr = sp.sympify(mat[i, j])
+            expr = mat[i, j]
             fs = expr.free_symbols
             stray = fs - syms
             if stray:

@@ -2,22 +2,17 @@
 
 from __future__ import annotations
 
-import io
 import keyword
-import tokenize
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
 import sympy as sp
-from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
 
 from symid.errors import ModelError
+from symid.model.expressions import parse_expression
 
 __all__ = ["as_symbolic_matrix", "parameters", "parse_entry"]
-
-_TRANSFORMATIONS = (*standard_transformations, convert_xor)  # what sympy.sympify uses for strings
-
 
 def parameters(names: str | Sequence[str], *, positive: bool = False):
     """Declare the unknown physical parameters of a model.
@@ -63,30 +58,16 @@ def parameters(names: str | Sequence[str], *, positive: bool = False):
     return symbols[0] if len(symbols) == 1 else symbols
 
 
-def _bare_names(text: str) -> set[str]:
-    """Names in ``text`` that are not called (not followed by ``(``); Python keywords are refused."""
-    tokens = [t for t in tokenize.generate_tokens(io.StringIO(text).readline)
-              if t.type not in (tokenize.NL, tokenize.NEWLINE, tokenize.ENDMARKER, tokenize.COMMENT)]
-    names = set()
-    for k, tok in enumerate(tokens):
-        if tok.type != tokenize.NAME:
-            continue
-        if keyword.iskeyword(tok.string):
-            raise SyntaxError(f"the Python keyword {tok.string!r} cannot appear in an entry")
-        if not (k + 1 < len(tokens) and tokens[k + 1].string == "("):
-            names.add(tok.string)
-    return names
-
-
 def parse_entry(text: str, where: str = "entry") -> sp.Expr:
-    """Parse a matrix entry written as a string, every bare name being a real parameter.
+    """Parse a matrix entry written as text, every bare name being a real parameter.
 
-    Unlike :func:`sympy.sympify`, a name that is not called as a function is always a
-    symbol, so ``"E*A/L"``, ``"I"``, ``"N"``, ``"S"``, ``"beta"`` or ``"gamma"`` are
-    parameters, not sympy's constants, singletons or special functions (a physical
-    model is more likely to mean Young's modulus than Euler's number by ``E``). The
-    one exception is ``pi`` (π); write ``exp(1)`` for e. Names followed by ``(`` are
-    functions (``sin(a)``, ``sqrt(2)``). ``^`` means a power, as in sympy.
+    The text is never evaluated: it is read by the whitelisted grammar of
+    :mod:`symid.model.expressions` (numbers, names, ``+ - * /``, numeric powers with
+    ``**`` or ``^``, parentheses, a few functions). Unlike :func:`sympy.sympify`, a name
+    is always a symbol, so ``"E*A/L"``, ``"I"``, ``"N"``, ``"S"``, ``"beta"`` or
+    ``"gamma"`` are parameters, not sympy's constants, singletons or special functions
+    (a physical model is more likely to mean Young's modulus than Euler's number by
+    ``E``). The one exception is ``pi`` (π); write ``exp(1)`` for e.
 
     Parameters
     ----------
@@ -103,27 +84,21 @@ def parse_entry(text: str, where: str = "entry") -> sp.Expr:
     Raises
     ------
     ModelError
-        If the text cannot be parsed or does not give an expression.
+        If the text is outside the grammar, naming the entry and the construct.
 
     Examples
     --------
-    >>> from symid.symbols import parse_entry
+    >>> from symid.model.symbols import parse_entry
     >>> expr = parse_entry("E*I/L**3 + pi")
     >>> sorted(map(str, expr.free_symbols))
     ['E', 'I', 'L']
     """
-    try:
-        names = _bare_names(text)
-        local = {n: sp.Symbol(n, real=True) for n in names if n != "pi"}
-        out = parse_expr(text, local_dict=local, transformations=_TRANSFORMATIONS)
-    except (sp.SympifyError, SyntaxError, TypeError, ValueError, AttributeError, tokenize.TokenError) as exc:
-        raise ModelError(f"{where} = {text!r} cannot be parsed by sympy: {exc}") from None
-    if not isinstance(out, sp.Expr):
-        raise ModelError(f"{where} = {text!r} is not an expression (sympy reads it as {type(out).__name__})")
-    return out
+    return parse_expression(text, where)
 
 
 def _entry(value: Any, name: str, i: int, j: int) -> sp.Expr:
+    if isinstance(value, (bytes, bytearray)):
+        raise ModelError(f"{name}[{i}, {j}] is bytes; write the entry as text (str) or a number")
     if isinstance(value, str):
         return parse_entry(value, f"{name}[{i}, {j}]")
     if isinstance(value, (bool, np.bool_)):
