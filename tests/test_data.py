@@ -263,20 +263,23 @@ def test_csv_layout_is_documented_text(tmp_path):
     path = tmp_path / "io.csv"
     IOData([[1.0, 2.0], [3.0, 4.0]], [0.1, 0.2], dt=0.01).to_csv(path)
     assert path.read_text().splitlines() == [
-        "# symid IOData csv v1",
+        "# symid IOData csv v2",
         "# dt: 0.01",
         "# n_inputs: 2",
         "# n_outputs: 1",
+        "# n_rows: 2",
         "u[0],u[1],y[0]",
         "1.0,2.0,0.1",
         "3.0,4.0,0.2",
+        "# end",
     ]
     path = tmp_path / "spec.csv"
     SpectralData([1.0], [[[2.0]]], [[[1.0, complex(0, 0.5)], [complex(0, -0.5), 1.0]]]).to_csv(path)
-    assert path.read_text().splitlines()[3:] == [
+    assert path.read_text().splitlines()[4:] == [
         "w,Phi_yy[0][0].re,Phi_yy[0][0].im,Phi_uu[0][0].re,Phi_uu[0][0].im,Phi_uu[0][1].re,Phi_uu[0][1].im,"
         "Phi_uu[1][0].re,Phi_uu[1][0].im,Phi_uu[1][1].re,Phi_uu[1][1].im",
         "1.0,2.0,0.0,1.0,0.0,0.0,0.5,0.0,-0.5,1.0,0.0",
+        "# end",
     ]
 
 
@@ -319,11 +322,19 @@ CSV_DAMAGE = [
     ("not symid", lambda t: "hello,world\n1,2\n", "is not a symid CSV file"),
     ("empty", lambda t: "", "is empty"),
     ("cell", lambda t: t.replace("0.5,", "abc,", 1), "is not a number"),
-    ("short row", lambda t: t.rstrip("\n").rsplit(",", 1)[0] + "\n", "cells; the header has"),
+    ("short row", lambda t: t.replace("\n2.0,3.0,0.0\n", "\n2.0,3.0\n"), "cells; the header has"),
+    ("cut at a line", lambda t: "\n".join(t.splitlines()[:-2]) + "\n", "does not end with the line '# end'"),
+    ("row missing", lambda t: t.replace("2.0,3.0,0.0\n", "", 1), "declares 3 data rows"),
+    ("row count", lambda t: t.replace("# n_rows: 3", "# n_rows: 2"), "declares 2 data rows"),
+    ("row count huge", lambda t: t.replace("# n_rows: 3", "# n_rows: 20000000"), "more than the file's contents"),
+    ("sizes too large", lambda t: t.replace("# n_inputs: 1", "# n_inputs: 20000"), "more than the file's contents"),
+    ("sizes inconsistent", lambda t: t.replace("# n_outputs: 1", "# n_outputs: 2"), "imply 5 columns"),
+    ("float size", lambda t: t.replace("# n_inputs: 1", "# n_inputs: 1e10"), "written in digits"),
+    ("negative size", lambda t: t.replace("# n_inputs: 1", "# n_inputs: -3"), "written in digits"),
     ("header", lambda t: t.replace("H[0][0].im", "H[0][0].imag"), "unexpected CSV header"),
     ("meta", lambda t: t.replace("# n_inputs: 1\n", ""), "'# n_inputs: ...' is missing"),
-    ("meta int", lambda t: t.replace("# n_inputs: 1", "# n_inputs: one"), "must be an integer"),
-    ("version", lambda t: t.replace("csv v1", "csv v7"), "format version 7"),
+    ("meta int", lambda t: t.replace("# n_inputs: 1", "# n_inputs: one"), "positive integer written in digits"),
+    ("version", lambda t: t.replace("csv v2", "csv v7"), "format version 7"),
     ("duplicate w", lambda t: t.replace("\n1.0,", "\n0.5,"), "(duplicate)"),
     ("header missing", lambda t: "\n".join(t.splitlines()[:3]) + "\n", "header line of column names is missing"),
 ]
@@ -343,7 +354,9 @@ BB_DAMAGE = [
     ("unknown matrix", lambda t: t.replace("\nD,0,0", "\nE,0,0"), "unknown matrix 'E'"),
     ("out of range", lambda t: t.replace("\nD,0,0", "\nD,5,0"), "outside D's shape"),
     ("twice", lambda t: t.replace("\nD,0,0", "\nA,0,0"), "A[0,0] appears twice"),
-    ("missing", lambda t: t.replace(t.splitlines()[-1] + "\n", ""), "D[0,0] is missing"),
+    ("missing", lambda t: t.replace(t.splitlines()[-2] + "\n", "").replace("# n_rows: 9", "# n_rows: 8"),
+     "9 entries, but holds 8 rows"),
+    ("huge n", lambda t: t.replace("# n_states: 2", "# n_states: 20000"), "more than the file's contents"),
     ("not int", lambda t: t.replace("\nD,0,0", "\nD,x,0"), "must be integers"),
 ]
 

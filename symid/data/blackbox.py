@@ -48,13 +48,15 @@ class BlackBox(DataContainer):
 
     CSV layout (see :meth:`to_csv`), one entry per line in long form::
 
-        # symid BlackBox csv v1
+        # symid BlackBox csv v2
         # n_states: n
         # n_inputs: m
         # n_outputs: p
+        # n_rows: (n + p)(n + m)
         matrix,row,col,value
         A,0,0,-1.0
         ...
+        # end
 
     Every entry of A, B, C and D appears exactly once, in that order, row-major.
 
@@ -202,10 +204,14 @@ class BlackBox(DataContainer):
             or out of range, or the matrices fail the constructor's checks.
         """
         meta, columns, rows = _files.read_csv(path, cls._kind)
-        n = _files.meta_int(meta, "n_states", path)
-        m = _files.meta_int(meta, "n_inputs", path)
-        p = _files.meta_int(meta, "n_outputs", path)
+        n = _files.meta_int(meta, "n_states", path, at_most=len(rows))
+        m = _files.meta_int(meta, "n_inputs", path, at_most=len(rows))
+        p = _files.meta_int(meta, "n_outputs", path, at_most=len(rows))
         _files.expect_columns(columns, ["matrix", "row", "col", "value"], path)
+        if len(rows) != (n + p) * (n + m):  # every entry of A, B, C, D once, before any matrix is built
+            raise DataError(f"{str(path)!r} declares n_states {n}, n_inputs {m}, n_outputs {p}, i.e. "
+                            f"{(n + p) * (n + m)} entries, but holds {len(rows)} rows: the header does not match "
+                            f"the data")
         shapes = {"A": (n, n), "B": (n, m), "C": (p, n), "D": (p, m)}
         mats = {k: np.full(shp, np.nan) for k, shp in shapes.items()}
         seen = {k: np.zeros(shp, dtype=bool) for k, shp in shapes.items()}

@@ -41,11 +41,13 @@ class FrequencyData(DataContainer):
     -----
     CSV layout (see :meth:`to_csv`)::
 
-        # symid FrequencyData csv v1
+        # symid FrequencyData csv v2
         # n_outputs: p
         # n_inputs: m
+        # n_rows: N
         w,H[0][0].re,H[0][0].im,H[0][1].re,H[0][1].im,...
         <one row per frequency>
+        # end
 
     The H entries run row-major over (output i, input j).
 
@@ -142,12 +144,14 @@ class FrequencyData(DataContainer):
         >>> path = os.path.join(tempfile.mkdtemp(), "frf.csv")
         >>> frf.to_csv(path)
         >>> print(open(path).read(), end="")
-        # symid FrequencyData csv v1
+        # symid FrequencyData csv v2
         # n_outputs: 1
         # n_inputs: 1
+        # n_rows: 2
         w,H[0][0].re,H[0][0].im
         1.0,0.5,-0.5
         2.0,0.2,-0.4
+        # end
         >>> FrequencyData.from_csv(path) == frf
         True
         """
@@ -171,8 +175,9 @@ class FrequencyData(DataContainer):
             constructor's checks.
         """
         meta, columns, rows = _files.read_csv(path, cls._kind)
-        p = _files.meta_int(meta, "n_outputs", path)
-        m = _files.meta_int(meta, "n_inputs", path)
+        p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
+        m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
+        _files.expect_width(columns, 1 + 2 * p * m, path, "1 + 2 × n_outputs × n_inputs")
         _files.expect_columns(columns, cls._columns(p, m), path)
         table = _files.parse_float_rows(rows, path, len(columns))
         H = _files.complex_from_parts(table[:, 1::2], table[:, 2::2]).reshape(-1, p, m)

@@ -55,12 +55,14 @@ class IOData(DataContainer):
 
     CSV layout (see :meth:`to_csv`)::
 
-        # symid IOData csv v1
+        # symid IOData csv v2
         # dt: 0.01
         # n_inputs: m
         # n_outputs: p
+        # n_rows: N
         u[0],...,u[m-1],y[0],...,y[p-1]
         <one row per sample>
+        # end
 
     Examples
     --------
@@ -171,8 +173,9 @@ class IOData(DataContainer):
             constructor's checks.
         """
         meta, columns, rows = _files.read_csv(path, cls._kind)
-        m = _files.meta_int(meta, "n_inputs", path)
-        p = _files.meta_int(meta, "n_outputs", path)
+        m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
+        p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
+        _files.expect_width(columns, m + p, path, "n_inputs + n_outputs")
         dt = _files.meta_float(meta, "dt", path)
         _files.expect_columns(columns, cls._columns(m, p), path)
         table = _files.parse_float_rows(rows, path, len(columns))

@@ -60,11 +60,13 @@ class SpectralData(DataContainer):
     -----
     CSV layout (see :meth:`to_csv`)::
 
-        # symid SpectralData csv v1
+        # symid SpectralData csv v2
         # n_outputs: p
         # n_inputs: m
+        # n_rows: N
         w,Phi_yy[0][0].re,Phi_yy[0][0].im,...,Phi_uu[0][0].re,Phi_uu[0][0].im,...
         <one row per frequency>
+        # end
 
     Full matrices are written (not only a triangle), row-major, first Φyy then Φuu.
 
@@ -158,8 +160,9 @@ class SpectralData(DataContainer):
             constructor's checks.
         """
         meta, columns, rows = _files.read_csv(path, cls._kind)
-        p = _files.meta_int(meta, "n_outputs", path)
-        m = _files.meta_int(meta, "n_inputs", path)
+        p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
+        m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
+        _files.expect_width(columns, 1 + 2 * (p * p + m * m), path, "1 + 2 (n_outputs² + n_inputs²)")
         _files.expect_columns(columns, cls._columns(p, m), path)
         table = _files.parse_float_rows(rows, path, len(columns))
         flat = _files.complex_from_parts(table[:, 1::2], table[:, 2::2])
