@@ -179,3 +179,14 @@ def test_readme_quick_start_is_two_commands():
                         'python3 -m venv .venv && .venv/bin/pip install ".[test]" && .venv/bin/pytest']
     ci = (ROOT / ".ci" / "run").read_text()
     assert f"TEST_CMD='{commands[1]}'" in ci  # .ci/run runs exactly the README's test command
+
+
+def test_readme_tables_are_generated_from_the_benchmark_json():
+    """Results tables in README.md are written by benchmarks/readme_tables.py from benchmarks/results/*.json."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_tables", ROOT / "benchmarks" / "readme_tables.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert "<!-- table: " in README
+    assert module.render(README) == README, "run: python benchmarks/readme_tables.py"

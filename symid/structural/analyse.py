@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+import math
+import numbers
 import time
 import warnings
 from collections.abc import Mapping
 
 import sympy as sp
 
-from symid.errors import IdentifiabilityWarning, ModelError
+from symid.errors import IdentifiabilityWarning, ModelError, OptionError, SolverError
 from symid.structural.combinations import monomial_candidates, parameters_to_fix, select_combinations
-from symid.structural.deadline import run_with_deadline
+from symid.structural.deadline import run_with_deadline, start
 from symid.structural.global_ import GlobalResult, global_analysis, star_and_summary
 from symid.structural.local import local_analysis
 from symid.structural.numeric import numeric_local_check
@@ -19,10 +21,6 @@ from symid.structural.summary import free_parameters, model_kind, rational
 from symid.structural.witness import find_witnesses
 
 _EXACT_LIMIT = 400
-_WITNESS_TIME = 1.0
-"""Seconds of the budget kept for the numerical witness search (at most 0.3·``timeout``)."""
-_GROEBNER_FIRST = 0.75
-"""Seconds the Gröbner step gets before the witness search (every zoo model but random5 needs < 0.35 s)."""
 _WITNESS_SEARCH = 0.5
 """Seconds after which the witness search begins no new batch of starts (when it has found one)."""
 
@@ -62,6 +60,83 @@ def _complexity(expr: sp.Expr) -> tuple[int, int]:
     return terms, sp.count_ops(expr)
 
 
+def _global_step(model, known, positive, seed, extra_candidates, expressions):
+    """θ*, the summary and the Gröbner step, in one child process."""
+    prepared = star_and_summary(model, known, seed=seed)
+    return global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
+                           expressions=expressions, prepared=prepared)
+
+
+def _witness_step(model, known, positive, seed, max_time):
+    """θ*, the summary and the numerical witness search, in one child process."""
+    prepared = star_and_summary(model, known, seed=seed)
+    return find_witnesses(model, known, positive=positive, seed=seed, max_time=max_time, prepared=prepared)
+
+
+def _raise_on_error(step: str, status: str, value: object) -> None:
+    """An internal failure is raised, never turned into a weaker verdict: model problems as ModelError."""
+    if status != "error":
+        return
+    name, message, tb = value
+    if name in ("ModelError", "NonAffineError", "DataError", "OptionError"):
+        raise ModelError(message)
+    raise SolverError(f"the {step} step of the identifiability analysis failed: {name}: {message}"
+                      + (f"\n{tb}" if tb else ""))
+
+
+def _witness_verdict(wit, names, notes) -> tuple[dict, tuple, tuple, bool]:
+    """(θ*, witnesses, certified flags, whether certified witnesses move every parameter)."""
+    theta_star, witnesses, certified = wit.theta_star, wit.witnesses, wit.certified
+    star_f = {k: float(sp.Rational(v)) for k, v in theta_star.items()}
+    moved = {nm for w, ok in zip(witnesses, certified, strict=True) if ok
+             for nm in names if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
+    proven = moved == set(names)
+    if witnesses and not any(certified):
+        why = ("the Krawczyk test failed for each" if wit.square else
+               "the Krawczyk test needs as many summary equations as unknowns; this system has more")
+        notes.append(f"the witnesses are not certified ({why}): they are numerical evidence, not a proof")
+    elif not witnesses:
+        notes.append(f"no second solution found numerically ({wit.n_starts} starts in {wit.seconds:.1f} s); "
+                     "this proves nothing about the global verdict")
+    return theta_star, witnesses, certified, proven
+
+
+def _checked_arguments(model, known, timeout, positive, exact_count, seed):
+    """Every argument of :func:`identifiability` checked before any work; named errors otherwise."""
+    model_kind(model)
+    if known is None:
+        known = {}
+    if not isinstance(known, Mapping):
+        raise OptionError(f"known must be a dict of parameter name → value; got {type(known).__name__}")
+    names = set(model.parameter_names)
+    out = {}
+    for k, v in known.items():
+        key = k.name if isinstance(k, sp.Symbol) else k
+        if not isinstance(key, str) or key not in names:
+            raise ModelError(f"known= names unknown parameter(s) {k!r}; the model's parameters are "
+                             f"{', '.join(model.parameter_names)}")
+        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(float(v)):
+            raise OptionError(f"known[{key!r}] must be a finite real number; got {v!r}")
+        out[key] = float(v)
+    if model.n_parameters == 0:
+        raise ModelError("the model has no parameter: there is nothing to identify")
+    if len(out) == model.n_parameters:
+        raise ModelError("every parameter is given in known=: nothing is left to identify")
+    if timeout is not None:
+        if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real) or math.isnan(float(timeout)) \
+                or float(timeout) <= 0:
+            raise OptionError(f"timeout must be a number of seconds > 0, or None (no limit); got {timeout!r}")
+        timeout = None if math.isinf(float(timeout)) else float(timeout)
+    if positive is not None and not isinstance(positive, bool):
+        raise OptionError(f"positive must be None (the declarations), True or False; got {positive!r}")
+    if not isinstance(exact_count, bool):
+        raise OptionError(f"exact_count must be True or False; got {exact_count!r}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed < 2**63:
+        raise OptionError(f"seed must be an integer between 0 and 2**63 − 1 (reports are deterministic: the same "
+                          f"seed gives the same report); got {seed!r}")
+    return out, timeout, positive, exact_count, int(seed)
+
+
 def identifiability(model, *, known: Mapping[str, float] | None = None, positive: bool | None = None,
                     timeout: float | None = DEFAULT_TIMEOUT, exact_count: bool = False,
                     seed: int = 0) -> IdentifiabilityReport:
@@ -90,28 +165,39 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         ``True`` treats every parameter as positive; ``False`` ignores positivity.
         The report says when positivity changed a verdict.
     timeout : float or None, optional
-        Wall-time budget in seconds of the whole analysis (default 30 s). The exact
-        local step comes first (if even it does not finish, the local verdicts come
-        from a floating-point rank, flagged as a screen). For a locally identifiable
-        model the Gröbner step then gets 0.75 s; if it has not finished, a numerical
-        search for other solutions of summary(θ) = summary(θ*) runs (about 0.5 s,
-        within a reserve of min(1 s, 0.3·timeout)), and each solution found is
-        certified by the Krawczyk interval test when the summary system is square
-        (as many equations as unknowns). Certified solutions that
-        move every parameter prove the model locally but not globally identifiable:
-        the report stops there, with ``n_solutions_at_least`` in place of the exact
-        count. Otherwise the Gröbner step is re-run with the rest of the budget; if
-        it does not finish, the global verdict is marked undetermined (numerical
-        witnesses, if any, are reported as evidence). The combinations of a
-        non-identifiable model are computed after the budget (small, bounded work).
-        ``None`` waits for ever.
+        Wall-time budget in seconds of the whole analysis (default 30 s; ``inf`` or
+        ``None``: no limit, everything in this process). Each bounded step runs in a
+        child process that is killed when the budget is spent (:mod:`~.deadline`), so
+        the call returns within about ``timeout`` plus the time to stop a process. The
+        exact local step comes first (if even it does not finish, the local verdicts
+        come from a floating-point rank, flagged as a screen). For a locally
+        identifiable model the Gröbner step and a numerical search for other solutions
+        of summary(θ) = summary(θ*) (about 0.5 s) then run side by side; each solution
+        found is certified by the Krawczyk interval test when the summary system is
+        square (as many equations as unknowns). Certified solutions that move every
+        parameter prove the model locally but not globally identifiable: the report
+        stops there, with ``n_solutions_at_least`` in place of the exact count.
+        Otherwise the Gröbner step has the rest of the budget; if it does not finish,
+        the global verdict is marked undetermined (numerical witnesses, if any, are
+        reported as evidence). The combinations of a non-identifiable model are
+        computed after the budget (small, bounded work).
     exact_count : bool, optional
-        Give the Gröbner step the whole budget (less the witness reserve) even when
-        certified witnesses could settle the verdicts sooner: for the exact solution
-        count k. Default False.
+        Keep the Gröbner step running for the exact solution count k even when
+        certified witnesses settle the verdicts sooner. Default False.
     seed : int, optional
-        Seed of the random rational points (the verdicts are generic; the seed only
-        matters on a measure-zero set).
+        Seed of the random rational points, an integer ≥ 0 (default 0). The same model
+        and seed give the same report; the verdicts are generic, so the seed only
+        matters on a measure-zero set.
+
+    Raises
+    ------
+    ModelError
+        A model or ``known`` that cannot be analysed (an unknown name, every parameter
+        known, no parameter at all).
+    OptionError
+        A bad ``timeout``, ``positive``, ``exact_count``, ``seed`` or known value.
+    SolverError
+        An analysis step failed unexpectedly (a bug): never reported as a weaker verdict.
 
     Returns
     -------
@@ -129,8 +215,8 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     ['b*c']
     """
     t0 = time.perf_counter()
-    model_kind(model)
-    known = {str(k): float(v) for k, v in (known or {}).items()}
+    known, timeout, positive, exact_count, seed = _checked_arguments(model, known, timeout, positive, exact_count,
+                                                                     seed)
     known_exact = {k: rational(v) for k, v in known.items()}
     free = free_parameters(model, known)
     names = tuple(q.name for q in free)
@@ -138,79 +224,81 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     necessary = _necessary(model, len(free), known)
     notes: list[str] = []
 
+    def left() -> float | None:
+        return None if timeout is None else max(timeout - (time.perf_counter() - t0), 1e-3)
+
     status_local, local = run_with_deadline(local_analysis, {"model": model, "known": known_exact, "seed": seed},
-                                            timeout)
+                                            left())
     t_local = time.perf_counter() - t0
-    if status_local == "error":
-        raise ModelError(f"the local identifiability test failed: {local}")
+    _raise_on_error("local (Jacobian rank)", status_local, local)
     if status_local == "timeout":
         return _numeric_report(model, names, known, necessary, timeout, t0)
     monos = monomial_candidates(local)
     full_rank = local.rank == len(free)
 
-    # One budget. The Gröbner step runs first for at most _GROEBNER_FIRST s; if it has not
-    # finished, the numerical witness search runs; certified witnesses that show every
-    # locally identifiable parameter is not global settle all verdicts (unless
-    # exact_count), otherwise the Gröbner step is re-run with the rest of the budget.
+    # One budget. The Gröbner step and, for a locally identifiable model, the numerical
+    # witness search run side by side in two child processes; certified witnesses that
+    # show every parameter is not global settle all verdicts (unless exact_count), and
+    # then the Gröbner step is stopped; otherwise it has the rest of the budget.
     search = full_rank and bool(free)
-    reserve = min(_WITNESS_TIME, 0.3 * timeout) if timeout is not None and search else 0.0
     t1 = time.perf_counter()
-    status, glob, first = "timeout", None, None
-    # θ* and the summary once, shared by the Gröbner runs and the witness search
-    p_status, prepared = run_with_deadline(star_and_summary, {"model": model, "known": known_exact, "seed": seed},
-                                           None if timeout is None else max(timeout - (t1 - t0) - reserve, 1e-3))
-    if p_status == "error":
-        status, glob = "error", prepared
+    status, glob = "timeout", None
+    # each child computes θ* and the summary itself (sympy's polynomial rings cannot be sent between processes;
+    # the two children run on separate cores)
     g_kwargs = {"model": model, "known": known_exact, "positive": pos, "seed": seed,
-                "extra_candidates": monos, "expressions": not full_rank, "prepared": prepared}
-    now = time.perf_counter() - t0
-    if exact_count or not search:
-        remaining = None if timeout is None else timeout - now - reserve
-    else:
-        remaining = _GROEBNER_FIRST if timeout is None else min(_GROEBNER_FIRST, timeout - now - reserve)
-        first = remaining
-    if p_status == "ok" and (remaining is None or remaining > 0):
-        status, glob = run_with_deadline(global_analysis, g_kwargs, remaining)
+                "extra_candidates": monos, "expressions": not full_rank}
+    p_status = "ok"
     witnesses: tuple = ()
     certified: tuple = ()
     theta_star: dict[str, str] = {}
     proven_by_witnesses = False
-    if status == "timeout" and search and p_status == "ok":
-        left = _WITNESS_TIME / 0.3 if timeout is None else max(timeout - (time.perf_counter() - t0), 0.05)
-        wstatus, wit = run_with_deadline(
-            find_witnesses, {"model": model, "known": known_exact, "positive": pos, "seed": seed,
-                             "max_time": min(0.5 * left, _WITNESS_SEARCH), "prepared": prepared}, left)
-        if wstatus == "ok":
-            theta_star, witnesses, certified = wit.theta_star, wit.witnesses, wit.certified
-            star_f = {k: float(sp.Rational(v)) for k, v in theta_star.items()}
-            moved = {nm for w, ok in zip(witnesses, certified, strict=True) if ok
-                     for nm in names if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
-            proven_by_witnesses = moved == set(names)
-            if witnesses and not any(certified):
-                why = ("the Krawczyk test failed for each" if wit.square else
-                       "the Krawczyk test needs as many summary equations as unknowns; this system has more")
-                notes.append(f"the witnesses are not certified ({why}): they are numerical evidence, not a proof")
-            elif not witnesses:
-                notes.append(f"no second solution found numerically ({wit.n_starts} starts in {wit.seconds:.1f} s); "
-                             "this proves nothing: the global verdict stays undetermined")
-        else:
-            notes.append(f"the numerical search for a second solution did not finish ({wstatus})")
-        if first is not None and not proven_by_witnesses:
-            rest = None if timeout is None else timeout - (time.perf_counter() - t0)
-            if rest is None or rest > first:  # a shorter re-run of the same computation cannot finish
-                status, glob = run_with_deadline(global_analysis, g_kwargs, rest)
+    if p_status == "ok" and timeout is None:  # no deadline: the exact answer, in this process
+        status, glob = run_with_deadline(_global_step, g_kwargs, None)
+    elif p_status == "ok":
+        gjob = start(_global_step, g_kwargs)
+        wjob = None
+        if search:
+            wjob = start(_witness_step, {"model": model, "known": known_exact, "positive": pos, "seed": seed,
+                                         "max_time": _WITNESS_SEARCH})
+        try:
+            wit = None
+            while True:
+                status, glob = gjob.wait(0.0 if wjob is not None else left())
+                if status != "timeout" or (wjob is None and left() <= 1e-3):
+                    break
+                if wjob is not None:
+                    wstatus, wit = wjob.wait(min(0.02, left()))
+                    if wstatus != "timeout":
+                        wjob = None
+                        _raise_on_error("witness search", wstatus, wit)
+                        theta_star, witnesses, certified, proven_by_witnesses = _witness_verdict(wit, names, notes)
+                        if proven_by_witnesses and not exact_count:
+                            break
+                if left() <= 1e-3:
+                    break
+            if wjob is not None and status == "timeout":
+                notes.append("the numerical search for a second solution did not finish within the timeout")
+        finally:
+            gjob.stop()
+            if wjob is not None:
+                wjob.stop()
+    limit = None
+    if status == "error" and glob[0] == "ModelError":  # a documented limit of the exact step, e.g. too many solutions
+        status, limit = "limit", glob[1]
+    _raise_on_error("global (Gröbner basis)", status, glob)
     if status == "ok" and not isinstance(glob, GlobalResult):  # pragma: no cover - defensive
-        status, glob = "error", "unexpected result"
+        raise SolverError(f"the global step returned {type(glob).__name__}, not a result")
     determined = status == "ok"
     if determined:
         global_status = "determined"
-    elif status == "error":
-        global_status = f"undetermined (error: {str(glob).splitlines()[0]})"
     elif proven_by_witnesses:
-        why = (f"Gröbner basis stopped after {first:g} s; exact_count=True keeps it running until the timeout"
-               if first is not None else f"Gröbner basis did not finish within the timeout of {timeout:g} s")
+        spent = time.perf_counter() - t1
+        why = (f"Gröbner basis stopped after {spent:.2g} s; exact_count=True keeps it running until the timeout"
+               if not exact_count else f"Gröbner basis did not finish within the timeout of {timeout:g} s")
         global_status = (f"NOT globally identifiable, proven by {sum(certified)} certified solution(s) θ ≠ θ* of "
                          f"summary(θ) = summary(θ*); exact count not computed ({why})")
+    elif limit is not None:
+        global_status = f"undetermined ({limit})"
     else:
         global_status = f"undetermined (timeout after {timeout:g} s)"
         if witnesses:
@@ -233,8 +321,6 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         for nm in names:
             verdicts[nm] = "local" if loc[nm] else "none"
         verdict = "local" if full_rank else "none"
-        if status == "error":
-            notes.append(f"global step failed: {glob}")
     else:
         notes.extend(glob.notes)
         n_sol, n_real, n_complex = glob.n_admissible, glob.n_real, glob.n_complex

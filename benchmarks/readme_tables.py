@@ -1,0 +1,93 @@
+"""Write the README's results tables from the benchmark JSON files, so they cannot drift.
+
+Each table sits in README.md between two markers naming its source::
+
+    <!-- table: benchmarks/results/identifiability.json -->
+    | model | wall s | ... |
+    <!-- /table -->
+
+Run ``python benchmarks/readme_tables.py`` to rewrite every such table from its JSON;
+``--check`` only compares and exits with status 1 when a table differs (the test suite
+runs the check). A table whose JSON is missing is an error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+_BLOCK = re.compile(r"(<!-- table: (?P<src>[^ ]+) -->\n)(?P<body>.*?)(<!-- /table -->)", re.DOTALL)
+
+
+def _k(row: dict) -> str:
+    if row["verdict"] == "none" and row.get("global_determined"):
+        return "∞"  # not identifiable: a positive-dimensional solution set
+    if row.get("n_solutions") is None:
+        at_least = row.get("n_solutions_at_least")
+        return f"≥ {at_least}" if at_least else "not found"
+    return str(row["n_solutions"])
+
+
+def identifiability_table(doc: dict) -> str:
+    """The identifiability benchmark: one row per model (cold process, import included)."""
+    lines = ["| model | parameters | wall s | cpu s | verdict | solutions |", "|---|---|---|---|---|---|"]
+    for row in doc["rows"]:
+        name = row["model"] + (" with `exact_count=True`" if row.get("exact_count") else "")
+        verdict = {"none": "not identifiable"}.get(row["verdict"], row["verdict"])
+        if verdict == "local" and row.get("verdicts_proven") and not row.get("global_determined"):
+            verdict = "local, not global (proven by certified witnesses)"
+        elif not row.get("global_determined") and not row.get("verdicts_proven"):
+            verdict += " (global undetermined)"
+        wall = f"{row['wall_s']:.2f}" + (f" (timeout {doc['timeout_s']:g} s)"
+                                          if row["report_s"] >= doc["timeout_s"] else "")
+        lines.append(f"| {name} | {row['n_parameters']} | {wall} | {row['cpu_s']:.2f} | {verdict} | {_k(row)} |")
+    lines.append(f"\nLoad average (1 min) {doc['load_average_before']:.2f} before, {doc['load_average_after']:.2f} "
+                 f"after, on {doc['cores']} cores.")
+    return "\n".join(lines) + "\n"
+
+
+TABLES: dict[str, Callable[[dict], str]] = {
+    "benchmarks/results/identifiability.json": identifiability_table,
+}
+
+
+def render(text: str) -> str:
+    """README text with every marked table rewritten from its JSON."""
+    def one(m: re.Match) -> str:
+        src = m.group("src")
+        if src not in TABLES:
+            raise SystemExit(f"README.md: no table writer for {src}")
+        path = ROOT / src
+        if not path.is_file():
+            raise SystemExit(f"README.md: {src} is missing; run its benchmark first")
+        return m.group(1) + TABLES[src](json.loads(path.read_text(encoding="utf-8"))) + m.group(4)
+
+    return _BLOCK.sub(one, text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true", help="compare only; exit 1 when a table differs")
+    args = parser.parse_args(argv)
+    text = README.read_text(encoding="utf-8")
+    new = render(text)
+    if args.check:
+        if new != text:
+            print("README.md tables differ from benchmarks/results; run python benchmarks/readme_tables.py",
+                  file=sys.stderr)
+            return 1
+        return 0
+    if new != text:
+        README.write_text(new, encoding="utf-8")
+        print("README.md tables rewritten")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
