@@ -1,6 +1,8 @@
 """Write the README's results tables from the benchmark JSON files, so they cannot drift.
 
-Each table sits in README.md between two markers naming its source::
+Each table sits in README.md between two markers naming its source (a JSON file, or
+``options`` for the options of every method, read from the estimators' signatures and
+docstrings by :func:`symid.fit.catalog.options_table`)::
 
     <!-- table: benchmarks/results/identifiability.json -->
     | model | wall s | ... |
@@ -56,11 +58,18 @@ TABLES: dict[str, Callable[[dict], str]] = {
     "benchmarks/results/identifiability.json": identifiability_table,
 }
 
+CODE_TABLES: dict[str, Callable[[], str]] = {
+    "options": lambda: __import__("symid.fit.catalog", fromlist=["options_table"]).options_table(),
+}
+"""Tables written from the code rather than a benchmark (``<!-- table: options -->``)."""
+
 
 def render(text: str) -> str:
     """README text with every marked table rewritten from its JSON."""
     def one(m: re.Match) -> str:
         src = m.group("src")
+        if src in CODE_TABLES:
+            return m.group(1) + CODE_TABLES[src]() + m.group(4)
         if src not in TABLES:
             raise SystemExit(f"README.md: no table writer for {src}")
         path = ROOT / src

@@ -31,7 +31,9 @@ class AlsSimilarity(SimilarityEstimator):
     seed : int
         Seed of the random T₀.
     max_iter : int
+        Sweeps at most (default 10 000, the limit quoted in §6-7-2).
     tol : float
+        Stop when the relative step ‖z⁺ − z‖/‖z‖ is at most this (default 1e-6, thesis (6-31)).
     """
 
     method = "als"

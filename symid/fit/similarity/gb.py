@@ -31,7 +31,9 @@ class GbSimilarity(SimilarityEstimator):
     model : StateSpaceModel
     data : SimilarityData
     aux_init : {"random", "model", "zero", "identity"}
+        How (θ₀, T₀) follow from a start (:mod:`~symid.fit.similarity.start`).
     seed : int
+        Seed of the random T₀.
     max_iter : int
         BFGS iteration limit (default 10 000).
     tol : float

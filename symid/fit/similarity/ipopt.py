@@ -29,7 +29,9 @@ class IpoptSimilarity(SimilarityEstimator):
     model : StateSpaceModel
     data : SimilarityData
     aux_init : {"random", "model", "zero", "identity"}
+        How (θ₀, T₀) follow from a start (:mod:`~symid.fit.similarity.start`).
     seed : int
+        Seed of the random T₀.
     positivity : bool
         Bound parameters declared positive below by 0 (default True).
     max_iter : int
@@ -84,6 +86,21 @@ class IpoptSimilarityFRF(SimilarityEstimator):
     The second-order models of chapter 7 are not affine in state-space form, so (6-9)
     does not apply; nonlinear least squares on the black box's response on the misfit
     grid (:class:`~symid.fit.frf.ipopt.IpoptFRF`, with its options) does.
+
+    Parameters
+    ----------
+    model : SecondOrderModel
+    data : SimilarityData
+    scale : array_like, optional
+        Typical magnitude of each parameter; IPOPT works on θ / scale (default 1).
+    positivity : bool
+        Bound parameters declared ``positive=True`` below by 0 (default True).
+    hessian : {"exact", "limited-memory"}
+        Exact Hessian (default) or L-BFGS.
+    max_iter : int
+        IPOPT iteration limit (default 3000).
+    tol : float
+        IPOPT tolerance (default 1e-12).
     """
 
     method = "ipopt"

@@ -230,6 +230,7 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
         Figure 7-3). θ₀ is the start; τ₀ the entries of M(θ₀)⁻¹ when M(θ₀) is positive
         definite, of the identity otherwise.
     seed : int
+        Seed of the random T₀, S₀.
     lmis : bool
         M⁻¹(τ), V, K ⪰ 0 (when symmetric) and positive parameters ≥ 0 (default True).
     implied : bool

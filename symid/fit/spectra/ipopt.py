@@ -51,6 +51,7 @@ class IpoptPSD(SpectraEstimator):
     positivity : bool
         θₖ ≥ 0 for parameters declared ``positive=True`` (default True).
     hessian : {"exact", "limited-memory"}
+        Exact Hessian by automatic differentiation (default) or L-BFGS.
     max_iter : int
         IPOPT iteration limit (default 3000).
     tol : float
