@@ -10,7 +10,7 @@ import traceback
 from collections.abc import Sequence
 
 from symid.errors import SymidError
-from symid.fit.registry import all_methods
+from symid.fit.registry import all_methods, data_kinds
 from symid.interrupt import Interrupted
 
 __all__ = ["build_parser", "main"]
@@ -274,9 +274,10 @@ def build_parser() -> argparse.ArgumentParser:
                                    "median time per start, time to solution and best cost.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     p.add_argument("--data", metavar="FILE", help="data file; default: simulate the zoo recipe (truth known)")
+    per_kind = "; ".join(f"{k.name}: {', '.join(k.methods)}" for k in data_kinds())
     p.add_argument("--methods", default="scr,ipopt",
-                   help="comma-separated methods among scr, scr+polish (SCR then IPOPT from its estimate, "
-                        "reported apart), ipopt, ls, and for black-box or I/O data als, gb (default: scr,ipopt)")
+                   help=f"comma-separated methods ({per_kind}); 'scr+polish' is SCR then IPOPT from its "
+                        "estimate, reported apart (default: scr,ipopt)")
     p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=10, metavar="N",
                    help="number of starts (default: 10)")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
