@@ -71,7 +71,8 @@ def frf_table(doc: dict) -> str:
                          f"{m['n_success']}/{m['n_starts']} | {1e3 * m['median_time']:.3g} | "
                          f"{'∞' if tts is None else f'{tts:.3g}'} | {ratio} |")
     lines.append("")
-    lines.append("| IPOPT configuration | " + " | ".join(_PROBLEM_LABELS.get(p, p) for p in doc["ipopt_variants"]) + " |")
+    names = [_PROBLEM_LABELS.get(p, p) for p in doc["ipopt_variants"]]
+    lines.append("| IPOPT configuration | " + " | ".join(names) + " |")
     lines.append("|---|" + "---|" * len(doc["ipopt_variants"]))
     labels = list(next(iter(doc["ipopt_variants"].values())))
     for label in labels:
@@ -84,7 +85,21 @@ def frf_table(doc: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def similarity_table(doc: dict) -> str:
+    """Success rate (%) per number of unknown entries of random5, per method (thesis Figure 6-3)."""
+    rates = doc["random"]["rate"]
+    ks = sorted({int(k) for m in rates.values() for k in m})
+    n = doc["random"].get("experiments_per_count", "")
+    lines = [f"| unknowns (random5, {n} experiments each) | " + " | ".join(map(str, ks)) + " |",
+             "|---|" + "---|" * len(ks)]
+    for method, rate in rates.items():
+        lines.append(f"| {method.upper()} | " + " | ".join(f"{100 * rate[str(k)]:.0f}" if str(k) in rate else "—"
+                                                          for k in ks) + " |")
+    return "\n".join(lines) + "\n"
+
+
 TABLES: dict[str, Callable[[dict], str]] = {
+    "benchmarks/results/similarity_study.json": similarity_table,
     "benchmarks/results/identifiability.json": identifiability_table,
     "benchmarks/results/frf.json": frf_table,
 }
