@@ -68,13 +68,21 @@ class DataContainer:
 
     @classmethod
     def from_npz(cls, path: _files.PathLike) -> Self:
-        """Read data written by :meth:`to_npz` (``np.load`` with ``allow_pickle=False``).
+        """Read data written by :meth:`to_npz`.
+
+        Only the arrays of this class and the two tags are decompressed, each after its
+        declared size has been checked against its ``.npy`` header and against what the
+        file's size can plausibly hold; pickles are never loaded (rules in the notes of
+        ``symid.data._files``).
 
         Raises
         ------
         DataError
-            If the file is not a symid NPZ file, holds another kind of data, or its
-            arrays fail the constructor's checks.
+            If the file is not a symid NPZ file, holds another kind of data, is damaged
+            or declares more than it can hold, or its arrays fail the constructor's
+            checks.
+        FileNotFoundError, IsADirectoryError, PermissionError
+            If the file cannot be opened.
         """
         arrays = _files.read_npz(path, cls._kind, cls._npz_keys)
         with naming_file(path):

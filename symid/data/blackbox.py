@@ -200,40 +200,43 @@ class BlackBox(DataContainer):
         Raises
         ------
         DataError
-            If the file is not a symid BlackBox CSV file, an entry is missing, repeated
-            or out of range, or the matrices fail the constructor's checks.
+            If the file is not a symid BlackBox CSV file, its sizes do not match the
+            number of entries, an entry is missing, repeated or out of range, or the
+            matrices fail the constructor's checks.
+        FileNotFoundError, IsADirectoryError, PermissionError
+            If the file cannot be opened.
         """
-        meta, columns, rows = _files.read_csv(path, cls._kind)
+        meta, columns, rows = _files.read_csv(path, cls._kind, complete_by_content=True)
         n = _files.meta_int(meta, "n_states", path, at_most=len(rows))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(rows))
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(rows))
         _files.expect_columns(columns, ["matrix", "row", "col", "value"], path)
         if len(rows) != (n + p) * (n + m):  # every entry of A, B, C, D once, before any matrix is built
             raise DataError(f"{str(path)!r} declares n_states {n}, n_inputs {m}, n_outputs {p}, i.e. "
-                            f"{(n + p) * (n + m)} entries, but holds {len(rows)} rows: the header does not match "
-                            f"the data")
+                            f"{(n + p) * (n + m)} entries, but holds {len(rows)} rows (one per entry of A, B, C and D: "
+                            f"n² + n·m + p·n + p·m): the header does not match the data")
         shapes = {"A": (n, n), "B": (n, m), "C": (p, n), "D": (p, m)}
         mats = {k: np.full(shp, np.nan) for k, shp in shapes.items()}
         seen = {k: np.zeros(shp, dtype=bool) for k, shp in shapes.items()}
         where = repr(str(path))
-        for line, (name, row, col, value) in rows:
+        for line, text in rows:
+            name, row, col, value = (c.strip() for c in text.split(","))
             if name not in shapes:
-                raise DataError(f"{where}, line {line}: unknown matrix {name!r}; expected A, B, C or D")
+                raise DataError(f"{where}, line {line}: unknown matrix {name[:40]!r}; expected A, B, C or D")
             try:
+                if not (row.isdigit() and col.isdigit()):  # ASCII already (read_csv): plain digits, no sign
+                    raise ValueError(row)
                 i, j, x = int(row), int(col), float(value)
             except ValueError:
-                raise DataError(f"{where}, line {line}: row and col must be integers and value a number; "
-                                f"got {row!r}, {col!r}, {value!r}") from None
-            if not (0 <= i < shapes[name][0] and 0 <= j < shapes[name][1]):
+                raise DataError(f"{where}, line {line}: row and col must be integers ≥ 0 and value a number; "
+                                f"got {row[:40]!r}, {col[:40]!r}, {value[:40]!r}") from None
+            if not (i < shapes[name][0] and j < shapes[name][1]):
                 raise DataError(f"{where}, line {line}: entry {name}[{i},{j}] is outside {name}'s shape "
                                 f"{shapes[name]}")
             if seen[name][i, j]:
                 raise DataError(f"{where}, line {line}: entry {name}[{i},{j}] appears twice")
             seen[name][i, j] = True
             mats[name][i, j] = x
-        for name in _NAMES:
-            if not seen[name].all():
-                i, j = (int(v) for v in np.argwhere(~seen[name])[0])
-                raise DataError(f"{where}: entry {name}[{i},{j}] is missing")
+        # no entry can be missing: as many rows as entries, each in range and none twice
         with naming_file(path):
             return cls(mats["A"], mats["B"], mats["C"], mats["D"])

@@ -171,8 +171,16 @@ class FrequencyData(DataContainer):
         Raises
         ------
         DataError
-            If the file is not a symid FrequencyData CSV file or its contents fail the
-            constructor's checks.
+            If the file is not a symid FrequencyData CSV file, was cut short, declares
+            sizes that its rows and columns do not match, or its contents fail the
+            constructor's checks (rules in the notes of ``symid.data._files``).
+        FileNotFoundError, IsADirectoryError, PermissionError
+            If the file cannot be opened.
+
+        Warns
+        -----
+        UserWarning
+            For a version-1 file, whose completeness cannot be checked.
         """
         meta, columns, rows = _files.read_csv(path, cls._kind)
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))

@@ -169,8 +169,16 @@ class IOData(DataContainer):
         Raises
         ------
         DataError
-            If the file is not a symid IOData CSV file or its contents fail the
-            constructor's checks.
+            If the file is not a symid IOData CSV file, was cut short, declares
+            sizes that its rows and columns do not match, or its contents fail the
+            constructor's checks (rules in the notes of ``symid.data._files``).
+        FileNotFoundError, IsADirectoryError, PermissionError
+            If the file cannot be opened.
+
+        Warns
+        -----
+        UserWarning
+            For a version-1 file, whose completeness cannot be checked.
         """
         meta, columns, rows = _files.read_csv(path, cls._kind)
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
