@@ -98,7 +98,32 @@ def similarity_table(doc: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+_PSD_LABELS = {"scr-cvxpy": "SCR, Clarabel (default), Yᵢ = −ZᵢZᵢᵀ", "scr-admm": "SCR, ADMM back end",
+               "ipopt": "IPOPT on (5-13)", "scr-no-lmi": "SCR without the LMIs and bounds",
+               "ipopt-weighted": "IPOPT, (5-13) weighted per frequency",
+               "ipopt-equation": "IPOPT, equation error of (5-8)", "scr-printed-sign": "SCR, Yᵢ = +ZᵢZᵢᵀ as printed"}
+_PSD_SIBLINGS = ("psd_no_lmi_admm.json", "psd_ipopt_variants.json")
+
+
+def psd_table(doc: dict) -> str:
+    """The spectral variants of benchmarks/psd.py: psd.json, then the separate runs saved beside it."""
+    docs = [("psd.json", doc)]
+    for name in _PSD_SIBLINGS:
+        path = ROOT / "benchmarks" / "results" / name
+        if path.is_file():
+            docs.append((name, json.loads(path.read_text(encoding="utf-8"))))
+    lines = ["| variant | successes | median s/start | median iterations | best max-entry error | file |",
+             "|---|---|---|---|---|---|"]
+    for name, d in docs:
+        for r in d["results"]:
+            lines.append(f"| {_PSD_LABELS.get(r['variant'], r['variant'])} | {r['successes']}/{r['starts']} | "
+                         f"{r['median_time_per_start']:.3g} | {r['median_iterations']:.0f} | "
+                         f"{r['best_max_entry_error']:.2g} | `{name}` |")
+    return "\n".join(lines) + "\n"
+
+
 TABLES: dict[str, Callable[[dict], str]] = {
+    "benchmarks/results/psd.json": psd_table,
     "benchmarks/results/similarity_study.json": similarity_table,
     "benchmarks/results/identifiability.json": identifiability_table,
     "benchmarks/results/frf.json": frf_table,
