@@ -31,22 +31,28 @@ Run (one BLAS thread per process: threaded BLAS slows the many small solves on 2
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/frf.py [--starts 20] [--seed 0]
 
 Prints a table per problem and the targets of issue 4, and writes
-``benchmarks/results/frf.json``. Absolute times depend on the machine and on what else
-runs on it (the JSON records the load average); ratios are measured in one run.
+``benchmarks/results/frf.json`` when everything is done. Every start is logged as it ends
+to ``benchmarks/results/frf.jsonl`` (``--log``); after Ctrl-C (exit status 130, no summary
+written) the same command resumes; ``--fresh`` starts over; the log is removed once the
+summary is written. ``--problems`` and ``--no-variants`` run a part. Absolute times
+depend on the machine and on what else runs on it (the JSON records the load average);
+ratios are measured in one run.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from _study import add_log_arguments, finish_log, logged  # benchmarks/_study.py (the script's folder is on the path)
 
 import symid as si
+from symid.runlog import RunLog, write_json_atomic
 
 PROBLEMS = ("belt_drive", "mass_damper_2dof")
 METHODS = ("scr", "scr+polish", "ipopt")
@@ -88,14 +94,14 @@ IPOPT_VARIANTS = {  # the default first; the others show it is IPOPT's best conf
 }
 
 
-def ipopt_variants(name: str, starts: int, seed: int) -> dict:
+def ipopt_variants(name: str, starts: int, seed: int, log: RunLog) -> dict:
     """Success rate and time to solution of IPOPT configurations from the same starts."""
     entry = si.load_model(name)
     data = entry.data()
     rows = {}
     for label, opts in IPOPT_VARIANTS.items():
         st = si.compare(entry.model, data, methods=("ipopt",), starts=starts, seed=seed, truth=entry.truth,
-                        progress=False, options={"ipopt": opts})["ipopt"]
+                        progress=False, options={"ipopt": opts}, log=log.scoped(f"{label}/"))["ipopt"]
         rows[label] = {"options": opts, "n_success": st.n_success, "success_rate": st.success_rate,
                        "median_time": st.median_time, "time_to_solution": st.time_to_solution}
     print(f"\n{name}: IPOPT configurations, {starts} starts (seed {seed})")
@@ -104,10 +110,10 @@ def ipopt_variants(name: str, starts: int, seed: int) -> dict:
     return rows
 
 
-def run_problem(name: str, starts: int, seed: int) -> dict:
+def run_problem(name: str, starts: int, seed: int, log: RunLog) -> dict:
     entry = si.load_model(name)
     cmp = si.compare(entry.model, entry.data(), methods=METHODS, starts=starts, seed=seed, truth=entry.truth,
-                     progress=True)
+                     progress=True, log=log)
     print(f"\n{name}: {entry.title}\n{cmp.table()}")
     if name == "mass_damper_2dof":
         assert cmp["scr"].ran_as == "scr", "the 2-DOF must run SCR (4-8), not the LS special case"
@@ -124,18 +130,38 @@ def run_problem(name: str, starts: int, seed: int) -> dict:
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--starts", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--problems", default=",".join(PROBLEMS), help="comma-separated subset of %(default)s")
+    parser.add_argument("--no-variants", action="store_true", help="skip the IPOPT configurations")
     parser.add_argument("--out", default=str(Path(__file__).parent / "results" / "frf.json"))
-    args = parser.parse_args()
+    add_log_arguments(parser, "frf")
+    args = parser.parse_args(argv)
+    problems = tuple(p.strip() for p in args.problems.split(",") if p.strip())
+    if not problems or set(problems) - set(PROBLEMS):
+        parser.error(f"--problems must name some of {', '.join(PROBLEMS)}")
+    log = RunLog(args.log, fresh=args.fresh)
+    if len(log):
+        print(f"resuming from {args.log}: {len(log)} finished runs are read back, not run again", flush=True)
     load0 = os.getloadavg()
     t0 = time.perf_counter()
-    zeros = belt_drive_from_zeros()
-    print(f"belt drive, SCR from θ = 0: ‖θ̂ − θ*‖₂ = {zeros['error']:.2e} in {zeros['wall_time']:.3f} s")
-    results = {name: run_problem(name, args.starts, args.seed) for name in PROBLEMS}
-    variants = {name: ipopt_variants(name, args.starts, args.seed) for name in PROBLEMS}
+    try:
+        zeros = logged(log, "belt_drive_from_zeros", belt_drive_from_zeros)
+        print(f"belt drive, SCR from θ = 0: ‖θ̂ − θ*‖₂ = {zeros['error']:.2e} in {zeros['wall_time']:.3f} s")
+        results = {name: run_problem(name, args.starts, args.seed, log.scoped(f"{name}/")) for name in problems}
+        variants = {} if args.no_variants else {
+            name: ipopt_variants(name, args.starts, args.seed, log.scoped(f"variants/{name}/")) for name in problems}
+    except KeyboardInterrupt:
+        print(f"\ninterrupted: {len(RunLog(args.log))} finished runs are kept in {args.log}; run the same command "
+              "again to resume (no summary written)", file=sys.stderr)
+        return 130
+    return _summarise(args, problems, zeros, results, variants, load0, t0)
+
+
+def _summarise(args: argparse.Namespace, problems: tuple[str, ...], zeros: dict, results: dict, variants: dict,
+               load0: tuple, t0: float) -> int:
 
     def rate(p: str, m: str) -> float:
         return next(s["success_rate"] for s in results[p]["methods"] if s["method"] == m)
@@ -144,30 +170,33 @@ def main() -> None:
         return next(s["time_to_solution"] for s in results[p]["methods"] if s["method"] == m)
 
     print("\nratio of time to solution, SCR / IPOPT (< 1: SCR faster)")
-    for p in PROBLEMS:
+    for p in problems:
         r = results[p]["ratio_time_to_solution"]
         print(f"  {p:18s} scr {_fmt(r['scr/ipopt'])}   scr+polish {_fmt(r['scr+polish/ipopt'])}")
-    harder = min(PROBLEMS, key=lambda p: rate(p, "ipopt"))
+    harder = min(problems, key=lambda p: rate(p, "ipopt"))
     best_scr = min(tts(harder, "scr"), tts(harder, "scr+polish"))
     targets = {
         "belt drive from zeros to 1e-6 in < 1 s": zeros["error"] <= 1e-6 and zeros["wall_time"] < 1.0,
-        **{f"SCR success >= 90% on {p}": rate(p, "scr") >= 0.9 for p in PROBLEMS},
+        **{f"SCR success >= 90% on {p}": rate(p, "scr") >= 0.9 for p in problems},
         f"SCR(+polish) time to solution <= IPOPT's on {harder} (IPOPT's lower success rate)":
             bool(best_scr <= tts(harder, "ipopt")),
     }
     print("\ntargets (issue 4)")
     for k, v in targets.items():
         print(f"  {'met    ' if v else 'NOT MET'}  {k}")
-    doc = {"benchmark": "frf", "starts": args.starts, "seed": args.seed, "belt_drive_from_zeros": zeros,
+    doc = {"benchmark": "frf", "complete": True, "starts": args.starts, "seed": args.seed,
+           "belt_drive_from_zeros": zeros,
            "problems": results, "ipopt_variants": variants, "targets": targets, "total_time": time.perf_counter() - t0,
            "machine": {"platform": platform.platform(), "python": platform.python_version(),
                        "cpus": os.cpu_count(), "load_average_start": load0, "load_average_end": os.getloadavg(),
                        "threads": {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")}}}
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(_finite(doc), indent=1))
+    write_json_atomic(out, _finite(doc))
+    finish_log(Path(args.log))
     print(f"\nwrote {out} (total {doc['total_time']:.0f} s)")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -33,6 +33,8 @@ import sys
 import time
 from pathlib import Path
 
+from symid.runlog import write_json_atomic
+
 MODELS = ("belt_drive", "belt_drive_dorf", "enose", "enose_overparameterized", "compartment_catenary",
           "mass_damper_2dof", "msd3_psd", "msd3_similarity", "random5")
 TARGET_S = 2.0
@@ -113,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
            "rows": rows}
     path = Path(__file__).resolve().parent / "results" / "identifiability.json"
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(out, indent=2))
+    write_json_atomic(path, out, indent=2)
     print(f"wrote {path}")
     return 0
 

@@ -30,27 +30,33 @@ Run (one BLAS thread per process)::
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/psd.py \\
         [--starts 5] [--ipopt-starts 20] [--seed 0] [--variants scr-cvxpy,ipopt,...] [--out FILE]
 
-Prints one table and writes ``benchmarks/results/psd.json`` after every variant (an
-interrupted run keeps the variants it finished). SCR with Clarabel costs about a minute
+Prints one table and writes ``benchmarks/results/psd.json`` when every variant is done.
+SCR with Clarabel costs about a minute
 and a half per start here; the whole default run about half an hour.
+
+Every start is logged as it ends to ``benchmarks/results/psd.jsonl`` (``--log``); after
+Ctrl-C (exit status 130, no summary written) the same command resumes; ``--fresh`` starts
+over; the log is removed once the summary is written.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from _study import add_log_arguments, finish_log, logged  # benchmarks/_study.py (the script's folder is on the path)
 
 import symid as si
 from symid.fit.spectra.ipopt import IpoptPSD
 from symid.fit.spectra.scr import ScrPSD
 from symid.fit.starts import make_starts
 from symid.progress import progress_bar
+from symid.runlog import RunLog, write_json_atomic
 
 SUCCESS = 1e-4  # largest entry error of M, V, K (issue 6)
 VARIANTS = {
@@ -64,14 +70,7 @@ VARIANTS = {
 }
 
 
-def _json_default(obj: object) -> object:
-    """numpy scalars as Python numbers; anything else is a bug in this script."""
-    if isinstance(obj, np.generic):
-        return obj.item()
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
-
-
-def run_variant(name: str, starts: int, seed: int) -> dict:
+def run_variant(name: str, starts: int, seed: int, log: RunLog) -> dict:
     entry = si.load_model("msd3_psd")
     model, data = entry.model, entry.data()
     truth = model.theta_vector(entry.truth)
@@ -80,12 +79,18 @@ def run_variant(name: str, starts: int, seed: int) -> dict:
     solver = ScrPSD(model, data, **opts) if kind == "scr" else IpoptPSD(model, data, **opts)
     setup = time.perf_counter() - t0
     rows = []
-    for x0 in progress_bar(make_starts(model, starts, seed), desc=name, enabled=True):
+
+    def one(x0: np.ndarray) -> dict:
         out = solver.run(x0)
         err = float(np.max(np.abs(out.theta - truth))) if np.all(np.isfinite(out.theta)) else float("inf")
-        rows.append({"start": x0.tolist(), "theta": out.theta.tolist(), "max_entry_error": err,
-                     "misfit": float(out.cost), "iterations": int(out.iterations), "wall_time": float(out.wall_time),
-                     "success": bool(out.success), "status": out.status, "message": out.message})
+        return {"start": x0.tolist(), "theta": out.theta.tolist(), "max_entry_error": err,
+                "misfit": float(out.cost), "iterations": int(out.iterations), "wall_time": float(out.wall_time),
+                "success": bool(out.success), "status": out.status, "message": out.message}
+
+    for i, x0 in enumerate(progress_bar(make_starts(model, starts, seed), desc=name, enabled=True)):
+        rows.append(logged(log, f"{name}/start{i}", lambda x0=x0: one(x0)))
+        if rows[-1]["start"] != x0.tolist():
+            raise SystemExit(f"the log holds another start {i} for {name}: resume with the same --seed, or --fresh")
     n_ok = sum(r["max_entry_error"] <= SUCCESS for r in rows)
     total = setup + sum(r["wall_time"] for r in rows)
     return {"variant": name, "method": kind, "options": {k: repr(v) for k, v in opts.items()},
@@ -107,14 +112,15 @@ def table(results: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--starts", type=int, default=5, help="starts per SCR variant (issue 6: 5)")
     parser.add_argument("--ipopt-starts", type=int, default=20, help="IPOPT starts (thesis §5-7: 20)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--variants", default=",".join(VARIANTS), help=f"comma-separated subset of {list(VARIANTS)}")
     parser.add_argument("--out", default=str(Path(__file__).parent / "results" / "psd.json"))
-    args = parser.parse_args()
+    add_log_arguments(parser, "psd")
+    args = parser.parse_args(argv)
     names = [v.strip() for v in args.variants.split(",") if v.strip()]
     unknown = [v for v in names if v not in VARIANTS]
     if unknown:
@@ -126,15 +132,26 @@ def main() -> None:
            "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
                        "load_average_start": os.getloadavg()}, "results": []}
     t_all = time.perf_counter()
-    for name in names:
-        n = args.ipopt_starts if VARIANTS[name][0] == "ipopt" else args.starts
-        doc["results"].append(run_variant(name, n, args.seed))
-        doc["machine"]["load_average_end"] = os.getloadavg()
-        out.write_text(json.dumps(doc, indent=1, default=_json_default))
+    log = RunLog(args.log, fresh=args.fresh)
+    if len(log):
+        print(f"resuming from {args.log}: {len(log)} finished runs are read back, not run again", flush=True)
+    try:
+        for name in names:
+            n = args.ipopt_starts if VARIANTS[name][0] == "ipopt" else args.starts
+            doc["results"].append(run_variant(name, n, args.seed, log))
+    except KeyboardInterrupt:
+        print(f"\ninterrupted: {len(RunLog(args.log))} finished runs are kept in {args.log}; run the same command "
+              "again to resume (no summary written)", file=sys.stderr)
+        return 130
+    doc["machine"]["load_average_end"] = os.getloadavg()
+    doc["complete"] = True
+    write_json_atomic(out, doc)
+    finish_log(Path(args.log))
     print(f"\nmsd3_psd (thesis §5-6): success = max entry error of M, V, K <= {SUCCESS:g}; seed {args.seed}")
     print(table(doc["results"]))
     print(f"\nwrote {out} (total {time.perf_counter() - t_all:.0f} s)")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

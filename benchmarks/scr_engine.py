@@ -31,15 +31,16 @@ Prints tables and writes ``benchmarks/results/scr_engine.json``.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
 from symid import scr
+from symid.runlog import write_json_atomic
 
 TARGET_SPEEDUP = 10.0  # issue 3: ADMM ≥ 10× faster per SCR iteration than cvxpy on the belt drive
 FIXED = scr.ADMMOptions(inner=50, inner_first=50, inner_max=50, eps_abs=0.0, eps_rel=0.0, adaptive_rho=False)
@@ -255,14 +256,18 @@ def main() -> None:
     print(f"\nload average at end {load1[0]:.2f}; total {time.perf_counter() - t0:.0f} s")
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({
-        "machine": platform.platform(), "python": platform.python_version(), "cores": os.cpu_count(),
-        "omp_threads": os.environ.get("OMP_NUM_THREADS"), "load_average": [load0[0], load1[0]],
-        "belt_drive": belt, "grid": rows, "admm_growth_exponent": growth,
+    write_json_atomic(out, {
+        "complete": True, "machine": platform.platform(), "python": platform.python_version(),
+        "cores": os.cpu_count(), "omp_threads": os.environ.get("OMP_NUM_THREADS"),
+        "load_average": [load0[0], load1[0]], "belt_drive": belt, "grid": rows, "admm_growth_exponent": growth,
         "admm_fixed_options": {"inner": FIXED.inner, "eps_abs": FIXED.eps_abs, "adaptive_rho": FIXED.adaptive_rho},
-    }, indent=1))
+    })
     print(f"wrote {out}")
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except KeyboardInterrupt:  # timings: nothing to resume; the summary is written only at the end
+        print("\ninterrupted: no summary written (the previous one, if any, is untouched)", file=sys.stderr)
+        raise SystemExit(130) from None

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 import warnings
 from pathlib import Path
@@ -47,6 +48,7 @@ import numpy as np
 import symid as si
 from symid.fit.registry import prepare
 from symid.progress import progress_bar
+from symid.runlog import write_json_atomic
 
 RESULTS = Path(__file__).resolve().parent / "results"
 METHODS = ("scr", "als", "gb", "ipopt")
@@ -217,7 +219,10 @@ def main() -> None:
     args = parser.parse_args()
     RESULTS.mkdir(parents=True, exist_ok=True)
     summary_path = RESULTS / "similarity_study.json"
-    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+    try:
+        summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+    except ValueError:  # a damaged summary is rebuilt from the run logs
+        summary = {}
     if args.study in ("random", "both"):
         recs = random_study(args.experiments, range(1, args.max_unknowns + 1), args.fresh)
         summary["random"] = summarise_random(recs) | {"experiments_per_count": args.experiments}
@@ -228,9 +233,14 @@ def main() -> None:
         summary["prior"] = summarise_prior(recs) | {"runs_per_variance": args.runs}
         plot_prior(recs, RESULTS / "similarity_study_prior.png")
         print(_table_prior(summary["prior"]))
-    summary_path.write_text(json.dumps(summary, indent=1, default=float))
+    write_json_atomic(summary_path, summary)
     print(f"wrote {summary_path}")
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except KeyboardInterrupt:
+        print("\ninterrupted: finished runs are kept in benchmarks/results/similarity_study_*.jsonl; run the same "
+              "command again to resume (summary not written)", file=sys.stderr)
+        raise SystemExit(130) from None

@@ -23,18 +23,23 @@ Run (pin BLAS to one thread)::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/similarity_thesis.py
 
-Prints tables and writes ``benchmarks/results/similarity_thesis.json`` (sections merged
-into an existing file, so ``--only`` updates one).
+Prints tables and writes ``benchmarks/results/similarity_thesis.json`` when every section
+is done (``--only`` updates one section and keeps the others' earlier results). Every
+start is logged as it ends to ``benchmarks/results/similarity_thesis.jsonl`` (``--log``);
+after Ctrl-C (exit status 130, no summary written) the same command resumes;
+``--fresh`` starts over.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from _study import add_log_arguments, logged, run_study  # benchmarks/_study.py (the script's folder is on the path)
 
 import symid as si
 from symid.fit.compare import relative_parameter_error
@@ -43,17 +48,19 @@ from symid.fit.similarity.data import similarity_data
 from symid.fit.similarity.scr import ScrSimilarity
 from symid.fit.starts import make_starts
 from symid.progress import progress_bar
+from symid.runlog import RunLog
 
 RESULTS = Path(__file__).resolve().parent / "results" / "similarity_thesis.json"
 SUCCESS = 1e-3  # thesis (6-32)/(6-33)
 SCR_OPTIONS = {"max_iter": 2000}
 
 
-def enose(starts: int = 10, seed: int = 0) -> dict:
+def enose(log: RunLog, starts: int = 10, seed: int = 0) -> dict:
     """SCR, ALS, GB and IPOPT on the e-nose (6-19) from identical random starts."""
     entry = si.load_model("enose")
     cmp = si.compare(entry.model, entry.data(), methods=("scr", "als", "gb", "ipopt"), starts=starts, seed=seed,
-                     truth=entry.truth, param_tol=SUCCESS, progress=True, options={"scr": SCR_OPTIONS})
+                     truth=entry.truth, param_tol=SUCCESS, progress=True, options={"scr": SCR_OPTIONS},
+                     log=log.scoped("compare/"))
     print(cmp.table())
     truth = entry.model.theta_vector(entry.truth)
     out = {"starts": starts, "seed": seed, "success_threshold": SUCCESS, "thesis_scr": "about 3 of 10",
@@ -64,11 +71,15 @@ def enose(starts: int = 10, seed: int = 0) -> dict:
                                     "times": [o.wall_time for o in s.result.starts],
                                     "median_time": s.median_time, "options": s.result.options}
     # thesis §6-6-2: "S, T initialized as zero matrices ... the method fails"
-    zero = prepare(entry.model, entry.data(), "scr", {"aux_init": "zero", **SCR_OPTIONS}).run(
-        np.zeros(entry.model.n_parameters))
-    zero_err = relative_parameter_error(zero.theta, truth)
-    print(f"SCR from T = S = 0: parameter error {zero_err:.3e} after {zero.iterations} iterations")
-    out["zero_start"] = {"parameter_error": zero_err, "iterations": zero.iterations, "time": zero.wall_time}
+    def zero_start() -> dict:
+        zero = prepare(entry.model, entry.data(), "scr", {"aux_init": "zero", **SCR_OPTIONS}).run(
+            np.zeros(entry.model.n_parameters))
+        return {"parameter_error": relative_parameter_error(zero.theta, truth), "iterations": zero.iterations,
+                "time": zero.wall_time}
+
+    out["zero_start"] = logged(log, "zero_start", zero_start)
+    print(f"SCR from T = S = 0: parameter error {out['zero_start']['parameter_error']:.3e} after "
+          f"{out['zero_start']['iterations']} iterations")
     # the printed (6-18): a noisy estimate, no exact solution
     bb = si.BlackBox(entry.extra["A_bb_printed"], entry.extra["B_bb_printed"], entry.extra["C_bb_printed"])
     res = si.identify(entry.model, bb, method="scr", starts=starts, seed=seed, progress=True,
@@ -80,22 +91,26 @@ def enose(starts: int = 10, seed: int = 0) -> dict:
     return out
 
 
-def enose_over(starts: int = 10, seed: int = 0) -> dict:
+def enose_over(log: RunLog, starts: int = 10, seed: int = 0) -> dict:
     """SCR on the over-parameterised e-nose (6-22): a point of the solution manifold."""
     entry = si.load_model("enose_overparameterized")
     model = entry.model
     sd = similarity_data(model, entry.data())
     solver = ScrSimilarity(model, sd, **SCR_OPTIONS)
     runs = []
-    for x in progress_bar(make_starts(model, starts, seed, zero_first=True), desc="scr", enabled=True):
+
+    def one(x: np.ndarray) -> dict:
         t0 = time.perf_counter()
         sol = solver.solve(x)
         T, S = solver.transform(sol, original=True)
         theta = np.asarray(sol.x["theta"], dtype=float)
-        runs.append({"theta": theta.tolist(), "misfit": sd.misfit(model, theta),
-                     "TS_minus_I": float(np.linalg.norm(T @ S - np.eye(3))),
-                     "ST_minus_I": float(np.linalg.norm(S @ T - np.eye(3))), "iterations": sol.iterations,
-                     "time": time.perf_counter() - t0, "T": T.tolist(), "S": S.tolist()})
+        return {"theta": theta.tolist(), "misfit": sd.misfit(model, theta),
+                "TS_minus_I": float(np.linalg.norm(T @ S - np.eye(3))),
+                "ST_minus_I": float(np.linalg.norm(S @ T - np.eye(3))), "iterations": sol.iterations,
+                "time": time.perf_counter() - t0}
+
+    for i, x in enumerate(progress_bar(make_starts(model, starts, seed, zero_first=True), desc="scr", enabled=True)):
+        runs.append(logged(log, f"start{i}", lambda x=x: one(x)))
     best = min(runs, key=lambda r: r["misfit"])
     theta = np.array(best["theta"])
     A_true = model.maps["A"](model.theta_vector(entry.truth))
@@ -106,11 +121,10 @@ def enose_over(starts: int = 10, seed: int = 0) -> dict:
     print(f"best: θ̂ = {np.round(theta, 4)}, misfit {best['misfit']:.2e}, ‖TS − I‖ {best['TS_minus_I']:.2e}, "
           f"‖ST − I‖ {best['ST_minus_I']:.2e}, eigenvalue error {eig_err:.2e}, "
           f"θ̂2 + θ̂4 + θ̂6 = {theta[1] + theta[3] + theta[5]:.4f} (0 at the physical point)")
-    return {"starts": starts, "seed": seed, "found": found, "best": best, "eigenvalue_error": eig_err,
-            "runs": [{k: v for k, v in r.items() if k not in ("T", "S")} for r in runs]}
+    return {"starts": starts, "seed": seed, "found": found, "best": best, "eigenvalue_error": eig_err, "runs": runs}
 
 
-def msd3(starts: int = 3, seed: int = 0) -> dict:
+def msd3(log: RunLog, starts: int = 3, seed: int = 0) -> dict:
     """Algorithm 7.1 on the 3-D mass-spring-damper (7-17) from simulated I/O data."""
     entry = si.load_model("msd3_similarity")
     model, io = entry.model, entry.data()
@@ -124,7 +138,7 @@ def msd3(starts: int = 3, seed: int = 0) -> dict:
     bb_err = float(np.max(np.abs(sd.frf.H - H0)) / np.max(np.abs(H0)))
     print(f"N4SID + d2c: {t_bb:.2f} s, black-box frequency response off by {bb_err:.2e} (max, relative)")
     cmp = si.compare(model, io, methods=("scr", "scr+polish"), starts=starts, seed=seed, truth=entry.truth,
-                     param_tol=1e-2, progress=True, options={"scr": SCR_OPTIONS})
+                     param_tol=1e-2, progress=True, options={"scr": SCR_OPTIONS}, log=log.scoped("compare/"))
     print(cmp.table())
     out = {"n4sid_time": t_bb, "blackbox_frf_error": bb_err, "starts": starts, "seed": seed, "methods": {}}
     for s in cmp.stats:
@@ -143,21 +157,23 @@ def msd3(starts: int = 3, seed: int = 0) -> dict:
 SECTIONS = {"enose": enose, "enose_over": enose_over, "msd3": msd3}
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", choices=sorted(SECTIONS), help="run one section")
-    args = parser.parse_args()
-    results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
-    for name, fn in SECTIONS.items():
-        if args.only and name != args.only:
-            continue
-        print(f"== {name}")
-        t0 = time.perf_counter()
-        results[name] = fn() | {"wall_time": time.perf_counter() - t0}
-        RESULTS.parent.mkdir(parents=True, exist_ok=True)
-        RESULTS.write_text(json.dumps(results, indent=1, default=float))
-    print(f"wrote {RESULTS}")
+    parser.add_argument("--out", default=str(RESULTS), help="summary JSON (default: %(default)s)")
+    add_log_arguments(parser, "similarity_thesis")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    previous = {}
+    if args.only and out.is_file():  # keep the other sections' earlier results; a damaged file is not trusted
+        try:
+            previous = {k: v for k, v in json.loads(out.read_text()).items() if k in SECTIONS}
+        except (ValueError, OSError):
+            print(f"{out} is not valid JSON; it will be replaced", file=sys.stderr)
+    sections = {k: v for k, v in SECTIONS.items() if not args.only or k == args.only}
+    return run_study(sections, out=out, log_path=Path(args.log), fresh=args.fresh,
+                     header={"benchmark": "similarity_thesis"}, previous=previous)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())
