@@ -196,3 +196,11 @@ def test_every_option_of_every_method_is_documented():
     assert len(rows) > 60
     undocumented = [r for r in rows if r.endswith("|  |")]
     assert not undocumented, undocumented
+
+
+def test_the_polish_is_judged_with_the_same_noise_floor():
+    model = chain()
+    noisy = si.simulate_frf(model, TRUTH_2DOF, np.logspace(np.log10(0.5), np.log10(2), 30), noise=0.01, seed=1)
+    res = si.identify(model, noisy, method="scr", seed=0, polish=True, identifiability_check=False,
+                      noise_floor=1e-6)  # 100 times too small: nothing may count as a success
+    assert not res.success and not res.polished.success and "noise floor" in res.polished.fit

@@ -312,6 +312,7 @@ def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s
         polisher = estimator.polisher()
         if polisher is None:
             raise OptionError(f"{method!r}: method {estimator.method!r} has no polish step")
+        polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
     setup = time.perf_counter() - t0
     opts = dict(estimator.options)
     ran_as = estimator.method

@@ -103,6 +103,8 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
     polisher = estimator.polisher() if polish else None
     if polish and polisher is None:
         raise OptionError(f"method {estimator.method!r} has no polish step (polish=True applies to SCR)")
+    if polisher is not None:
+        polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
     x0s = make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
