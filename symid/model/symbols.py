@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import keyword
+import unicodedata
 from collections.abc import Iterable, Sequence
 from typing import Any
 
@@ -10,7 +11,7 @@ import numpy as np
 import sympy as sp
 
 from symid.errors import ModelError
-from symid.model.expressions import parse_expression
+from symid.model.expressions import parse_expression, sympify_value
 
 __all__ = ["as_symbolic_matrix", "parameters", "parse_entry"]
 
@@ -50,6 +51,10 @@ def parameters(names: str | Sequence[str], *, positive: bool = False):
             raise ModelError(f"parameter name {p!r} is not a valid identifier")
         if keyword.iskeyword(p):
             raise ModelError(f"parameter name {p!r} is a Python keyword; choose another (e.g. {p + '_'!r})")
+        normal = unicodedata.normalize("NFKC", p)
+        if normal != p:  # a text entry could never name it: Python reads identifiers in NFKC form
+            raise ModelError(f"parameter name {p!r} {p!a} is read by Python as {normal!r} {normal!a}; "
+                             f"write {normal!r}")
     if len(set(parts)) != len(parts):
         dup = sorted({p for p in parts if parts.count(p) > 1})
         raise ModelError(f"parameter names are repeated: {', '.join(dup)}")
@@ -97,22 +102,15 @@ def parse_entry(text: str, where: str = "entry") -> sp.Expr:
 
 
 def _entry(value: Any, name: str, i: int, j: int) -> sp.Expr:
-    if isinstance(value, (bytes, bytearray)):
-        raise ModelError(f"{name}[{i}, {j}] is bytes; write the entry as text (str) or a number")
     if isinstance(value, str):
         return parse_entry(value, f"{name}[{i}, {j}]")
-    if isinstance(value, (bool, np.bool_)):
-        raise ModelError(f"{name}[{i}, {j}] is a boolean ({value}); expected a number or expression")
     if isinstance(value, (np.floating, np.integer, np.complexfloating)):
         value = value.item()
     if isinstance(value, float):
         if not np.isfinite(value):
             raise ModelError(f"{name}[{i}, {j}] is {value}; entries must be finite")
         return sp.Float(value)
-    try:
-        out = sp.sympify(value, strict=True)
-    except (sp.SympifyError, SyntaxError, TypeError):
-        raise ModelError(f"{name}[{i}, {j}] = {value!r} is neither a number nor a sympy expression") from None
+    out = sympify_value(value, f"{name}[{i}, {j}]")  # never parses text (nor text inside a tuple or dict)
     if not isinstance(out, sp.Expr):
         raise ModelError(f"{name}[{i}, {j}] = {value!r} is not a number or an expression "
                          f"(sympy reads it as {type(out).__name__})")

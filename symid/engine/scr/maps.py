@@ -8,6 +8,7 @@ are compiled by :func:`compile_sympy` with one expansion per entry.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -17,10 +18,13 @@ import sympy as sp
 
 from symid.engine.scr.variables import Layout
 from symid.errors import ModelError, NonAffineError
-from symid.model.expressions import parse_expression
+from symid.model.expressions import parse_expression, sympify_value
 
-__all__ = ["Affine", "LocalMap", "as_map", "compile_sympy", "stack_index", "stack_maps", "sympy_entry",
-           "variable_names"]
+__all__ = ["MAX_EXPANDED_TERMS", "Affine", "LocalMap", "as_map", "checked_expansion", "compile_sympy", "stack_index",
+           "stack_maps", "sympy_entry", "variable_names"]
+
+MAX_EXPANDED_TERMS = 100_000
+"""Most terms an entry or objective may expand to (an upper bound, counted before like terms merge)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,6 +108,21 @@ def _clean(idx: np.ndarray, coef: np.ndarray, const: np.ndarray) -> LocalMap:
     return LocalMap(np.asarray(const, dtype=complex), idx, coef)
 
 
+def _numeric_array(value: Any, what: str) -> np.ndarray:
+    """An array of numbers as complex; text is refused, never read by numpy (which would parse "nan")."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise ModelError(f"{what} cannot be read as an array of numbers: {exc}") from None
+    if arr.dtype.kind == "O" and all(isinstance(v, (int, float, complex, np.number)) and not isinstance(v, bool)
+                                     for v in arr.flat):
+        arr = arr.astype(complex)
+    if arr.dtype.kind not in "biufc":
+        raise ModelError(f"{what} must hold numbers, got an array of dtype {arr.dtype} "
+                         f"(write symbolic or text entries as a sympy matrix or a nested list instead of Affine)")
+    return arr.astype(complex)
+
+
 class Affine:
     """A numeric affine matrix map, the sympy-free way to pose problem data.
 
@@ -133,14 +152,14 @@ class Affine:
     """
 
     def __init__(self, const: Any, coefs: Mapping[Any, Any] | None = None):
-        c0 = np.asarray(const)
+        c0 = _numeric_array(const, "Affine: the constant part")
         if c0.ndim == 1:
             c0 = c0.reshape(-1, 1)
         if c0.ndim == 0:
             c0 = c0.reshape(1, 1)
         if c0.ndim != 2:
             raise ModelError(f"Affine: the constant part must be a matrix, got shape {c0.shape}")
-        self.const = c0.astype(complex)
+        self.const = c0
         self.coefs = dict(coefs or {})
 
     @property
@@ -155,7 +174,7 @@ class Affine:
         idxs, cols = [], []
         for key, arr in self.coefs.items():
             v = layout.variable(key)
-            a = np.asarray(arr, dtype=complex)
+            a = _numeric_array(arr, f"{name}: the coefficient of {v.name}")
             want = (r, c, *v.shape)
             if a.shape != want and a.size == int(np.prod(want)):
                 a = a.reshape(want)
@@ -192,15 +211,42 @@ def sympy_entry(value: Any, where: str, layout: Layout) -> sp.Expr:
     which never parses text."""
     if isinstance(value, str):
         return parse_expression(value, where, symbol=variable_names(layout))
-    if isinstance(value, (bytes, bytearray)):
-        raise ModelError(f"{where} is bytes; write it as text (str), a number or a sympy expression")
-    try:
-        out = sp.sympify(value, strict=True)
-    except (sp.SympifyError, TypeError, ValueError) as exc:
-        raise ModelError(f"{where} = {value!r} is not a number or a sympy expression ({exc})") from None
-    if isinstance(out, sp.Basic) and out.has(sp.oo, -sp.oo, sp.zoo, sp.nan):
+    out = sympify_value(value, where)  # never parses text (nor text inside a tuple or dict)
+    if not isinstance(out, sp.Expr):
+        raise ModelError(f"{where} = {value!r} is not a number or an expression "
+                         f"(sympy reads it as {type(out).__name__})")
+    if out.has(sp.oo, -sp.oo, sp.zoo, sp.nan):
         raise ModelError(f"{where} = {out} is not finite")
     return out
+
+
+def _expanded_terms(expr: sp.Basic, limit: int) -> int:
+    """An upper bound on the number of terms ``sympy.expand(expr)`` builds, capped at ``limit + 1``."""
+    if expr.is_Add:
+        return min(limit + 1, sum(_expanded_terms(a, limit) for a in expr.args))
+    if expr.is_Mul:
+        out = 1
+        for a in expr.args:
+            out = min(limit + 1, out * _expanded_terms(a, limit))
+        return out
+    if expr.is_Pow and expr.exp.is_Integer:
+        n, k = _expanded_terms(expr.base, limit), abs(int(expr.exp))
+        if n == 1:
+            return 1
+        if n > limit or k > limit:
+            return limit + 1
+        return min(limit + 1, math.comb(n + k - 1, k))  # monomials of degree k in n terms
+    # a function, or a power with another exponent: one term, whose arguments expand inside
+    return limit + 1 if any(_expanded_terms(a, limit) > limit for a in expr.args) else 1
+
+
+def checked_expansion(expr: sp.Expr, where: str) -> sp.Expr:
+    """``sympy.expand(expr)``, refused with a :class:`ModelError` when it would build over
+    :data:`MAX_EXPANDED_TERMS` terms (``(x1 + … + x8)**64`` has 10⁹: expanding it never ends)."""
+    if _expanded_terms(expr, MAX_EXPANDED_TERMS) > MAX_EXPANDED_TERMS:
+        raise ModelError(f"{where} = {sp.sstr(expr)[:80]} would expand to more than {MAX_EXPANDED_TERMS} terms; "
+                         f"write it expanded, or as scr.SumSquares for a large objective")
+    return sp.expand(expr)
 
 
 def _sympy_matrix(value: Any, name: str, layout: Layout) -> sp.Matrix:
@@ -253,7 +299,7 @@ def compile_sympy(value: Any, layout: Layout, name: str) -> LocalMap:
             if not fs:
                 const[i, j] = complex(sp.N(expr))
                 continue
-            for term in sp.Add.make_args(sp.expand(expr)):
+            for term in sp.Add.make_args(checked_expansion(expr, f"{name}[{i}, {j}]")):
                 tfs = term.free_symbols
                 if not tfs:
                     const[i, j] += complex(sp.N(term))

@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sps
 import sympy as sp
 
-from symid.engine.scr.maps import LocalMap, as_map, stack_index, stack_maps, sympy_entry
+from symid.engine.scr.maps import LocalMap, as_map, checked_expansion, stack_index, stack_maps, sympy_entry
 from symid.engine.scr.variables import Layout, Variable
 from symid.errors import ModelError
 
@@ -85,7 +85,7 @@ class CompiledTerm:
 
 
 def _quadratic_from_sympy(expr: Any, layout: Layout) -> tuple[sps.csr_matrix, np.ndarray, float]:
-    e = sp.expand(sympy_entry(expr, "objective", layout))
+    e = checked_expansion(sympy_entry(expr, "objective", layout), "objective")
     index = layout.symbol_index
     stray = e.free_symbols - set(index)
     if stray:
