@@ -3,11 +3,16 @@
 from __future__ import annotations
 
 import json
+import multiprocessing
+import os
+import signal
 import subprocess
 import sys
 import threading
 import time
 import warnings
+from functools import partial
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -196,7 +201,7 @@ def _hang(*args, **kwargs):
 def test_timeout_returns_the_exact_local_verdict_and_never_hangs(monkeypatch):
     # the Gröbner step made to hang on the belt drive (globally identifiable: no witness can
     # exist): the child running it is killed at the deadline and the verdict is undetermined
-    monkeypatch.setattr("symid.structural.analyse.global_analysis", _hang)
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _hang)
     model = si.load_model("belt_drive").model
     t0 = time.perf_counter()
     rep = si.identifiability(model, timeout=4.0)
@@ -214,7 +219,7 @@ def test_timeout_returns_the_exact_local_verdict_and_never_hangs(monkeypatch):
 
 @pytest.mark.parametrize("t", [1.0, 2.0])
 def test_timeout_is_kept_within_half_a_second(monkeypatch, t):
-    monkeypatch.setattr("symid.structural.analyse.global_analysis", _hang)
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _hang)
     t0 = time.perf_counter()
     rep = si.identifiability(si.load_model("belt_drive").model, timeout=t)
     assert time.perf_counter() - t0 < t + 0.5
@@ -223,7 +228,7 @@ def test_timeout_is_kept_within_half_a_second(monkeypatch, t):
 
 def test_no_exception_is_ignored_at_the_deadline():
     # the old SIGALRM deadline could land in a weakref callback, where Python prints "Exception ignored"
-    code = ("import symid as si, symid.structural.analyse as a, time\n"
+    code = ("import symid as si, symid.structural.steps as a, time\n"
             "a.global_analysis = lambda *p, **k: time.sleep(600)\n"
             "for t in (0.3, 0.6, 1.0):\n"
             "    si.identifiability(si.load_model('random5').model, timeout=t)\n")
@@ -258,7 +263,7 @@ def test_random5_is_proven_not_global_by_certified_witnesses():
 
 
 def test_exact_count_keeps_the_groebner_step_running(monkeypatch):
-    monkeypatch.setattr("symid.structural.analyse.global_analysis", _hang)
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _hang)
     model = si.load_model("random5").model
     t0 = time.perf_counter()
     rep = si.identifiability(model, timeout=2.0, exact_count=True)
@@ -282,7 +287,7 @@ def test_tiny_timeout_falls_back_to_the_float_screen_with_known_values():
 def test_a_verified_witness_shows_the_model_is_not_global_after_a_timeout(monkeypatch):
     # (1-2) as printed has 4 positive solutions (see the catenary test above); with the Gröbner
     # step made to time out, the numerical search must find and verify the other three
-    monkeypatch.setattr("symid.structural.analyse.global_analysis", _hang)
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _hang)
     model = si.load_model("compartment_catenary").extra["model_as_printed"]
     t0 = time.perf_counter()
     rep = si.identifiability(model, timeout=3.0)
@@ -341,11 +346,13 @@ def test_krawczyk_certifies_a_true_root_and_rejects_a_near_miss():
 
 
 def _fail(*args, **kwargs):
-    raise si.ModelError("more than 400 complex solutions; not enumerated")
+    from symid.structural.global_ import ExactStepLimit
+
+    raise ExactStepLimit("more than 400 complex solutions; not enumerated")
 
 
 def test_a_documented_limit_of_the_global_step_is_reported(monkeypatch):
-    monkeypatch.setattr("symid.structural.analyse.global_analysis", _fail)
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _fail)
     rep = si.identifiability(si.load_model("belt_drive").model, timeout=2.0)
     assert rep.verdict == "local" and not rep.global_determined
     assert "more than 400 complex solutions" in rep.global_status
@@ -356,11 +363,165 @@ def _bug(*args, **kwargs):
 
 
 def test_an_internal_failure_is_raised_never_a_weaker_verdict(monkeypatch):
-    monkeypatch.setattr("symid.structural.analyse.global_analysis", _bug)
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _bug)
     with pytest.raises(si.SolverError, match=r"global .* step .* failed: TypeError: an internal bug"):
         si.identifiability(si.load_model("belt_drive").model, timeout=5.0)
     with pytest.raises(si.SolverError, match="TypeError: an internal bug"):
         si.identifiability(si.load_model("belt_drive").model, timeout=None)
+
+
+def test_an_internal_failure_of_the_other_steps_is_raised(monkeypatch):
+    belt = si.load_model("belt_drive").model
+    monkeypatch.setattr("symid.structural.analyse.local_analysis", _bug)
+    with pytest.raises(si.SolverError, match=r"local \(Jacobian rank\) step .* failed: TypeError: an internal bug"):
+        si.identifiability(belt, timeout=5.0)
+    monkeypatch.undo()
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _hang)
+    monkeypatch.setattr("symid.structural.steps.find_witnesses", _bug)
+    with pytest.raises(si.SolverError, match=r"witness search step .* failed: TypeError: an internal bug"):
+        si.identifiability(belt, timeout=5.0)
+
+
+# -- a child that dies, Ctrl-C, no zombie or orphan ---------------------------------------
+
+def _killed(sig, *args, **kwargs):
+    import faulthandler
+
+    faulthandler.disable()  # pytest's handler would print a "Fatal Python error" dump for SIGSEGV
+    os.kill(os.getpid(), sig)
+    time.sleep(60)
+
+
+def _exits(*args, **kwargs):
+    os._exit(3)
+
+
+def _out_of_memory(*args, **kwargs):
+    raise MemoryError("test")
+
+
+DEATHS = [
+    (partial(_killed, signal.SIGKILL), "stopped without a result: its process was killed by SIGKILL (a crash, "
+     "the out-of-memory killer, or another process)"),
+    (partial(_killed, signal.SIGSEGV), "stopped without a result: its process was killed by SIGSEGV (a crash, "
+     "the out-of-memory killer, or another process)"),
+    (_exits, "stopped without a result: its process exited with code 3"),
+    (_out_of_memory, "ran out of memory (MemoryError: test)"),
+]
+
+
+@pytest.mark.parametrize(("die", "reason"), DEATHS)
+def test_a_dead_groebner_step_is_undetermined_with_the_reason(monkeypatch, die, reason):
+    monkeypatch.setattr("symid.structural.steps.global_analysis", die)
+    t0 = time.perf_counter()
+    rep = si.identifiability(si.load_model("belt_drive").model, timeout=20.0)
+    assert time.perf_counter() - t0 < 10.0  # seen when it happens, not at the deadline (measured < 0.7 s)
+    assert rep.global_status == f"undetermined (the Gröbner step {reason})"
+    assert rep.verdict == "local" and not rep.global_determined and not rep.verdicts_proven
+    assert rep.jacobian_ranks == (4, 4)
+
+
+def test_out_of_memory_without_a_deadline_is_undetermined_too(monkeypatch):
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _out_of_memory)
+    rep = si.identifiability(si.load_model("belt_drive").model, timeout=None)
+    assert rep.global_status == "undetermined (the Gröbner step ran out of memory (MemoryError: test))"
+
+
+def test_a_dead_local_step_falls_back_to_the_float_screen(monkeypatch):
+    monkeypatch.setattr("symid.structural.analyse.local_analysis", partial(_killed, signal.SIGKILL))
+    rep = si.identifiability(si.load_model("belt_drive").model, timeout=20.0)
+    assert rep.global_status == ("undetermined (the exact local step stopped without a result: its process was "
+                                 "killed by SIGKILL (a crash, the out-of-memory killer, or another process))")
+    assert rep.jacobian_ranks == (4,) and rep.verdict == "local"  # one floating-point rank
+    assert any("floating-point rank" in n for n in rep.notes)
+
+
+def test_a_dead_witness_search_leaves_the_groebner_step_its_budget(monkeypatch):
+    monkeypatch.setattr("symid.structural.steps.global_analysis", _hang)
+    monkeypatch.setattr("symid.structural.steps.find_witnesses", partial(_killed, signal.SIGKILL))
+    t0 = time.perf_counter()
+    rep = si.identifiability(si.load_model("belt_drive").model, timeout=1.5)
+    assert 1.5 - 0.05 <= time.perf_counter() - t0 < 1.5 + 0.5
+    assert rep.global_status == "undetermined (timeout after 1.5 s)"
+    assert any(n.startswith("the numerical search for a second solution stopped without a result: its process was "
+                            "killed by SIGKILL") for n in rep.notes)
+
+
+def _record_pid_and_hang(path, *args, **kwargs):
+    Path(path).write_text(f"{os.getpid()}\n")
+    time.sleep(600)
+
+
+def _exited(pid: int, within: float) -> bool:
+    """Whether process ``pid`` has ended within ``within`` s (a zombie left to init counts as ended)."""
+    end = time.monotonic() + within
+    while True:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        try:
+            if Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z":
+                return True
+        except (OSError, IndexError):
+            pass
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.05)
+
+
+def test_a_stopped_child_is_killed_and_reaped(monkeypatch, tmp_path):
+    monkeypatch.setattr("symid.structural.steps.global_analysis", partial(_record_pid_and_hang, tmp_path / "pid"))
+    rep = si.identifiability(si.load_model("belt_drive").model, timeout=1.0)
+    assert not rep.global_determined
+    pid = int((tmp_path / "pid").read_text())
+    with pytest.raises(ChildProcessError):  # already reaped by the parent: no zombie left behind
+        os.waitpid(pid, os.WNOHANG)
+    with pytest.raises(ProcessLookupError):  # and gone
+        os.kill(pid, 0)
+    assert multiprocessing.active_children() == []
+
+
+_HANGING_PARENT = """
+import os, sys, time
+import symid as si, symid.structural.steps as steps
+
+def hang(*args, **kwargs):
+    with open(sys.argv[1], "w") as f:
+        f.write(f"{os.getpid()}\\n")
+    time.sleep(600)
+
+steps.global_analysis = hang
+si.identifiability(si.load_model("belt_drive").model, timeout=300)
+"""
+
+
+@pytest.mark.parametrize("how", ["ctrl-c", "parent killed"])
+def test_the_groebner_child_never_outlives_its_parent(tmp_path, how):
+    # Ctrl-C at a terminal sends SIGINT to the whole process group: the parent raises
+    # KeyboardInterrupt and kills the child (which ignores SIGINT). A parent killed outright
+    # (SIGKILL) cannot clean up: the orphaned child notices and exits by itself.
+    pidfile = tmp_path / "pid"
+    proc = subprocess.Popen([sys.executable, "-c", _HANGING_PARENT, str(pidfile)], stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    try:
+        end = time.monotonic() + 60
+        while not (pidfile.exists() and pidfile.read_text().endswith("\n")):
+            assert time.monotonic() < end and proc.poll() is None, "the Gröbner child never started"
+            time.sleep(0.05)
+        child = int(pidfile.read_text())
+        if how == "ctrl-c":
+            os.killpg(proc.pid, signal.SIGINT)
+        else:
+            proc.kill()
+        _, err = proc.communicate(timeout=30)
+        if how == "ctrl-c":
+            assert proc.returncode == -signal.SIGINT and err.rstrip().endswith("KeyboardInterrupt"), err
+        assert _exited(child, 5.0)  # measured: at once (Ctrl-C), within 0.25 s (parent killed)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
 
 
 def test_timeout_in_a_worker_thread_uses_a_process():
@@ -379,49 +540,6 @@ def test_process_isolation_returns_results_and_errors():
     assert status == "ok" and msg == 0.0
     status, msg = run_with_deadline(global_analysis, {"model": "not a model"}, 30)
     assert status == "error" and msg[0] == "ModelError"
-
-
-BAD_ARGUMENTS = [  # issue 12 item 5: each a named error, never a silently weaker report
-    ({"seed": None}, si.OptionError, "seed must be an integer"),
-    ({"seed": "a"}, si.OptionError, "seed must be an integer"),
-    ({"seed": -1}, si.OptionError, "seed must be an integer"),
-    ({"seed": 1.5}, si.OptionError, "seed must be an integer"),
-    ({"seed": True}, si.OptionError, "seed must be an integer"),
-    ({"seed": 2**200}, si.OptionError, "seed must be an integer"),
-    ({"timeout": float("nan")}, si.OptionError, "timeout must be a number of seconds > 0"),
-    ({"timeout": "5"}, si.OptionError, "timeout must be a number of seconds > 0"),
-    ({"timeout": -1}, si.OptionError, "timeout must be a number of seconds > 0"),
-    ({"timeout": 0}, si.OptionError, "timeout must be a number of seconds > 0"),
-    ({"timeout": True}, si.OptionError, "timeout must be a number of seconds > 0"),
-    ({"positive": "yes"}, si.OptionError, "positive must be None"),
-    ({"exact_count": 2}, si.OptionError, "exact_count must be True or False"),
-    ({"known": {"theta1": float("nan")}}, si.OptionError, r"known\['theta1'\] must be a finite real number"),
-    ({"known": {"theta1": None}}, si.OptionError, r"known\['theta1'\] must be a finite real number"),
-    ({"known": {"theta1": "1"}}, si.OptionError, r"known\['theta1'\] must be a finite real number"),
-    ({"known": ["theta1"]}, si.OptionError, "known must be a dict"),
-    ({"known": {"nope": 1.0}}, si.ModelError, "unknown parameter"),
-    ({"known": {"theta1": 1.0, "theta2": 2.0, "theta3": 3.0, "theta4": 4.0}}, si.ModelError,
-     "every parameter is given in known="),
-]
-
-
-@pytest.mark.parametrize(("kwargs", "error", "match"), BAD_ARGUMENTS)
-def test_bad_arguments_are_named_errors(kwargs, error, match):
-    with pytest.raises(error, match=match):
-        si.identifiability(si.load_model("belt_drive").model, **kwargs)
-
-
-def test_infinite_timeout_means_no_limit():
-    rep = si.identifiability(si.load_model("belt_drive").model, timeout=float("inf"))
-    assert rep.verdict == "global" and rep.global_determined
-
-
-def test_models_without_parameters_and_unused_declared_parameters():
-    with pytest.raises(si.ModelError, match="no parameter"):
-        si.identifiability(si.StateSpaceModel(A=[[-1]], B=[[1]], C=[[1]]))
-    a, b, unused = si.parameters("a b unused", positive=True)
-    with pytest.raises(si.ModelError, match="'unused' given in parameters= does not appear in any matrix"):
-        si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]], parameters=[a, b, unused])
 
 
 # -- necessary condition (item 5), output kinds, random points ---------------------------

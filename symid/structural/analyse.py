@@ -2,27 +2,23 @@
 
 from __future__ import annotations
 
-import math
-import numbers
 import time
 import warnings
 from collections.abc import Mapping
 
 import sympy as sp
 
-from symid.errors import IdentifiabilityWarning, ModelError, OptionError, SolverError
+from symid.errors import IdentifiabilityWarning, ModelError
+from symid.structural.arguments import checked_arguments, checked_known, checked_seed
 from symid.structural.combinations import monomial_candidates, parameters_to_fix, select_combinations
-from symid.structural.deadline import run_with_deadline, start
-from symid.structural.global_ import GlobalResult, global_analysis, star_and_summary
+from symid.structural.deadline import run_with_deadline
 from symid.structural.local import local_analysis
 from symid.structural.numeric import numeric_local_check
 from symid.structural.report import IdentifiabilityReport, NecessaryCondition
-from symid.structural.summary import free_parameters, model_kind, rational
-from symid.structural.witness import find_witnesses
+from symid.structural.steps import limit_reason, raise_on_error, run_global
+from symid.structural.summary import free_parameters, model_kind
 
 _EXACT_LIMIT = 400
-_WITNESS_SEARCH = 0.5
-"""Seconds after which the witness search begins no new batch of starts (when it has found one)."""
 
 __all__ = ["DEFAULT_TIMEOUT", "check_local", "identifiability", "warn_if_not_identifiable"]
 
@@ -60,83 +56,6 @@ def _complexity(expr: sp.Expr) -> tuple[int, int]:
     return terms, sp.count_ops(expr)
 
 
-def _global_step(model, known, positive, seed, extra_candidates, expressions):
-    """θ*, the summary and the Gröbner step, in one child process."""
-    prepared = star_and_summary(model, known, seed=seed)
-    return global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
-                           expressions=expressions, prepared=prepared)
-
-
-def _witness_step(model, known, positive, seed, max_time):
-    """θ*, the summary and the numerical witness search, in one child process."""
-    prepared = star_and_summary(model, known, seed=seed)
-    return find_witnesses(model, known, positive=positive, seed=seed, max_time=max_time, prepared=prepared)
-
-
-def _raise_on_error(step: str, status: str, value: object) -> None:
-    """An internal failure is raised, never turned into a weaker verdict: model problems as ModelError."""
-    if status != "error":
-        return
-    name, message, tb = value
-    if name in ("ModelError", "NonAffineError", "DataError", "OptionError"):
-        raise ModelError(message)
-    raise SolverError(f"the {step} step of the identifiability analysis failed: {name}: {message}"
-                      + (f"\n{tb}" if tb else ""))
-
-
-def _witness_verdict(wit, names, notes) -> tuple[dict, tuple, tuple, bool]:
-    """(θ*, witnesses, certified flags, whether certified witnesses move every parameter)."""
-    theta_star, witnesses, certified = wit.theta_star, wit.witnesses, wit.certified
-    star_f = {k: float(sp.Rational(v)) for k, v in theta_star.items()}
-    moved = {nm for w, ok in zip(witnesses, certified, strict=True) if ok
-             for nm in names if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
-    proven = moved == set(names)
-    if witnesses and not any(certified):
-        why = ("the Krawczyk test failed for each" if wit.square else
-               "the Krawczyk test needs as many summary equations as unknowns; this system has more")
-        notes.append(f"the witnesses are not certified ({why}): they are numerical evidence, not a proof")
-    elif not witnesses:
-        notes.append(f"no second solution found numerically ({wit.n_starts} starts in {wit.seconds:.1f} s); "
-                     "this proves nothing about the global verdict")
-    return theta_star, witnesses, certified, proven
-
-
-def _checked_arguments(model, known, timeout, positive, exact_count, seed):
-    """Every argument of :func:`identifiability` checked before any work; named errors otherwise."""
-    model_kind(model)
-    if known is None:
-        known = {}
-    if not isinstance(known, Mapping):
-        raise OptionError(f"known must be a dict of parameter name → value; got {type(known).__name__}")
-    names = set(model.parameter_names)
-    out = {}
-    for k, v in known.items():
-        key = k.name if isinstance(k, sp.Symbol) else k
-        if not isinstance(key, str) or key not in names:
-            raise ModelError(f"known= names unknown parameter(s) {k!r}; the model's parameters are "
-                             f"{', '.join(model.parameter_names)}")
-        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(float(v)):
-            raise OptionError(f"known[{key!r}] must be a finite real number; got {v!r}")
-        out[key] = float(v)
-    if model.n_parameters == 0:
-        raise ModelError("the model has no parameter: there is nothing to identify")
-    if len(out) == model.n_parameters:
-        raise ModelError("every parameter is given in known=: nothing is left to identify")
-    if timeout is not None:
-        if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real) or math.isnan(float(timeout)) \
-                or float(timeout) <= 0:
-            raise OptionError(f"timeout must be a number of seconds > 0, or None (no limit); got {timeout!r}")
-        timeout = None if math.isinf(float(timeout)) else float(timeout)
-    if positive is not None and not isinstance(positive, bool):
-        raise OptionError(f"positive must be None (the declarations), True or False; got {positive!r}")
-    if not isinstance(exact_count, bool):
-        raise OptionError(f"exact_count must be True or False; got {exact_count!r}")
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed < 2**63:
-        raise OptionError(f"seed must be an integer between 0 and 2**63 − 1 (reports are deterministic: the same "
-                          f"seed gives the same report); got {seed!r}")
-    return out, timeout, positive, exact_count, int(seed)
-
-
 def identifiability(model, *, known: Mapping[str, float] | None = None, positive: bool | None = None,
                     timeout: float | None = DEFAULT_TIMEOUT, exact_count: bool = False,
                     seed: int = 0) -> IdentifiabilityReport:
@@ -156,46 +75,56 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     Parameters
     ----------
     model : StateSpaceModel or SecondOrderModel
-        Parameters may appear in any matrix; any output kind.
+        Parameters may appear in any matrix; any output kind; at least one parameter.
     known : dict of str to float, optional
-        Parameter values taken as known (substituted before anything else).
+        Parameter values taken as known (substituted before anything else), by name or
+        symbol: finite real numbers (int, float, ``Fraction``, numpy or sympy numbers;
+        floats through their shortest decimal, ``Fraction`` exactly). At least one
+        parameter must remain free.
     positive : bool, optional
         Discard solutions with a non-positive value of a positive parameter. ``None``
         (default) uses the declarations (``si.parameters(..., positive=True)``);
         ``True`` treats every parameter as positive; ``False`` ignores positivity.
         The report says when positivity changed a verdict.
     timeout : float or None, optional
-        Wall-time budget in seconds of the whole analysis (default 30 s; ``inf`` or
-        ``None``: no limit, everything in this process). Each bounded step runs in a
+        Wall-time budget in seconds of the whole analysis, > 0 (default 30 s; ``None``
+        or ``inf``: no limit, everything in this process). Each bounded step runs in a
         child process that is killed when the budget is spent (:mod:`~.deadline`), so
-        the call returns within about ``timeout`` plus the time to stop a process. The
-        exact local step comes first (if even it does not finish, the local verdicts
-        come from a floating-point rank, flagged as a screen). For a locally
-        identifiable model the Gröbner step and a numerical search for other solutions
-        of summary(θ) = summary(θ*) (about 0.5 s) then run side by side; each solution
-        found is certified by the Krawczyk interval test when the summary system is
-        square (as many equations as unknowns). Certified solutions that move every
-        parameter prove the model locally but not globally identifiable: the report
-        stops there, with ``n_solutions_at_least`` in place of the exact count.
-        Otherwise the Gröbner step has the rest of the budget; if it does not finish,
-        the global verdict is marked undetermined (numerical witnesses, if any, are
-        reported as evidence). The combinations of a non-identifiable model are
-        computed after the budget (small, bounded work).
+        the call returns within about ``timeout`` plus the time to stop a process
+        (measured: under 0.1 s on the zoo models). The exact local step comes first (if
+        even it does not finish, the local verdicts come from a floating-point rank,
+        flagged as a screen). For a locally identifiable model the Gröbner step and a
+        numerical search for other solutions of summary(θ) = summary(θ*) (about 0.5 s)
+        then run side by side; each solution found is certified by the Krawczyk interval
+        test when the summary system is square (as many equations as unknowns).
+        Certified solutions that move every parameter prove the model locally but not
+        globally identifiable: the report stops there, with ``n_solutions_at_least`` in
+        place of the exact count. Otherwise the Gröbner step has the rest of the budget;
+        if it does not finish, the global verdict is marked undetermined with the
+        reason (the timeout; or a documented limit: more than 400 solutions, out of
+        memory, a worker process that died), and numerical witnesses, if any, are
+        reported as evidence. For a non-identifiable model, the combinations are then
+        computed (small work) and checked within what is left of the budget.
     exact_count : bool, optional
         Keep the Gröbner step running for the exact solution count k even when
         certified witnesses settle the verdicts sooner. Default False.
     seed : int, optional
-        Seed of the random rational points, an integer ≥ 0 (default 0). The same model
-        and seed give the same report; the verdicts are generic, so the seed only
-        matters on a measure-zero set.
+        Seed of the random rational points, an integer in [0, 2⁶³ − 1] (default 0). The
+        same model and seed give the same report, except for what wall time decides
+        (whether the Gröbner step finishes within ``timeout``, how many witnesses the
+        0.5 s search finds); the verdicts are generic, so the seed only matters on a
+        measure-zero set. ``None`` is refused rather than read as "a fresh random seed",
+        so that a report can always be reproduced.
 
     Raises
     ------
     ModelError
-        A model or ``known`` that cannot be analysed (an unknown name, every parameter
-        known, no parameter at all).
+        A model or ``known`` that cannot be analysed: not a model, no parameter at all,
+        ``known`` not a dict, an unknown or repeated name, a value that is not a finite
+        real number, every parameter known; or a model found degenerate during the
+        analysis (det M(θ) ≡ 0).
     OptionError
-        A bad ``timeout``, ``positive``, ``exact_count``, ``seed`` or known value.
+        A bad ``timeout``, ``positive``, ``exact_count`` or ``seed``.
     SolverError
         An analysis step failed unexpectedly (a bug): never reported as a weaker verdict.
 
@@ -213,104 +142,68 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     ('none', {'a': 'global', 'b': 'none', 'c': 'none'})
     >>> [c["expression"] for c in rep.combinations]
     ['b*c']
+    >>> si.identifiability(model, known={"b": 2}).verdict
+    'global'
     """
     t0 = time.perf_counter()
-    known, timeout, positive, exact_count, seed = _checked_arguments(model, known, timeout, positive, exact_count,
-                                                                     seed)
-    known_exact = {k: rational(v) for k, v in known.items()}
-    free = free_parameters(model, known)
+    args = checked_arguments(model, known=known, timeout=timeout, positive=positive, exact_count=exact_count,
+                             seed=seed)
+    timeout, seed, known_exact = args.timeout, args.seed, args.known
+    free = free_parameters(model, known_exact)
     names = tuple(q.name for q in free)
-    pos = _positive_flags(model, positive, known)
-    necessary = _necessary(model, len(free), known)
+    pos = _positive_flags(model, args.positive, known_exact)
+    necessary = _necessary(model, len(free), known_exact)
     notes: list[str] = []
 
     def left() -> float | None:
-        return None if timeout is None else max(timeout - (time.perf_counter() - t0), 1e-3)
+        return None if timeout is None else max(timeout - (time.perf_counter() - t0), 0.0)
 
     status_local, local = run_with_deadline(local_analysis, {"model": model, "known": known_exact, "seed": seed},
                                             left())
     t_local = time.perf_counter() - t0
-    _raise_on_error("local (Jacobian rank)", status_local, local)
     if status_local == "timeout":
-        return _numeric_report(model, names, known, necessary, timeout, t0)
+        return _numeric_report(model, names, args, necessary, t0,
+                               f"the exact local step exceeded the timeout ({timeout:g} s)")
+    stopped = limit_reason("exact local step", status_local, local)
+    if stopped is not None:
+        return _numeric_report(model, names, args, necessary, t0, stopped)
+    raise_on_error("local (Jacobian rank)", status_local, local)
     monos = monomial_candidates(local)
     full_rank = local.rank == len(free)
 
-    # One budget. The Gröbner step and, for a locally identifiable model, the numerical
-    # witness search run side by side in two child processes; certified witnesses that
-    # show every parameter is not global settle all verdicts (unless exact_count), and
-    # then the Gröbner step is stopped; otherwise it has the rest of the budget.
-    search = full_rank and bool(free)
-    t1 = time.perf_counter()
-    status, glob = "timeout", None
-    # each child computes θ* and the summary itself (sympy's polynomial rings cannot be sent between processes;
-    # the two children run on separate cores)
-    g_kwargs = {"model": model, "known": known_exact, "positive": pos, "seed": seed,
-                "extra_candidates": monos, "expressions": not full_rank}
-    p_status = "ok"
-    witnesses: tuple = ()
-    certified: tuple = ()
-    theta_star: dict[str, str] = {}
-    proven_by_witnesses = False
-    if p_status == "ok" and timeout is None:  # no deadline: the exact answer, in this process
-        status, glob = run_with_deadline(_global_step, g_kwargs, None)
-    elif p_status == "ok":
-        gjob = start(_global_step, g_kwargs)
-        wjob = None
-        if search:
-            wjob = start(_witness_step, {"model": model, "known": known_exact, "positive": pos, "seed": seed,
-                                         "max_time": _WITNESS_SEARCH})
-        try:
-            wit = None
-            while True:
-                status, glob = gjob.wait(0.0 if wjob is not None else left())
-                if status != "timeout" or (wjob is None and left() <= 1e-3):
-                    break
-                if wjob is not None:
-                    wstatus, wit = wjob.wait(min(0.02, left()))
-                    if wstatus != "timeout":
-                        wjob = None
-                        _raise_on_error("witness search", wstatus, wit)
-                        theta_star, witnesses, certified, proven_by_witnesses = _witness_verdict(wit, names, notes)
-                        if proven_by_witnesses and not exact_count:
-                            break
-                if left() <= 1e-3:
-                    break
-            if wjob is not None and status == "timeout":
-                notes.append("the numerical search for a second solution did not finish within the timeout")
-        finally:
-            gjob.stop()
-            if wjob is not None:
-                wjob.stop()
-    limit = None
-    if status == "error" and glob[0] == "ModelError":  # a documented limit of the exact step, e.g. too many solutions
-        status, limit = "limit", glob[1]
-    _raise_on_error("global (Gröbner basis)", status, glob)
-    if status == "ok" and not isinstance(glob, GlobalResult):  # pragma: no cover - defensive
-        raise SolverError(f"the global step returned {type(glob).__name__}, not a result")
-    determined = status == "ok"
+    # One budget: the Gröbner step and, for a locally identifiable model, the witness
+    # search side by side in two child processes (symid/structural/steps.py).
+    out = run_global(model, known_exact, names=names, positive=pos, seed=seed, extra_candidates=monos,
+                     full_rank=full_rank, exact_count=args.exact_count, left=left)
+    glob = out.result
+    notes.extend(out.notes)
+    determined = glob is not None
+    witnesses, certified, theta_star = out.witnesses, out.certified, out.theta_star
+    proven_by_witnesses = out.proven_by_witnesses and not determined
     if determined:
         global_status = "determined"
     elif proven_by_witnesses:
-        spent = time.perf_counter() - t1
-        why = (f"Gröbner basis stopped after {spent:.2g} s; exact_count=True keeps it running until the timeout"
-               if not exact_count else f"Gröbner basis did not finish within the timeout of {timeout:g} s")
+        why = (f"Gröbner basis stopped after {out.seconds:.2g} s; exact_count=True keeps it running until the "
+               "timeout" if not args.exact_count else
+               f"Gröbner basis did not finish within the timeout of {timeout:g} s")
+        if out.limit is not None:
+            why = out.limit
         global_status = (f"NOT globally identifiable, proven by {sum(certified)} certified solution(s) θ ≠ θ* of "
                          f"summary(θ) = summary(θ*); exact count not computed ({why})")
-    elif limit is not None:
-        global_status = f"undetermined ({limit})"
+    elif out.limit is not None:
+        global_status = f"undetermined ({out.limit})"
     else:
         global_status = f"undetermined (timeout after {timeout:g} s)"
-        if witnesses:
-            global_status += (f"; {len(witnesses)} other admissible solution(s) of summary(θ) = summary(θ*) "
-                              "found numerically: NOT globally identifiable")
+    if not determined and not proven_by_witnesses and witnesses:
+        global_status += (f"; {len(witnesses)} other admissible solution(s) of summary(θ) = summary(θ*) "
+                          "found numerically: NOT globally identifiable")
     if witnesses and not determined:
         n_cert = sum(certified)
         notes.append(f"the {len(witnesses)} solution(s) θ ≠ θ* in `witnesses` were found by Gauss–Newton from random "
                      "starts and refined by Newton's method at 60 digits (residual < 1e-40); "
                      f"{n_cert} of them certified by the Krawczyk test in interval arithmetic (an exact real "
                      "admissible solution within relative 1e-20, distinct from θ* and from each other)")
-    t_global = time.perf_counter() - t1
+    t_global = out.seconds
 
     loc = dict(zip(names, local.identifiable, strict=True))
     verdicts: dict[str, str] = {}
@@ -381,10 +274,7 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
             notes.append("the combinations found do not reach the Jacobian rank "
                          f"({sum(local.identifiable) + len(combos)} of {local.rank}); the list is incomplete")
         if fix:
-            check = local_analysis(model, {**known_exact, **{q: sp.Integer(1) for q in fix}}, seed=seed + 1)
-            if all(check.identifiable):
-                notes.append(f"with {', '.join(f'{q} = 1' for q in fix)} known, every other parameter is locally "
-                             "identifiable (checked)")
+            notes.append(_check_fix(model, known_exact, fix, seed, left()))
     if not necessary.satisfied:
         notes.append("the counting condition fails: the parameters cannot all be identifiable")
     total = time.perf_counter() - t0
@@ -392,7 +282,7 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     if determined:
         theta_star = {k: str(v) for k, v in glob.theta_star.items()}
     return IdentifiabilityReport(
-        model=_describe(model), parameters=names, known=known, verdict=verdict, verdicts=verdicts,
+        model=_describe(model), parameters=names, known=args.known_values, verdict=verdict, verdicts=verdicts,
         locally_identifiable=loc, global_determined=determined, global_status=global_status,
         n_solutions=n_sol, n_solutions_real=n_real, n_solutions_complex=n_complex,
         jacobian_ranks=tuple(local.ranks),
@@ -405,19 +295,37 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         verdicts_proven=determined or proven_by_witnesses, timing=timing)
 
 
-def _numeric_report(model, names, known, necessary, timeout, t0) -> IdentifiabilityReport:
-    """Report from the floating-point Jacobian rank when the exact local step did not finish in time."""
-    num = numeric_local_check(model, known=known)
+def _check_fix(model, known_exact, fix: tuple[str, ...], seed: int, budget: float | None) -> str:
+    """A note: with the parameters of ``fix`` set to 1, is every other parameter locally identifiable?"""
+    what = ", ".join(f"{q} = 1" for q in fix)
+    if budget is not None and budget <= 0:
+        return f"with {what} known, the other parameters were not checked (no time left in the budget)"
+    status, check = run_with_deadline(local_analysis, {"model": model, "known": {**known_exact, **dict.fromkeys(fix,
+                                      sp.Integer(1))}, "seed": seed + 1}, budget)
+    if status == "timeout":
+        return f"with {what} known, the other parameters were not checked (no time left in the budget)"
+    stopped = limit_reason("check of the reparameterisation", status, check)
+    if stopped is not None:
+        return f"with {what} known, the other parameters were not checked ({stopped})"
+    raise_on_error("local check of the reparameterisation", status, check)
+    if all(check.identifiable):
+        return f"with {what} known, every other parameter is locally identifiable (checked)"
+    bad = [q.name for q, ok in zip(check.parameters, check.identifiable, strict=True) if not ok]
+    return f"with {what} known, {', '.join(bad)} remain(s) not locally identifiable (checked)"
+
+
+def _numeric_report(model, names, args, necessary, t0, why: str) -> IdentifiabilityReport:
+    """Report from the floating-point Jacobian rank when the exact local step did not finish (``why``)."""
+    num = numeric_local_check(model, known=args.known_values, seed=args.seed)
     bad = set(num.not_identifiable)
     verdicts = {nm: ("none" if nm in bad else "local") for nm in names}
-    why = f"the exact local step exceeded the timeout ({timeout:g} s)"
     notes = (f"{why}: local verdicts come from the floating-point rank of the frequency-response Jacobian "
              f"(rank {num.rank} of {num.n_parameters}), a screen rather than a proof",)
     if not necessary.satisfied:
         notes += ("the counting condition fails: the parameters cannot all be identifiable",)
     total = time.perf_counter() - t0
     return IdentifiabilityReport(
-        model=_describe(model), parameters=names, known=known, verdict="local" if not bad else "none",
+        model=_describe(model), parameters=names, known=args.known_values, verdict="local" if not bad else "none",
         verdicts=verdicts, locally_identifiable={nm: nm not in bad for nm in names}, global_determined=False,
         global_status=f"undetermined ({why})", n_solutions=None, n_solutions_real=None, n_solutions_complex=None,
         jacobian_ranks=(num.rank,), summary_kind=None, n_summary=None, necessary_condition=necessary,
@@ -431,7 +339,15 @@ def check_local(model, known: Mapping[str, float] | None = None, *, seed: int = 
     Exact (rational Jacobian rank) for models with at most ``_EXACT_LIMIT`` = 400
     parameters × states; above that the floating-point rank of
     :func:`symid.structural.numeric.numeric_local_check` (the 108-parameter truss takes
-    about 10 s exactly and a fraction of a second in floating point).
+    about 10 s exactly and a fraction of a second in floating point). No deadline.
+
+    Raises
+    ------
+    ModelError
+        Not a model, or a bad ``known`` (as for :func:`identifiability`; every
+        parameter known is allowed here and gives ``()``).
+    OptionError
+        A bad ``seed``.
 
     Examples
     --------
@@ -441,9 +357,12 @@ def check_local(model, known: Mapping[str, float] | None = None, *, seed: int = 
     >>> check_local(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[c]]))
     ('b', 'c')
     """
+    known_exact, known_values = checked_known(model, known, require_free=False)
+    seed = checked_seed(seed)
+    if len(known_exact) == model.n_parameters:
+        return ()
     if model.n_parameters * model.n_states > _EXACT_LIMIT:
-        return numeric_local_check(model, known=known, seed=seed).not_identifiable
-    known_exact = {str(k): rational(v) for k, v in (known or {}).items()}
+        return numeric_local_check(model, known=known_values, seed=seed).not_identifiable
     local = local_analysis(model, known_exact, seed=seed)
     return tuple(q.name for q, ok in zip(local.parameters, local.identifiable, strict=True) if not ok)
 

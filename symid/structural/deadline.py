@@ -6,31 +6,80 @@ weakref callback or a destructor, and the budget is then lost). So every bounded
 runs in a child process (``fork`` on POSIX, ``spawn`` elsewhere) that is killed when
 its time is up; the child's result comes back through a pipe (it must be picklable).
 :func:`start` returns at once, so two steps can run side by side (the Gröbner basis
-and the numerical witness search use both cores); :func:`run_with_deadline` waits.
-A child is always killed and reaped on the way out, Ctrl-C in the parent included.
+and the numerical witness search use both cores); :func:`wait_any` waits for the first
+of several; :func:`run_with_deadline` runs one and waits.
+
+The outcome of a job is ``(status, value)``:
+
+* ``("ok", result)``;
+* ``("timeout", None)``: not finished in time (the child keeps running until
+  :meth:`Running.stop`);
+* ``("error", (type name, message, traceback))``: the computation raised;
+* ``("died", reason)``: the child ended without a result (killed, a crash such as a
+  segmentation fault, out of memory), with the exit code or signal in ``reason``.
+
+A child is always killed and reaped (no zombie) on the way out, Ctrl-C in the parent
+included: the child ignores SIGINT (the parent, which receives it too from the
+terminal, stops the child), and a child whose parent has gone (killed with SIGKILL,
+say) exits by itself within ``_ORPHAN_POLL`` seconds, so no orphan keeps computing.
 """
 
 from __future__ import annotations
 
 import multiprocessing as mp
+import os
+import signal
+import threading
 import time
 import traceback
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from multiprocessing.connection import wait as _wait_connections
 from typing import Any
 
-__all__ = ["Running", "run_with_deadline", "start"]
+__all__ = ["Running", "run_with_deadline", "start", "wait_any"]
+
+_ORPHAN_POLL = 0.2
+"""Seconds between a child's checks that its parent is still alive."""
+_MAX_WAIT = 86400.0
+"""Longest single wait (s): longer timeouts are waited in slices (the OS refuses waits beyond ~292 years)."""
 
 
-def _child(conn, fn, kwargs):  # pragma: no cover - runs in the child process
+def _exit_when_orphaned(parent: int) -> None:  # pragma: no cover - runs in the child process
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(_ORPHAN_POLL)
+        os._exit(70)
+
+    threading.Thread(target=watch, name="symid-orphan-watch", daemon=True).start()
+
+
+def _child(conn, fn, kwargs, parent):  # pragma: no cover - runs in the child process
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent decides, and stops this process
+    _exit_when_orphaned(parent)
     try:
-        conn.send(("ok", fn(**kwargs)))
+        outcome = ("ok", fn(**kwargs))
     except BaseException as exc:
-        try:
-            conn.send(("error", (type(exc).__name__, str(exc), traceback.format_exc(limit=6))))
-        except Exception:  # an unpicklable payload: at least say what happened
-            conn.send(("error", (type(exc).__name__, repr(exc)[:500], "")))
+        outcome = ("error", (type(exc).__name__, str(exc), traceback.format_exc(limit=8)))
+    try:
+        conn.send(outcome)  # pickled before anything is written: a failure sends nothing
+    except Exception as exc:  # an unpicklable result or message: say so
+        conn.send(("error", (type(exc).__name__, f"the result could not be sent back: {exc!r:.500}",
+                             traceback.format_exc(limit=8))))
     finally:
         conn.close()
+
+
+def _reason(exitcode: int | None) -> str:
+    """Why a child ended without a result, from its exit code."""
+    if exitcode is None:
+        return "its process closed the result pipe and did not exit"
+    if exitcode < 0:
+        try:
+            name = signal.Signals(-exitcode).name
+        except ValueError:
+            name = f"signal {-exitcode}"
+        return f"its process was killed by {name} (a crash, the out-of-memory killer, or another process)"
+    return f"its process exited with code {exitcode}"
 
 
 class Running:
@@ -40,49 +89,89 @@ class Running:
     ----------
     started : float
         ``time.monotonic()`` when it started.
+    pid : int
+        The child's process id.
     """
 
     def __init__(self, fn: Callable[..., Any], kwargs: Mapping[str, Any]):
         method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
         ctx = mp.get_context(method)
-        self._recv, send = ctx.Pipe(duplex=False)
-        self._proc = ctx.Process(target=_child, args=(send, fn, dict(kwargs)), daemon=True)
-        self.started = time.monotonic()
-        self._proc.start()
-        send.close()
         self._outcome: tuple[str, Any] | None = None
+        self._recv, send = ctx.Pipe(duplex=False)
+        self._proc = ctx.Process(target=_child, args=(send, fn, dict(kwargs), os.getpid()), daemon=True,
+                                 name=f"symid-{getattr(fn, '__name__', 'job')}")
+        self.started = time.monotonic()
+        try:
+            self._proc.start()
+        except BaseException:
+            self._recv.close()
+            raise
+        finally:
+            send.close()  # only the child writes: its death closes the pipe (EOF here)
+        self.pid = self._proc.pid
+
+    @property
+    def connection(self):
+        """The parent's end of the result pipe (readable when the outcome is ready)."""
+        return self._recv
 
     def wait(self, timeout: float | None) -> tuple[str, Any]:
-        """Wait up to ``timeout`` s (``None``: for ever) for the result.
+        """Wait up to ``timeout`` s (``None``: for ever) for the outcome.
 
-        Returns ``("ok", value)``, ``("error", (type name, message, traceback))`` or
-        ``("timeout", None)``; on a timeout the child keeps running until :meth:`stop`
-        (so a later :meth:`wait` can still collect it).
+        Returns ``("ok", value)``, ``("error", (type name, message, traceback))``,
+        ``("died", reason)`` or ``("timeout", None)``; on a timeout the child keeps
+        running until :meth:`stop` (so a later :meth:`wait` can still collect it).
+        Once collected, the child has been reaped.
         """
         if self._outcome is not None:
             return self._outcome
-        try:
-            ready = self._recv.poll(None if timeout is None else max(timeout, 0.0))
-        except (EOFError, OSError):
-            ready = True
-        if not ready:
+        if self._recv.closed:  # stopped before it finished
+            return "timeout", None
+        if not _wait_for([self._recv], timeout):
             return "timeout", None
         try:
             self._outcome = self._recv.recv()
-        except (EOFError, OSError):  # the child died without a word (killed, out of memory, a crash)
+        except (EOFError, OSError):  # the child ended without a word
             self._proc.join(1)
-            code = self._proc.exitcode
-            self._outcome = ("error", ("ChildDied", f"the worker process died (exit code {code}) without a result",
-                                       ""))
+            self._outcome = ("died", _reason(self._proc.exitcode))
         self.stop()
         return self._outcome
 
     def stop(self) -> None:
-        """Kill the child if it still runs, and reap it."""
-        if self._proc.is_alive():
+        """Kill the child if it still runs, and reap it (idempotent)."""
+        if self._proc.exitcode is None:  # ``exitcode`` polls: a finished child is reaped here
             self._proc.kill()
         self._proc.join(5)
         self._recv.close()
+
+
+def _wait_for(connections: Sequence[Any], timeout: float | None) -> list:
+    """The connections ready within ``timeout`` s, waiting in slices of at most ``_MAX_WAIT``."""
+    end = None if timeout is None else time.monotonic() + max(timeout, 0.0)
+    while True:
+        left = _MAX_WAIT if end is None else min(max(end - time.monotonic(), 0.0), _MAX_WAIT)
+        ready = _wait_connections(connections, left)
+        if ready or (end is not None and time.monotonic() >= end):
+            return ready
+
+
+def wait_any(jobs: Sequence[Running], timeout: float | None) -> list[Running]:
+    """Wait up to ``timeout`` s until at least one job's outcome is ready; the ready ones.
+
+    Examples
+    --------
+    >>> from symid.structural.deadline import start, wait_any
+    >>> job = start(dict, {"a": 1})
+    >>> wait_any([job], 30) == [job]
+    True
+    >>> job.wait(0)
+    ('ok', {'a': 1})
+    """
+    done = [j for j in jobs if j._outcome is not None or j.connection.closed]
+    if done:
+        return done
+    ready = _wait_for([j.connection for j in jobs], timeout)
+    return [j for j in jobs if j.connection in ready]
 
 
 def start(fn: Callable[..., Any], kwargs: Mapping[str, Any]) -> Running:
@@ -113,23 +202,26 @@ def run_with_deadline(fn: Callable[..., Any], kwargs: Mapping[str, Any], timeout
     Returns
     -------
     (status, value)
-        ``("ok", result)``, ``("timeout", None)`` or ``("error", (type name, message,
-        traceback))`` when the computation raised an exception.
+        ``("ok", result)``, ``("timeout", None)``, ``("error", (type name, message,
+        traceback))`` when the computation raised an exception, or ``("died",
+        reason)`` when its process ended without a result.
 
     Examples
     --------
     >>> from symid.structural.deadline import run_with_deadline
     >>> run_with_deadline(dict, {"a": 1}, 5.0)
     ('ok', {'a': 1})
+    >>> from fractions import Fraction
+    >>> run_with_deadline(Fraction, {"numerator": "?"}, 5.0)[1][:2]
+    ('ValueError', "Invalid literal for Fraction: '?'")
     """
     if timeout is None:
         try:
             return "ok", fn(**kwargs)
-        except Exception as exc:
-            return "error", (type(exc).__name__, str(exc), traceback.format_exc(limit=6))
+        except Exception as exc:  # reported as the child would (the caller raises or names the limit)
+            return "error", (type(exc).__name__, str(exc), traceback.format_exc(limit=8))
     job = start(fn, kwargs)
     try:
-        out = job.wait(timeout)
+        return job.wait(timeout)
     finally:
         job.stop()
-    return out

@@ -41,7 +41,7 @@ from sympy.polys.groebnertools import groebner
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
-from symid.errors import ModelError
+from symid.errors import SolverError
 from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
     KIND_TF,
@@ -52,7 +52,8 @@ from symid.structural.summary import (
     model_matrices,
 )
 
-__all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "GlobalResult", "global_analysis", "star_and_summary"]
+__all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "ExactStepLimit", "GlobalResult", "global_analysis",
+           "star_and_summary"]
 
 REAL_TOL = 1e-7
 """Relative tolerance on a parameter value when comparing numerical solutions to θ*."""
@@ -60,6 +61,15 @@ POSITIVE_TOL = 1e-9
 """A real solution is positive in a coordinate when the value exceeds this (absolute)."""
 MAX_QUOTIENT = 400
 """Largest quotient dimension (number of complex solutions with multiplicity) enumerated."""
+
+
+class ExactStepLimit(SolverError):
+    """A documented limit of the exact global step was reached (the count is then undetermined, not wrong).
+
+    Raised when the quotient algebra has more than :data:`MAX_QUOTIENT` standard
+    monomials (too many solutions to enumerate), or when no separating linear form is
+    found in ten random draws (probability zero for generic draws).
+    """
 
 
 @dataclass(frozen=True)
@@ -376,7 +386,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     else:
         basis = _standard_monomials([g.LM for g in G], nv, MAX_QUOTIENT)
         if basis is None:
-            raise ModelError(f"more than {MAX_QUOTIENT} complex solutions; not enumerated")
+            raise ExactStepLimit(f"more than {MAX_QUOTIENT} complex solutions; not enumerated")
         if len(basis) == 1:
             n_c = n_r = n_a = 1
             sol = {n: float(v) for n, v in theta_star.items()}
@@ -434,7 +444,7 @@ def _solve_numeric(mm: dict[int, DomainMatrix], theta_idx, rng: random.Random, x
         if cp.degree() == D and sp.degree(sp.gcd(cp, cp.diff(x)), x) == 0:
             break
     else:  # pragma: no cover - a separating form exists with probability one
-        raise ModelError("no separating linear form found for the solution set")
+        raise ExactStepLimit("no separating linear form found for the solution set in 10 random draws")
     n_real = int(cp.count_roots())
     Fl = sum(r[v] * F[v] for v in range(nv))
     w, vecs = np.linalg.eig(Fl.T)

@@ -35,11 +35,17 @@ from dataclasses import dataclass
 import sympy as sp
 from sympy import QQ
 from sympy.polys.matrices import DomainMatrix
+from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from symid.errors import ModelError
 from symid.structural.summary import free_parameters, model_kind, rational
 
-__all__ = ["LocalResult", "jacobian_at", "local_analysis", "random_point"]
+__all__ = ["LocalResult", "PoleError", "jacobian_at", "local_analysis", "random_point"]
+
+
+class PoleError(ModelError):
+    """A test frequency is a pole of H(s, θ) at the test point (:func:`local_analysis` then draws again)."""
+
 
 _SHIFT = {"position": 0, "velocity": 1, "acceleration": 2}
 
@@ -121,8 +127,9 @@ def jacobian_at(model, point: Sequence, known: Mapping[str, object] | None = Non
 
     Raises
     ------
-    ModelError
-        If a frequency is a pole at the point (then draw other frequencies).
+    PoleError
+        If a frequency is a pole at the point (then draw other frequencies); a
+        :class:`~symid.errors.ModelError`.
 
     Examples
     --------
@@ -155,8 +162,8 @@ def jacobian_at(model, point: Sequence, known: Mapping[str, object] | None = Non
         Z = eye * s - A if parts.kind == "state-space" else M * (s * s) + V * s + K
         try:
             Zi = Z.inv()
-        except Exception:  # sympy raises DMNonInvertibleMatrixError
-            raise ModelError(f"s = {s} is a pole at the test point") from None
+        except DMNonInvertibleMatrixError:
+            raise PoleError(f"s = {s} is a pole at the test point") from None
         X, Y = (Zi * B).to_list(), (C * Zi).to_list()
         if parts.kind == "state-space":
             dZ = co["A"]
@@ -260,7 +267,7 @@ def local_analysis(model, known: Mapping[str, object] | None = None, *, seed: in
             freqs = _frequencies(rng, 2 * parts.n_order + 1 + shift)
             try:
                 J = jacobian_at(model, pt, known, frequencies=freqs, _parts=parts)
-            except ModelError:  # a frequency hit a pole (or M(θ) is singular): draw again
+            except PoleError:  # a frequency hit a pole (or M(θ) is singular): draw again
                 continue
             break
         else:

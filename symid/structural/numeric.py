@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from symid.errors import ModelError
+
 __all__ = ["NumericLocalResult", "numeric_local_check"]
 
 
@@ -99,6 +101,12 @@ def numeric_local_check(model: Any, *, known: Mapping[str, float] | None = None,
     -------
     NumericLocalResult
 
+    Raises
+    ------
+    ModelError
+        When the frequency response is singular or not finite at every one of 10
+        random points (a degenerate model).
+
     Examples
     --------
     >>> import symid as si
@@ -130,8 +138,9 @@ def numeric_local_check(model: Any, *, known: Mapping[str, float] | None = None,
             continue
         if np.all(np.isfinite(J)):
             break
-    else:  # pragma: no cover - degenerate models only
-        return NumericLocalResult(0, len(free), tuple(model.parameter_names[k] for k in free), np.zeros(0))
+    else:  # pragma: no cover - degenerate models only; never reported as "nothing identifiable"
+        raise ModelError("the frequency response is singular or not finite at 10 random parameter points "
+                         f"({freqs.size} test frequencies in {freqs.min():g}–{freqs.max():g} rad/s): no rank to take")
     nf = len(free)
     norms = np.linalg.norm(J, axis=0)
     zero_cols = norms == 0

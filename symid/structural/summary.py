@@ -35,6 +35,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
 from symid.errors import ModelError
+from symid.model.expressions import sympify_value
 from symid.structural.order import grevlex_memo
 
 __all__ = ["ExhaustiveSummary", "exhaustive_summary", "free_parameters", "model_matrices", "rational"]
@@ -51,13 +52,13 @@ def rational(value: object) -> sp.Rational:
         return sp.Rational(value)
     if isinstance(value, sp.Float):
         return sp.Rational(repr(float(value)))
-    if isinstance(value, float):
-        return sp.Rational(repr(value))
+    if isinstance(value, float):  # numpy.float64 included (its repr is not a number in numpy 2)
+        return sp.Rational(repr(float(value)))
     if isinstance(value, (str, bytes)):
         raise ModelError(f"expected a real number, got the text {value!r}")
-    try:
-        out = sp.sympify(value, strict=True)  # strict: never parses text
-    except (sp.SympifyError, TypeError, ValueError):
+    try:  # never parses text, nor text inside a tuple or dict (which sympify(strict=True) would)
+        out = sympify_value(value, "value")
+    except ModelError:
         raise ModelError(f"expected a real number, got {value!r}") from None
     if out.is_Rational:
         return out
@@ -100,7 +101,8 @@ def model_kind(model) -> str:
         return "second-order"
     if hasattr(model, "symbolic_state_space") and "A" in model.symbolic:
         return "state-space"
-    raise ModelError(f"identifiability needs a StateSpaceModel or SecondOrderModel; got {type(model).__name__}")
+    hint = " (a zoo entry? pass its .model)" if hasattr(model, "model") else ""
+    raise ModelError(f"identifiability needs a StateSpaceModel or SecondOrderModel; got {type(model).__name__}{hint}")
 
 
 @dataclass(frozen=True, eq=False)
