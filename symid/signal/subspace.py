@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 import scipy.linalg
+import scipy.signal
 
 from symid.data import BlackBox, IOData
 from symid.errors import DataError
@@ -151,28 +152,44 @@ def _check(io: Any, order: Any, horizon: Any) -> tuple[int, int]:
     return order, i
 
 
+def _markov(A: np.ndarray, C: np.ndarray, N: int) -> np.ndarray:
+    """``C A^k`` for k = 0..N−1, shape (N, p, n), by doubling: block [s, 2s) is block [0, s) times A^s."""
+    p, n = C.shape
+    M = np.empty((N, p, n))
+    M[0] = C
+    power, filled = A.copy(), 1  # power = A^filled
+    with np.errstate(over="ignore", invalid="ignore"):
+        while filled < N:
+            k = min(filled, N - filled)
+            M[filled:filled + k] = M[:k] @ power
+            filled += k
+            power = power @ power
+    return M
+
+
 def _b_d_x0(io: IOData, A: np.ndarray, C: np.ndarray, feedthrough: bool) -> tuple[np.ndarray, ...]:
-    """Least squares for B, D and x0 with A and C fixed (the output is linear in them)."""
+    """Least squares for B, D and x0 with A and C fixed (the output is linear in them).
+
+    ``y_k = Σ_{l<k} C A^{k−1−l} B u_l + D u_k + C A^k x0``: the regressor of ``B[r, c]``
+    is the convolution of the Markov sequence ``C A^j e_r`` with input c, computed for
+    every r and c at once by FFT (:func:`scipy.signal.fftconvolve`) on the sequence of
+    :func:`_markov`; the regressor of x0 is that sequence itself. No per-sample Python loop.
+    """
     u, y = io.u, io.y
     N, m = u.shape
     p, n = C.shape
-    # X[c] = Σ_{l<k} A^{k-1-l} u_l[c] : the state response to a unit column in B for input c
-    X = np.zeros((m, n, n))
-    P = np.eye(n)  # A^k for the initial-state regressor
-    rows_B = np.empty((N, p, m, n))
-    rows_x0 = np.empty((N, p, n))
-    for k in range(N):
-        rows_B[k] = np.einsum("pn,cnr->pcr", C, X)
-        rows_x0[k] = C @ P
-        X = A @ X + u[k][:, None, None] * np.eye(n)
-        P = A @ P
+    M = _markov(A, C, N)  # (N, p, n)
+    # rows_B[k, :, c, :] = Σ_{j<k} M_j u_{k-1-j}[c]  (zero at k = 0)
+    conv = scipy.signal.fftconvolve(M.reshape(N, 1, p * n), u[:, :, None], axes=0)[: N - 1]  # (N-1, m, p*n)
+    rows_B = np.zeros((N, p, m, n))
+    rows_B[1:] = np.transpose(conv.reshape(N - 1, m, p, n), (0, 2, 1, 3))
     # y_k = Σ_c (C X_k[c]) B[:, c] + D u_k + C A^k x0 ; unknowns vec(B) (row-major: B[r, c] at r*m + c)
     JB = np.transpose(rows_B, (0, 1, 3, 2)).reshape(N * p, n * m)
     blocks = [JB]
     if feedthrough:
         JD = np.einsum("pq,kc->kpqc", np.eye(p), u).reshape(N * p, p * m)
         blocks.append(JD)
-    blocks.append(rows_x0.reshape(N * p, n))
+    blocks.append(M.reshape(N * p, n))
     J = np.hstack(blocks)
     sol, *_ = np.linalg.lstsq(J, y.reshape(-1), rcond=None)
     B = sol[: n * m].reshape(n, m)
