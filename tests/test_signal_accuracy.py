@@ -3,7 +3,7 @@
 Reference values: the c2d → d2c round trip is exact in exact arithmetic, so the error is
 rounding only; the vectorised least squares solves the same problem as the former
 per-sample loop (kept below as the reference), so both agree to rounding.
-``benchmarks/signal.py`` measures the same properties at full size.
+``benchmarks/signal_layer.py`` measures the same properties at full size.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ def _scaled_system(rng: np.random.Generator, n: int, m: int) -> tuple[np.ndarray
 def test_d2c_balanced_on_badly_scaled_states():
     """100 random n = 20 systems with states scaled 1e±3: error ≤ 1e-10 in the well-scaled basis.
 
-    Without balancing the same systems give up to 1e-6 (benchmarks/signal.py: 83/100 above 1e-10);
+    Without balancing the same systems give up to 1e-6 (benchmarks/signal_layer.py: 83/100 above 1e-10);
     balanced, the largest measured error is 2.6e-13, so 1e-10 leaves a margin of ~400 for other
     LAPACK builds.
     """

@@ -15,7 +15,7 @@ diagonal of powers of two (:func:`scipy.linalg.matrix_balance`, the LAPACK ``geb
 scaling without permutation, so S is applied exactly), and ``logm(big) = S logm(bal) S⁻¹``.
 On states of very different scale (1e±3) the unbalanced logarithm loses up to seven
 digits; the balanced one keeps the round trip to about 1e-13
-(``benchmarks/signal.py`` measures both).
+(``benchmarks/signal_layer.py`` measures both).
 python-control offers ``c2d`` (``sample_system``) but no ``d2c``, and harold's
 ``undiscretize`` has had a bug on this very step, so a well-kept library function
 does not exist; the scipy primitive does the work.
