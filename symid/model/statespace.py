@@ -34,15 +34,22 @@ class StateSpaceModel(ParametricModel):
         Fixes the order of θ (a string is split at spaces and commas). By default it
         is the order of first appearance, row by row, through A, B, C, D (within one
         entry, sympy's canonical order: alphabetical for plain names).
+    x0 : array_like of length n, or "estimate", optional
+        The initial state x(0) of every experiment: zero when omitted; numbers or
+        expressions affine in the parameters (e.g. ``[dose / V, 0]`` for a bolus into
+        compartment 1 — parameters that appear only here join θ after those of the
+        matrices); or ``"estimate"``, an unknown initial state that the time-domain
+        methods estimate per experiment beside θ. Frequency-domain data carry no
+        information on x0 (it only shapes transients).
     name : str, optional
         A label used in reports.
 
     Raises
     ------
     NonAffineError
-        If an entry is not affine in the parameters.
+        If an entry (of x0 too) is not affine in the parameters.
     ModelError
-        On inconsistent shapes or unparsable entries.
+        On inconsistent shapes or unparsable entries, or an x0 of the wrong length.
 
     Examples
     --------
@@ -53,11 +60,20 @@ class StateSpaceModel(ParametricModel):
     ('a', 'b')
     >>> model.frequency_response({"a": 1.0, "b": 0.5}, [0.0]).real
     array([[[1.]]])
+
+    A bolus of unknown size ``d`` in the first of two compartments:
+
+    >>> k10, k12, k21, d = si.parameters("k10 k12 k21 d", positive=True)
+    >>> pk = si.StateSpaceModel(A=[[-k10 - k12, k21], [k12, -k21]], B=[[0], [0]], C=[[1, 0]], x0=[d, 0])
+    >>> pk.parameter_names, pk.initial_state_kind
+    (('k10', 'k12', 'k21', 'd'), 'affine')
+    >>> pk.initial_state({"k10": 0.1, "k12": 0.2, "k21": 0.3, "d": 5.0})
+    array([5., 0.])
     """
 
     _kind = "state-space"
 
-    def __init__(self, A: Any, B: Any, C: Any, D: Any | None = None, *,
+    def __init__(self, A: Any, B: Any, C: Any, D: Any | None = None, *, x0: Any = None,
                  parameters: Sequence[Any] | None = None, name: str | None = None):
         A_ = as_symbolic_matrix(A, "A")
         if A_.rows != A_.cols:
@@ -66,7 +82,14 @@ class StateSpaceModel(ParametricModel):
         B_ = as_symbolic_matrix(B, "B", shape=(n, None))
         C_ = as_symbolic_matrix(C, "C", shape=(None, n))
         D_ = sp.zeros(C_.rows, B_.cols) if D is None else as_symbolic_matrix(D, "D", shape=(C_.rows, B_.cols))
-        self._setup([("A", A_), ("B", B_), ("C", C_), ("D", D_)], parameters, name)
+        mats = [("A", A_), ("B", B_), ("C", C_), ("D", D_)]
+        self._x0_estimate = isinstance(x0, str) and x0 == "estimate"
+        if x0 is not None and not self._x0_estimate:
+            mats.append(("x0", _initial_state_matrix(x0, n)))
+        self._setup(mats, parameters, name)
+        # x(0) is not a system matrix: kept apart so that every method working on (A, B, C, D) is unchanged
+        self._x0_map = self._maps.pop("x0", None)
+        self._x0_symbolic = self._symbolic.pop("x0", None)
 
     @property
     def n_states(self) -> int:
@@ -82,6 +105,45 @@ class StateSpaceModel(ParametricModel):
     def n_outputs(self) -> int:
         """Number of outputs p."""
         return self._maps["C"].shape[0]
+
+    @property
+    def initial_state_kind(self) -> str:
+        """How x(0) is given: ``"zero"``, ``"known"`` (numbers), ``"affine"`` (in θ) or ``"estimate"``."""
+        if self._x0_estimate:
+            return "estimate"
+        if self._x0_map is None:
+            return "zero"
+        return "known" if self._x0_map.is_constant else "affine"
+
+    @property
+    def initial_state_map(self) -> Any:
+        """The affine map θ ↦ x(0) as an (n, 1) :class:`~symid.model.affine.AffineMap`, or ``None``
+        (x(0) zero, or to be estimated)."""
+        return self._x0_map
+
+    def initial_state(self, theta: Theta) -> np.ndarray:
+        """x(0) at θ, shape (n,).
+
+        Raises
+        ------
+        ModelError
+            When the model's initial state is to be estimated (``x0="estimate"``): it has no
+            value until an estimator gives it one; pass ``x0=`` to the simulator.
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> a = si.parameters("a")
+        >>> si.StateSpaceModel(A=[[-a]], B=[[1]], C=[[1]], x0=[[2 * a]]).initial_state({"a": 1.5})
+        array([3.])
+        """
+        if self._x0_estimate:
+            raise ModelError("this model's initial state is to be estimated (x0='estimate'): it has no value at θ; "
+                             "give x0= explicitly to simulate it")
+        vec = self.theta_vector(theta)
+        if self._x0_map is None:
+            return np.zeros(self.n_states)
+        return np.asarray(self._x0_map(vec), dtype=float).reshape(-1)
 
     def _shape_text(self) -> str:
         return f"{self.n_states} states, {self.n_inputs} input(s), {self.n_outputs} output(s)"
@@ -155,4 +217,25 @@ class StateSpaceModel(ParametricModel):
     def summary(self) -> str:
         """Parameters and matrices as readable text."""
         head = f"StateSpaceModel{' ' + repr(self.name) if self.name else ''}: {self._shape_text()}"
-        return f"{head}\nparameters: {', '.join(self.parameter_names) or '(none)'}\n{self._matrix_text()}"
+        text = f"{head}\nparameters: {', '.join(self.parameter_names) or '(none)'}\n{self._matrix_text()}"
+        if self._x0_estimate:
+            return f"{text}\nx0 = estimated per experiment"
+        if self._x0_symbolic is not None:
+            return f"{text}\nx0 =\n{sp.pretty(self._x0_symbolic, use_unicode=True)}"
+        return text
+
+
+def _initial_state_matrix(x0: Any, n: int) -> sp.Matrix:
+    """x0 as an (n, 1) symbolic column: a 1-D sequence or an (n, 1) / (1, n) matrix; a ModelError otherwise."""
+    if isinstance(x0, str):
+        raise ModelError(f"x0 must be numbers or expressions (one per state) or the word 'estimate'; got {x0!r}")
+    if isinstance(x0, np.ndarray) and x0.ndim == 1:
+        x0 = x0.reshape(-1, 1)
+    elif isinstance(x0, (list, tuple)) and x0 and not any(isinstance(v, (list, tuple, np.ndarray)) for v in x0):
+        x0 = [[v] for v in x0]
+    X = as_symbolic_matrix(x0, "x0")
+    if X.rows == 1 and X.cols == n and n != 1:
+        X = X.T
+    if X.shape != (n, 1):
+        raise ModelError(f"x0 must hold one value per state, n = {n}; got shape {X.shape}")
+    return X

@@ -290,6 +290,17 @@ def _input_series(u: Any, m: int) -> np.ndarray:
     return arr
 
 
+def _model_initial_state(model: Any, theta: Any, n: int) -> np.ndarray:
+    """The model's x(0) at θ (zero for a model without one); a DataError for ``x0="estimate"``."""
+    kind = getattr(model, "initial_state_kind", "zero")
+    if kind == "zero":
+        return np.zeros(n)
+    if kind == "estimate":
+        raise DataError("the model's initial state is to be estimated (x0='estimate'), so it has no value to "
+                        "simulate from: pass x0= (shape (n,)) to simulate_io")
+    return model.initial_state(theta)
+
+
 def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any = None,
                 noise: float | None = None, seed: Seed = None) -> IOData:
     """Sampled response of a model to a zero-order-hold input (exact discretisation).
@@ -313,7 +324,10 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
     dt : float
         Sample time in seconds, > 0.
     x0 : array_like, shape (n,), optional
-        Initial state of the first-order form; zero by default.
+        Initial state of the first-order form. By default the model's own
+        (``StateSpaceModel(..., x0=...)`` at θ; zero when the model gives none); a
+        model whose initial state is to be estimated needs it here. Given, it
+        replaces the model's.
     noise : float, optional
         Relative noise level ε ≥ 0 on the output: channel j gets white Gaussian noise of
         standard deviation ε·std(y_j) (the standard deviation over time of the exact
@@ -349,7 +363,7 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
     dt_ = checks.check_positive_scalar(dt, "dt")
     level, rng = _noise_level(noise), _generator(seed)
     if x0 is None:
-        x = np.zeros(n)
+        x = _model_initial_state(sys, th, n)
     else:
         x = checks.as_array(x0, "x0", complex_ok=False)
         if x.shape not in ((n,), (n, 1)):
