@@ -13,9 +13,10 @@ from symid.data.blackbox import BlackBox
 from symid.data.frequency import FrequencyData
 from symid.data.iodata import IOData
 from symid.data.spectral import SpectralData
+from symid.data.timeseries import TimeSeries
 from symid.errors import DataError
 
-__all__ = ["BlackBox", "FrequencyData", "IOData", "SpectralData", "load"]
+__all__ = ["BlackBox", "FrequencyData", "IOData", "SpectralData", "TimeSeries", "load"]
 
 _KINDS = {cls._kind: cls for cls in (FrequencyData, SpectralData, IOData, BlackBox)}
 

@@ -24,7 +24,7 @@ class DataKind:
     Attributes
     ----------
     name : str
-        ``"frequency response"``, ``"spectra"``, ``"black box"``.
+        ``"frequency response"``, ``"spectra"``, ``"time series"``, ``"black box"``.
     data_types : tuple of str
         Names of the :mod:`symid.data` classes it takes.
     package : str
@@ -49,7 +49,8 @@ class DataKind:
 _KINDS = (
     DataKind("frequency response", ("FrequencyData",), "symid.fit.frf"),
     DataKind("spectra", ("SpectralData",), "symid.fit.spectra"),
-    DataKind("black box", ("BlackBox", "IOData"), "symid.fit.similarity"),
+    DataKind("time series", ("IOData", "TimeSeries"), "symid.fit.timeseries"),
+    DataKind("black box", ("BlackBox",), "symid.fit.similarity"),
 )
 
 
@@ -69,6 +70,12 @@ def data_kind(data: Any) -> DataKind:
     >>> data_kind(si.FrequencyData([1.0, 2.0], np.ones(2))).methods
     ('scr', 'ipopt', 'ls')
     """
+    if isinstance(data, (list, tuple)) and data:  # several experiments: every record a time series
+        names = {type(d).__name__ for d in data}
+        if names <= {"IOData", "TimeSeries"} and all(type(d).__module__.startswith("symid.data") for d in data):
+            return _KINDS[2]
+        raise DataError(f"a list of data is read as several experiments and must hold only IOData or TimeSeries "
+                        f"records; got {', '.join(sorted(names))}")
     name = type(data).__name__
     for kind in _KINDS:
         if name in kind.data_types and type(data).__module__.startswith("symid.data"):

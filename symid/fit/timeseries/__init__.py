@@ -1,0 +1,48 @@
+"""Estimation from measured time series: directly on the samples, or through a black box.
+
+=================  ==========  =====================================================================
+data               method      what it fits
+=================  ==========  =====================================================================
+IOData, TimeSeries ``oe``      output error: the model simulated exactly on the sample times from
+or a list of them              its initial state, against the measured samples
+                               (:mod:`~symid.fit.timeseries.oe`, CasADi/IPOPT)
+one IOData         ``scr``,    the black box of N4SID + exact ``d2c`` (thesis Algorithms 6.1, 7.1;
+                   ``als``,    :mod:`symid.fit.similarity`): these fit the black box's frequency
+                   ``gb``,     response, not the samples; ``cost`` is the black-box misfit
+                   ``ipopt``,
+                   ``ls``
+=================  ==========  =====================================================================
+
+``oe`` takes non-uniform sample times, several experiments, free responses (u ≡ 0) and
+inputs that are not persistently exciting, none of which the N4SID route can use.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from symid.data import IOData
+from symid.errors import DataError, ModelError
+from symid.fit.base import Estimator
+
+__all__ = ["BLACK_BOX_METHODS", "METHODS", "prepare"]
+
+BLACK_BOX_METHODS = ("scr", "als", "gb", "ipopt", "ls")
+METHODS = ("oe", *BLACK_BOX_METHODS)
+
+
+def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
+            noise_floor: float | None = None) -> Estimator:
+    """The estimator of ``method`` for time-series data (see the module table)."""
+    if method not in METHODS:
+        raise ModelError(f"unknown method {method!r} for time-series data; choose one of {', '.join(METHODS)}")
+    if method == "oe":
+        from symid.fit.timeseries.oe import OutputError
+
+        return OutputError.create(model, data, options, noise_floor=noise_floor)
+    if not isinstance(data, IOData):
+        raise DataError(f"method {method!r} goes through N4SID, which needs one uniformly sampled record (IOData); "
+                        "for several records or non-uniform sample times use method='oe'")
+    from symid.fit.similarity import prepare as similarity_prepare
+
+    return similarity_prepare(model, data, method, options, noise_floor=noise_floor)
