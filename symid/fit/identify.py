@@ -6,11 +6,14 @@ import dataclasses
 import time
 from typing import Any
 
+import numpy as np
+
 from symid.errors import OptionError
 from symid.fit.options import check_bool
 from symid.fit.registry import prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import make_starts
+from symid.fit.uncertainty import FisherInformation
 from symid.interrupt import Interrupted
 from symid.progress import progress_bar
 
@@ -127,6 +130,10 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
                           f"the finished starts are in the exception's .partial result", partial) from None
     result = IdentificationResult.from_starts(estimator.method, model.parameter_names, outcomes,
                                               cost_kind=estimator.cost_kind, options=options_used)
+    if isinstance(estimator, FisherInformation) and np.all(np.isfinite(result.theta_vector)):
+        # declared by the estimator (symid.fit.uncertainty): covariance of θ̂ at the best estimate
+        result = dataclasses.replace(result, uncertainty=estimator.uncertainty(result.theta_vector,
+                                                                               model.parameter_names))
     if polisher is not None:
         from symid.fit.polish import polish_outcome
 

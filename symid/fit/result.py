@@ -166,6 +166,9 @@ class IdentificationResult:
         With ``polish=True``: SCR followed by a local refinement, reported separately.
     options : dict
         The options the method ran with.
+    uncertainty : Uncertainty or None
+        Covariance, standard errors and 95 % confidence intervals of θ from the Fisher
+        information, for methods that offer it (:mod:`symid.fit.uncertainty`).
     """
 
     method: str
@@ -183,6 +186,7 @@ class IdentificationResult:
     starts: tuple[StartOutcome, ...]
     polished: IdentificationResult | None = None
     options: dict[str, Any] = field(default_factory=dict)
+    uncertainty: Any = None
 
     @classmethod
     def from_starts(cls, method: str, parameter_names: tuple[str, ...], starts: list[StartOutcome], *,
@@ -219,12 +223,20 @@ class IdentificationResult:
                  f"total time {self.wall_time:.3f} s"]
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
+        unc = self.uncertainty
+        if unc is not None:
+            lines.append(unc.summary())
         head = f"{'parameter':>12s} {'estimate':>14s}"
+        if unc is not None:
+            head += f" {'std. error':>11s} {'95 % interval':>27s}"
         if truth is not None:
             head += f" {'truth':>14s} {'rel. error':>11s}"
         lines.append(head)
-        for name in self.parameter_names:
+        for i, name in enumerate(self.parameter_names):
             row = f"{name:>12s} {self.theta[name]:>14.6g}"
+            if unc is not None:
+                lo, hi = unc.intervals[i]
+                row += f" {unc.standard_errors[i]:>11.3g} {f'[{lo:.6g}, {hi:.6g}]':>27s}"
             if truth is not None and name in truth:
                 t = float(truth[name])
                 err = abs(self.theta[name] - t) / (abs(t) if t != 0 else 1.0)
@@ -246,5 +258,6 @@ class IdentificationResult:
                 "status": self.status, "iterations": int(self.iterations), "wall_time": float(self.wall_time),
                 "message": self.message, "fit": self.fit, "starts": [s.to_dict() for s in self.starts],
                 "polished": None if self.polished is None else self.polished.to_dict(),
+                "uncertainty": None if self.uncertainty is None else self.uncertainty.to_dict(),
                 "options": {k: (v if isinstance(v, (int, float, str, bool, type(None))) else repr(v))
                             for k, v in self.options.items()}}
