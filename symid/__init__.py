@@ -10,7 +10,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from symid.data import BlackBox, FrequencyData, IOData, SpectralData
+from symid.data import BlackBox, FrequencyData, IOData, SpectralData, TimeSeries
 from symid.errors import (
     DataError,
     IdentifiabilityWarning,
@@ -94,6 +94,7 @@ __all__ = [
     "StateSpaceMatrices",
     "StateSpaceModel",
     "SymidError",
+    "TimeSeries",
     "ZooEntry",
     "compare",
     "d2c",
