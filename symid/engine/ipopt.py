@@ -118,6 +118,9 @@ class IpoptSolver:
     max_iter : int
     tol : float
     hessian : {"exact", "limited-memory"}
+    time_limit : float, optional
+        Wall-time budget of one solve in seconds (IPOPT's ``max_wall_time``; status
+        ``"Maximum_WallTime_Exceeded"``). Default: no limit.
 
     Examples
     --------
@@ -133,13 +136,15 @@ class IpoptSolver:
     """
 
     def __init__(self, name: str, z: Any, f: Any, *, lbz: np.ndarray, ubz: np.ndarray, max_iter: int, tol: float,
-                 hessian: str):
+                 hessian: str, time_limit: float | None = None):
         opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                 "ipopt.max_iter": int(max_iter), "ipopt.tol": float(tol),
                 "ipopt.acceptable_tol": max(float(tol), 1e-12), "ipopt.acceptable_iter": 25,
                 "error_on_fail": False}
         if hessian == "limited-memory":
             opts["ipopt.hessian_approximation"] = "limited-memory"
+        if time_limit is not None:
+            opts["ipopt.max_wall_time"] = float(time_limit)
         self._solver = ca.nlpsol(name, "ipopt", {"x": z, "f": f}, opts)
         self.lbz = np.asarray(lbz, dtype=float)
         self.ubz = np.asarray(ubz, dtype=float)

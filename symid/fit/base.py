@@ -19,7 +19,8 @@ Naming rules followed by every estimator's options (one vocabulary across data k
                    the model at the start θ), ``"zero"``, ``"identity"`` (where they apply)
 ``weights``        SCR: weights of the nuclear-norm relaxations (λ of the thesis)
 ``backend``        SCR: ``"admm"`` or ``"cvxpy"`` (Clarabel)
-``scale``          IPOPT: typical magnitude of each parameter
+``scale``          typical magnitude of each parameter (the unknowns are θ / scale)
+``time_limit``     wall-time budget of one start in seconds (default: none)
 =================  ===========================================================================
 """
 
@@ -34,7 +35,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from symid.errors import OptionError
-from symid.fit.options import check_bool, check_choice, check_float, check_int, check_known_names
+from symid.fit.options import check_bool, check_choice, check_float, check_int, check_known_names, check_time_limit
 from symid.fit.result import ScrIteration, StartOutcome
 from symid.fit.success import fit_test
 
@@ -176,9 +177,10 @@ def positivity_lmis(model: Any, theta: Any, which: Callable[[int], bool] | None 
     return out
 
 
-def mvk_lmis(maps: Any, theta: Any, options: dict[str, Any], names: str = "MVK") -> list[Any]:
+def mvk_lmis(maps: Any, theta: Any, options: dict[str, Any], names: str = "MVK", scale: Any = None) -> list[Any]:
     """M, V, K ⪰ 0 as LMIs in θ for each non-constant symmetric map; a non-symmetric one is
-    skipped and recorded in ``options`` (``lmi_M`` … ``"skipped: not symmetric"``)."""
+    skipped and recorded in ``options`` (``lmi_M`` … ``"skipped: not symmetric"``). With
+    ``scale``, the variable is φ = θ / scale."""
     from symid import scr
 
     out = []
@@ -188,7 +190,8 @@ def mvk_lmis(maps: Any, theta: Any, options: dict[str, Any], names: str = "MVK")
         if not symmetric_map(maps[name]):
             options[f"lmi_{name}"] = "skipped: not symmetric"
             continue
-        out.append(scr.Affine(maps[name].X0, {theta: theta_coef(maps[name])}))
+        coef = theta_coef(maps[name]) if scale is None else theta_coef(maps[name]) * scale
+        out.append(scr.Affine(maps[name].X0, {theta: coef}))
     return out
 
 
@@ -202,11 +205,12 @@ class ScrEstimator(Estimator):
     method: ClassVar[str] = "scr"
 
     def _engine_options(self, *, backend: Any, max_iter: Any, tol: Any, heuristic: Any = "nuclear",
-                        truncate_after: Any = 0, admm: Any = None) -> dict[str, Any]:
+                        truncate_after: Any = 0, admm: Any = None, time_limit: Any = None) -> dict[str, Any]:
         """Validated options of :func:`symid.engine.scr.solve`."""
         from symid import scr
 
         opts = {"backend": check_choice("backend", backend, _BACKENDS),
+                "time_limit": check_time_limit("time_limit", time_limit),
                 "max_iter": check_int("max_iter", max_iter, low=1, high=10**7),
                 "tol": check_float("tol", tol, low=0, strict_low=True),
                 "heuristic": check_choice("heuristic", heuristic, _HEURISTICS),
@@ -218,12 +222,12 @@ class ScrEstimator(Estimator):
         return opts
 
     def _setup_engine(self, problem: Any, solve_options: dict[str, Any], *, presolve: bool = True,
-                      normalize: bool = True) -> None:
+                      normalize: bool = True, equalities: str = "exact") -> None:
         from symid import scr
 
         self.problem = problem
         self.compiled = scr.compile(problem, presolve=check_bool("presolve", presolve),
-                                    normalize=check_bool("normalize", normalize))
+                                    normalize=check_bool("normalize", normalize), equalities=equalities)
         self._solve_opts = solve_options
 
     def engine_solve(self, start: Mapping[str, Any], callback: Any = None, compiled: Any = None) -> Any:

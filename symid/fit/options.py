@@ -27,6 +27,7 @@ __all__ = [
     "check_known_names",
     "check_scale",
     "check_seed",
+    "check_time_limit",
 ]
 
 MAX_SEED = 2**63 - 1
@@ -146,6 +147,18 @@ def check_scale(name: str, value: Any, size: int) -> np.ndarray:
         k = int(np.argmax(bad))
         raise OptionError(f"{name}[{k}] = {float(arr[k])!r}; every entry must be a positive finite number")
     return arr.copy()
+
+
+def check_time_limit(name: str, value: Any) -> float | None:
+    """A wall-time budget in seconds: ``None`` (no limit) or a finite number > 0.
+
+    Examples
+    --------
+    >>> from symid.fit.options import check_time_limit
+    >>> check_time_limit("time_limit", 30), check_time_limit("time_limit", None)
+    (30.0, None)
+    """
+    return None if value is None else check_float(name, value, low=0, strict_low=True)
 
 
 def check_known_names(owner: str, given: Mapping[str, Any], valid: Iterable[str]) -> None:

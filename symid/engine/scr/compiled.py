@@ -42,6 +42,8 @@ class CompiledProblem:
         The problem it was compiled from.
     presolve, normalize : bool
         The options it was compiled with (see :func:`symid.engine.scr.solve`).
+    equalities : str
+        ``"exact"`` or ``"least_squares"`` (see :func:`compile`).
     reduced : Reduced
         The presolved problem.
     groups : list of TermGroup
@@ -53,8 +55,10 @@ class CompiledProblem:
     """
 
     def __init__(self, problem: BilinearProblem, *, presolve: bool, normalize: bool,
-                 reduced: Reduced, groups: list[TermGroup], lmi_groups: list[LMIGroup], prepare_time: float):
+                 reduced: Reduced, groups: list[TermGroup], lmi_groups: list[LMIGroup], prepare_time: float,
+                 equalities: str = "exact"):
         self.problem = problem
+        self.equalities = equalities
         self.presolve = bool(presolve)
         self.normalize = bool(normalize)
         self.reduced = reduced
@@ -85,7 +89,8 @@ class CompiledProblem:
                 f"presolve={self.presolve}, normalize={self.normalize})")
 
 
-def compile(problem: BilinearProblem, *, presolve: bool = True, normalize: bool = True) -> CompiledProblem:
+def compile(problem: BilinearProblem, *, presolve: bool = True, normalize: bool = True,
+            equalities: str = "exact") -> CompiledProblem:
     """Presolve and group a bilinear problem once, for many :func:`symid.engine.scr.solve` calls.
 
     Parameters
@@ -93,6 +98,12 @@ def compile(problem: BilinearProblem, *, presolve: bool = True, normalize: bool 
     problem : BilinearProblem
     presolve, normalize : bool, optional
         As in :func:`symid.engine.scr.solve` (both default ``True``).
+    equalities : {"exact", "least_squares"}, optional
+        Linear equalities (given, or split off the bilinear terms by the presolve) that
+        do not hold exactly: ``"exact"`` (default) makes the problem inconsistent (a
+        solve returns status ``"infeasible"``); ``"least_squares"`` keeps their
+        least-squares solution set, as measured data need (the relative residual is in
+        ``reduced.info["equality_residual"]``; :mod:`symid.engine.scr.presolve`).
 
     Returns
     -------
@@ -118,10 +129,12 @@ def compile(problem: BilinearProblem, *, presolve: bool = True, normalize: bool 
     """
     if not isinstance(problem, BilinearProblem):
         raise ModelError(f"compile() needs a BilinearProblem, got {type(problem).__name__}")
+    if equalities not in ("exact", "least_squares"):
+        raise ModelError(f"equalities must be 'exact' or 'least_squares', got {equalities!r}")
     t0 = time.perf_counter()
-    red = _presolve(problem, split=bool(presolve), normalize=bool(normalize))
+    red = _presolve(problem, split=bool(presolve), normalize=bool(normalize), equalities=equalities)
     ok = red.inconsistent <= INCONSISTENT_TOL
     groups = group_terms(red.terms) if ok else []
     lmi_groups = group_lmis(red.lmis) if ok else []
     return CompiledProblem(problem, presolve=presolve, normalize=normalize, reduced=red, groups=groups,
-                           lmi_groups=lmi_groups, prepare_time=time.perf_counter() - t0)
+                           lmi_groups=lmi_groups, prepare_time=time.perf_counter() - t0, equalities=equalities)

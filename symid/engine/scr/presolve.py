@@ -7,7 +7,14 @@
    at their value and substituted everywhere; that can make more rows constant, so 1 and
    2 repeat until nothing changes. A term with no row or column left disappears, and a
    problem with no bilinear term left is convex and is solved exactly in one step.
-3. Equalities are reduced to linearly independent rows of unit norm.
+3. Equalities are reduced to linearly independent rows of unit norm. With
+   ``equalities="least_squares"``, a set of equalities that noise has made inconsistent
+   (measured data never satisfy an over-determined linear system exactly) is replaced
+   by its least-squares solution set: each connected set of rows D x = d becomes
+   D x = D x̂ with x̂ the least-squares solution (d projected onto the range of D, rows
+   of unit norm weighed alike); the relative residual ‖D x̂ − d‖ / ‖d‖ is reported in
+   ``info["equality_residual"]``. With ``"exact"`` (the default) a residual above
+   1e-8 · (1 + ‖d‖) marks the problem inconsistent.
 4. Complex terms go through the real representation (2-8), with half the weight, so that
    λ weighs the nuclear norm of the complex matrix.
 5. Each remaining term is equilibrated without changing its solution set: P is divided
@@ -69,7 +76,7 @@ class Reduced:
     H: sps.csr_matrix
     g: np.ndarray
     c: float
-    inconsistent: float = 0.0  # residual of inconsistent equalities (0 when consistent)
+    inconsistent: float = 0.0  # residual of inconsistent equalities (0 when consistent or least squares)
     info: dict = field(default_factory=dict)
 
     @property
@@ -156,12 +163,14 @@ def _rows(maps: list[LocalMap], n: int) -> tuple[sps.csr_matrix, np.ndarray]:
     return D, np.concatenate(dd)
 
 
-def _analyse(D: sps.csr_matrix, d: np.ndarray, active: np.ndarray):
-    """Independent rows, determined variables and their values, and inconsistency, per component."""
+def _analyse(D: sps.csr_matrix, d: np.ndarray, active: np.ndarray, lsq: bool = False):
+    """Independent rows, determined variables and their values, inconsistency (exact mode) and
+    the relative least-squares residual (``lsq``: inconsistent components projected), per component."""
     n = D.shape[1]
     nrm = np.sqrt(np.asarray(D.multiply(D).sum(axis=1)).ravel())
     empty = nrm == 0
-    bad = float(np.max(np.abs(d[empty]), initial=0.0))
+    bad = 0.0 if lsq else float(np.max(np.abs(d[empty]), initial=0.0))
+    lsq_res = 0.0
     D = sps.diags(np.where(empty, 0.0, 1.0 / np.where(empty, 1.0, nrm))) @ D
     d = np.where(empty, 0.0, d / np.where(empty, 1.0, nrm))
     rows_keep: list[int] = []
@@ -187,7 +196,12 @@ def _analyse(D: sps.csr_matrix, d: np.ndarray, active: np.ndarray):
             xs = np.linalg.lstsq(Dd, dc, rcond=None)[0]
             res = np.linalg.norm(Dd @ xs - dc)
             if res > 1e-8 * (1 + np.linalg.norm(dc)):
-                bad = max(bad, float(res))
+                if lsq:  # keep the least-squares solution set: d projected onto the range of D
+                    lsq_res = max(lsq_res, float(res / max(np.linalg.norm(dc), 1e-300)))
+                    d = d.copy()
+                    d[live[rc]] = Dd @ xs
+                else:
+                    bad = max(bad, float(res))
             lev = np.sum(Qm[:, :rank] ** 2, axis=1)
             det = lev > 1 - 1e-9
             gv = cols[vc[det]]
@@ -195,7 +209,7 @@ def _analyse(D: sps.csr_matrix, d: np.ndarray, active: np.ndarray):
             values[gv] = xs[det]
     determined &= active
     keep = np.sort(np.asarray(rows_keep, dtype=np.int64))
-    return D[keep], d[keep], determined, values, bad
+    return D[keep], d[keep], determined, values, bad, lsq_res
 
 
 def _realrep(m: LocalMap) -> LocalMap:
@@ -253,7 +267,8 @@ def _compress(A: LocalMap, P: np.ndarray, B: LocalMap) -> tuple[LocalMap, np.nda
     return A, P, B
 
 
-def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = True) -> Reduced:
+def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = True,
+             equalities: str = "exact") -> Reduced:
     """Reduce ``prob`` to the real problem on the free variables that the back ends solve.
 
     Parameters
@@ -265,13 +280,20 @@ def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = Tru
         whole, as in the thesis, for experiments.
     normalize : bool, optional
         Equilibrate each bilinear term (default ``True``); see the module docstring.
+    equalities : {"exact", "least_squares"}, optional
+        What inconsistent linear equalities mean: an inconsistent problem (``"exact"``,
+        default), or noise, kept in the least-squares sense (step 3 of the module docstring).
     """
+    if equalities not in ("exact", "least_squares"):
+        raise ValueError(f"equalities must be 'exact' or 'least_squares', got {equalities!r}")
+    lsq = equalities == "least_squares"
     n = prob.n
     fixed = np.zeros(n, dtype=bool)
     xfix = np.zeros(n)
     terms: list[tuple[int, CompiledTerm]] = list(enumerate(prob.terms))
     eqmaps = list(prob.equalities)
     bad = 0.0
+    lsq_res = 0.0
     passes = 0
     while True:
         passes += 1
@@ -288,7 +310,8 @@ def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = Tru
                     kept.append((src, rest))
             terms = kept
         D, d = _rows([_substitute(m, fixed, xfix) for m in eqmaps], n)
-        D, d, det, val, bad = _analyse(D, d, ~fixed)
+        D, d, det, val, bad, lres = _analyse(D, d, ~fixed, lsq)
+        lsq_res = max(lsq_res, lres)
         if not split or (not det.any() and not new_eq) or passes > 20:
             break
         fixed |= det
@@ -325,5 +348,5 @@ def presolve(prob: BilinearProblem, *, split: bool = True, normalize: bool = Tru
     gz = prob.g[free] + 2 * Hx[free]
     c = prob.objective_value(xfix)
     info = {"passes": passes, "fixed": int(fixed.sum()), "equalities": int(Dz.shape[0]),
-            "bilinear_terms": len(real_terms)}
+            "bilinear_terms": len(real_terms), "equalities_mode": equalities, "equality_residual": lsq_res}
     return Reduced(n, free, xfix, real_terms, sps.csr_matrix(Dz), np.asarray(d), lmis, Hz, gz, c, bad, info)

@@ -66,7 +66,8 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
           max_iter: int = 100, tol: float = 1e-6, step_tol: float | None = None, heuristic: str = "nuclear",
           truncate_after: int = 0, presolve: bool | None = None, normalize: bool | None = None,
           admm: ADMMOptions | None = None, solver_options: dict | None = None,
-          callback: Callable[[int, dict[str, Any]], bool] | None = None) -> SCRSolution:
+          callback: Callable[[int, dict[str, Any]], bool] | None = None,
+          time_limit: float | None = None) -> SCRSolution:
     """Solve a bilinear problem by Sequential Convex Relaxation (thesis Algorithm 2.1).
 
     Every iteration minimises f(x) + Σ_t λ_t ||M_t(x; Q_t, R_t)||_* subject to the
@@ -119,6 +120,10 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
         meet the stopping rule, with the iterate ``x`` by variable name; a true return
         stops SCR (status ``"stopped"``). Its time counts in ``wall_time``. Used, e.g.,
         to hand over to a local solver once SCR has reached a good basin.
+    time_limit : float, optional
+        Wall-time budget in seconds: no new iteration starts once it is spent (status
+        ``"time_limit"``, the last iterate kept). An iteration that has started runs to
+        its end, so a solve can exceed the budget by one iteration. Default: no limit.
 
     Returns
     -------
@@ -173,6 +178,9 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
         raise ModelError(f"solver_options must be a dict, got {type(solver_options).__name__}")
     if callback is not None and not callable(callback):
         raise ModelError(f"callback must be callable, got {type(callback).__name__}")
+    if time_limit is not None and not (isinstance(time_limit, (int, float)) and not isinstance(time_limit, bool)
+                                       and time_limit > 0):
+        raise ModelError(f"time_limit must be a number of seconds > 0 or None, got {time_limit!r}")
     lay = (compiled.problem if compiled is not None else prob).layout
     x_start = lay.pack(x0)
     if compiled is None:
@@ -252,6 +260,9 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
         if callback is not None and callback(k + 1, lay.unpack(x)):
             status = "stopped"
             break
+        if time_limit is not None and time.perf_counter() - t_start >= time_limit and k + 1 < n_iter:
+            status = "time_limit"
+            break
         if res >= 0.99 * last_res:
             be.on_stall()
         last_res = res
@@ -265,12 +276,16 @@ def solve(prob: BilinearProblem | CompiledProblem, x0: Mapping[Any, Any] | None 
     x_final = red.lift(z)
     iterates = tuple(lay.unpack(xk) for xk in xs)
     # stationary: the last step met the step rule (converged, or stuck at a residual it cannot reduce)
-    info["stationary"] = bool(history) and status in ("converged", "max_iter") and history[-1].step <= stol
+    info["stationary"] = bool(history) and status in ("converged", "max_iter", "time_limit") and \
+        history[-1].step <= stol
     if status == "converged":
         message = ("solved exactly: no bilinear term left after presolve" if not groups else
                    f"bilinear residual {history[-1].residual:.3e} ≤ tol = {tol:g} after {len(history)} iterations")
         if msg:
             message += f" (last sub-problem: {msg})"
+    elif status == "time_limit":
+        message = (f"time limit of {time_limit:g} s reached after {len(history)} iterations; bilinear residual "
+                   f"{history[-1].residual:.3e}, last step {history[-1].step:.3e}")
     elif status == "max_iter" and not groups:
         message = f"the convex problem left after presolve was not solved to tolerance: {msg}"
     elif status == "stopped":

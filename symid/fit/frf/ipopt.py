@@ -9,7 +9,7 @@ import numpy as np
 
 from symid.engine.ipopt import HESSIANS, IpoptSolver, casadi_frf, positivity_bounds
 from symid.fit.frf.misfit import FrfEstimator
-from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale
+from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale, check_time_limit
 from symid.fit.result import StartOutcome
 
 __all__ = ["IpoptFRF"]
@@ -38,6 +38,8 @@ class IpoptFRF(FrfEstimator):
         IPOPT iteration limit (default 3000).
     tol : float, optional
         IPOPT convergence tolerance (default 1e-12 on the relative objective).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds (IPOPT's ``max_wall_time``). Default: none.
 
     Examples
     --------
@@ -55,7 +57,7 @@ class IpoptFRF(FrfEstimator):
     method: ClassVar[str] = "ipopt"
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, positivity: bool = True,
-                 hessian: str = "exact", max_iter: int = 3000, tol: float = 1e-12):
+                 hessian: str = "exact", max_iter: int = 3000, tol: float = 1e-12, time_limit: float | None = None):
         self.model, self.data = model, data
         l = model.n_parameters
         self.scale = np.ones(l) if scale is None else check_scale("scale", scale, l)
@@ -63,8 +65,9 @@ class IpoptFRF(FrfEstimator):
         hessian = check_choice("hessian", hessian, HESSIANS)
         max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         tol = check_float("tol", tol, low=0, strict_low=True)
+        time_limit = check_time_limit("time_limit", time_limit)
         self.options = {"scale": self.scale.tolist(), "positivity": positivity, "hessian": hessian,
-                        "max_iter": max_iter, "tol": tol}
+                        "max_iter": max_iter, "tol": tol, "time_limit": time_limit}
         z = ca.MX.sym("z", l)
         theta = z * ca.DM(self.scale)
         Hr, Hi = casadi_frf(model, theta, np.asarray(data.w))
@@ -75,7 +78,7 @@ class IpoptFRF(FrfEstimator):
             f = f + ca.sumsqr(Hr[i] - ca.DM(H[i].real)) + ca.sumsqr(Hi[i] - ca.DM(H[i].imag))
         lbz, ubz = positivity_bounds(model.positive, positivity, self.scale)
         self._solver = IpoptSolver("symid_ipopt_frf", z, f / norm2, lbz=lbz, ubz=ubz, max_iter=max_iter, tol=tol,
-                                   hessian=hessian)
+                                   hessian=hessian, time_limit=time_limit)
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start ``x0`` (parameter vector); never raises on solver failure."""

@@ -54,7 +54,7 @@ from symid import scr
 from symid.errors import ModelError, OptionError
 from symid.fit.base import ScrEstimator, identity_coef, mvk_lmis, positivity_lmis, theta_coef
 from symid.fit.frf.misfit import FrfEstimator
-from symid.fit.options import check_bool, check_choice, check_float, check_seed
+from symid.fit.options import check_bool, check_choice, check_float, check_scale, check_seed
 from symid.fit.polish import polish_outcome
 from symid.fit.result import StartOutcome
 
@@ -122,6 +122,14 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         second-order models (sub-problems solved to 1% while the bilinear residual is
         large, to the residual's level once it is smaller, through the engine's
         ``tighten``; see the module docstring).
+    scale : array_like, optional
+        Typical magnitude of each parameter (one number or one per parameter). SCR then
+        works on φ = θ / scale, and each Γᵢ on Γᵢ / gᵢ with gᵢ the size of Γᵢ of the
+        model at θ = scale, so that every unknown is of order one whatever the units.
+        Default: no scaling (θ and Γᵢ as they are).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds (no new SCR iteration starts once it
+        is spent; status ``"time_limit"``). Default: none.
     polish_misfit : float or None
         ``"scr+polish"`` (:meth:`run_polished`): after SCR iterations 1, 2, 4, 8, … a
         trial polish runs from the current SCR estimate, and SCR stops as soon as one
@@ -134,7 +142,8 @@ class ScrFRF(ScrEstimator, FrfEstimator):
     def __init__(self, model: Any, data: Any, *, substitution: str = "gamma", weights: Any = None,
                  lmis: bool = True, positivity: bool = True, backend: str = "admm", max_iter: int = 500,
                  tol: float = 1e-6, aux_init: str = "random", seed: int = 0, presolve: bool = True,
-                 heuristic: str = "nuclear", admm: Any = None, polish_misfit: float | None = 1e-8):
+                 heuristic: str = "nuclear", admm: Any = None, scale: Any = None, time_limit: float | None = None,
+                 polish_misfit: float | None = 1e-8):
         substitution = check_choice("substitution", substitution, ("gamma", "psi", "both"))
         self.aux_init = check_choice("aux_init", aux_init, _AUX_INITS)
         lmis, positivity = check_bool("lmis", lmis), check_bool("positivity", positivity)
@@ -147,23 +156,31 @@ class ScrFRF(ScrEstimator, FrfEstimator):
             substitution = "gamma"
         self.substitution = substitution
         self.w = np.asarray(data.w, dtype=float)
+        l = model.n_parameters
+        self.scale = np.ones(l) if scale is None else check_scale("scale", scale, l)
+        self._aux_scale = self._aux_scales(scale is not None)
         lam = self._weights(weights)
         solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, heuristic=heuristic,
-                                          admm=admm)
+                                          admm=admm, time_limit=time_limit)
         if admm is None and backend == "admm" and self.second_order:
             solve_opts["admm"] = scr.ADMMOptions(eps_rel=1e-2)  # measured, see the module docstring
         self.options = {"substitution": substitution, "weights": "uniform" if weights is None else "given",
                         "lmis": lmis, "positivity": positivity, "backend": backend, "max_iter": max_iter,
                         "tol": tol, "aux_init": aux_init, "seed": seed, "presolve": presolve,
-                        "heuristic": heuristic}
+                        "heuristic": heuristic, "scale": None if scale is None else self.scale.tolist(),
+                        "time_limit": solve_opts["time_limit"]}
         self.polish_misfit = polish_misfit
-        self._setup_engine(self._build(lam, lmis, positivity), solve_opts, presolve=presolve)
+        # measured data never satisfy the equalities the presolve splits off exactly: least squares
+        self._setup_engine(self._build(lam, lmis, positivity), solve_opts, presolve=presolve,
+                           equalities="least_squares")
 
     def polisher(self) -> Any:
         """IPOPT on the same frequency response (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
         from symid.fit.frf.ipopt import IpoptFRF
 
-        return IpoptFRF(self.model, self.data, positivity=self.options["positivity"])
+        scale = self.options["scale"]
+        return IpoptFRF(self.model, self.data, positivity=self.options["positivity"], scale=scale,
+                        time_limit=self.options["time_limit"])
 
     # -- problem construction ---------------------------------------------------------------
     def _families(self) -> dict[str, str]:
@@ -219,13 +236,19 @@ class ScrFRF(ScrEstimator, FrfEstimator):
             self.families.setdefault(labels[family], []).append(len(terms))
             terms.append(scr.Bilinear(**maps_, weight=float(lam[family][i]), name=f"{family}[{i}]"))
 
+        sc = self.scale
+        g = self._aux_scale
+
+        def tc(amap: Any) -> np.ndarray:  # coefficients of φ = θ / scale
+            return theta_coef(amap) * sc
+
         def aff(amap: Any, sign: float = 1.0) -> scr.Affine:
-            return scr.Affine(sign * amap.X0, {theta: sign * theta_coef(amap)})
+            return scr.Affine(sign * amap.X0, {theta: sign * tc(amap)})
 
         if self.second_order:
             n = model.n_dof
             MVK0 = np.hstack([maps["M"].X0, maps["V"].X0, maps["K"].X0])
-            MVKc = np.concatenate([theta_coef(maps["M"]), theta_coef(maps["V"]), theta_coef(maps["K"])], axis=1)
+            MVKc = np.concatenate([tc(maps["M"]), tc(maps["V"]), tc(maps["K"])], axis=1)
             A_mvk = scr.Affine(MVK0, {theta: MVKc})
             f = {"position": np.ones(self.w.size, dtype=complex), "velocity": 1j * self.w,
                  "acceleration": -(self.w**2) + 0j}[model.output]
@@ -235,23 +258,23 @@ class ScrFRF(ScrEstimator, FrfEstimator):
                 variables.append(G)
                 self.gamma_vars.append(G)
                 Pi = np.vstack([-(wi**2) * np.eye(n), 1j * wi * np.eye(n), np.eye(n)])
-                Gi = scr.Affine(np.zeros((n, m)), {G: identity_coef((n, m))})
+                Gi = scr.Affine(np.zeros((n, m)), {G: g[i] * identity_coef((n, m))})
                 add("dynamics", i, A=A_mvk, P=Pi, B=Gi, C=aff(maps["B"]))
                 add("output", i, A=aff(maps["C"]), P=f[i] * np.eye(n), B=Gi, C=scr.Affine(H[i]))  # Hᵢ = fᵢ C Γᵢ
             if lmis:
-                lmi_list.extend(mvk_lmis(maps, theta, self.options))
+                lmi_list.extend(mvk_lmis(maps, theta, self.options, scale=sc))
         else:
             n = model.n_states
             eye = np.eye(n)
             self.gamma_vars, self.psi_vars = [], []
             for i, wi in enumerate(self.w):
-                Hi_minus_D = scr.Affine(H[i] - maps["D"].X0, {theta: -theta_coef(maps["D"])})
+                Hi_minus_D = scr.Affine(H[i] - maps["D"].X0, {theta: -tc(maps["D"])})
                 if self.substitution in ("gamma", "both"):
                     G = scr.Variable(f"Gamma{i}", (n, m), complex=True)
                     variables.append(G)
                     self.gamma_vars.append(G)
-                    Gi = scr.Affine(np.zeros((n, m)), {G: identity_coef((n, m))})
-                    rhs = scr.Affine(-maps["B"].X0, {G: 1j * wi * identity_coef((n, m)), theta: -theta_coef(maps["B"])})
+                    Gi = scr.Affine(np.zeros((n, m)), {G: g[i] * identity_coef((n, m))})
+                    rhs = scr.Affine(-maps["B"].X0, {G: 1j * wi * g[i] * identity_coef((n, m)), theta: -tc(maps["B"])})
                     add("gamma_dynamics", i, A=aff(maps["A"]), P=eye, B=Gi, C=rhs)
                     add("gamma_output", i, A=aff(maps["C"]), P=eye, B=Gi, C=Hi_minus_D)
                 if self.substitution in ("psi", "both"):
@@ -259,7 +282,7 @@ class ScrFRF(ScrEstimator, FrfEstimator):
                     variables.append(S)
                     self.psi_vars.append(S)
                     Si = scr.Affine(np.zeros((p, n)), {S: identity_coef((p, n))})
-                    rhs = scr.Affine(-maps["C"].X0, {S: 1j * wi * identity_coef((p, n)), theta: -theta_coef(maps["C"])})
+                    rhs = scr.Affine(-maps["C"].X0, {S: 1j * wi * identity_coef((p, n)), theta: -tc(maps["C"])})
                     add("psi_dynamics", i, A=Si, P=eye, B=aff(maps["A"]), C=rhs)
                     add("psi_output", i, A=Si, P=eye, B=aff(maps["B"]), C=Hi_minus_D)
         if positivity:  # θk ≥ 0 for the parameters declared positive
@@ -267,10 +290,36 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         self.theta_var = theta
         return scr.BilinearProblem(variables=variables, bilinear=terms, lmis=lmi_list)
 
+    def _aux_scales(self, scaled: bool) -> np.ndarray:
+        """gᵢ: the size (largest entry) of Γᵢ of the model at θ = scale, or 1 without a scale."""
+        ones = np.ones(self.w.size)
+        if not scaled:
+            return ones
+        gam = self._model_gamma(self.scale)
+        if gam is None:
+            return ones
+        size = np.abs(gam).reshape(self.w.size, -1).max(axis=1)
+        return np.where((size > 0) & np.isfinite(size), size, 1.0)
+
+    def _model_gamma(self, theta: np.ndarray) -> np.ndarray | None:
+        """Γᵢ of the model at θ for every frequency (``None`` where it cannot be evaluated)."""
+        try:
+            if self.second_order:
+                mats = self.model.matrices(theta)
+                M, V, K, B = (mats[k] for k in "MVKB")
+                Z = -(self.w**2)[:, None, None] * M + 1j * self.w[:, None, None] * V + K
+            else:
+                A, B, _, _ = self.model.state_space(theta)
+                Z = 1j * self.w[:, None, None] * np.eye(A.shape[0]) - A
+            gam = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (self.w.size, *B.shape)))
+        except (np.linalg.LinAlgError, ModelError):
+            return None
+        return gam if np.all(np.isfinite(gam)) else None
+
     # -- one start ---------------------------------------------------------------------------
     def _aux_start(self, x0: np.ndarray) -> dict[str, Any]:
         model = self.model
-        start: dict[str, Any] = {"theta": x0}
+        start: dict[str, Any] = {"theta": x0 / self.scale}
         mode = self.aux_init
         gam = psi = None
         if mode == "model":
@@ -298,7 +347,7 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         rng = np.random.default_rng([self._rng_seed, *key])
         for i, G in enumerate(self.gamma_vars):
             if mode == "model":
-                start[G.name] = gam[i]
+                start[G.name] = gam[i] / self._aux_scale[i]
             elif mode == "random":
                 start[G.name] = rng.standard_normal(G.shape) + 1j * rng.standard_normal(G.shape)
         for i, S in enumerate(getattr(self, "psi_vars", [])):
@@ -326,8 +375,9 @@ class ScrFRF(ScrEstimator, FrfEstimator):
             return self.outcome(x0, np.full_like(x0, np.nan), finished=False, status="failed",
                                 message=f"SCR failed: {type(exc).__name__}: {exc}", iterations=0,
                                 wall_time=time.perf_counter() - t0), "failed"
-        theta = np.asarray(sol.x["theta"], dtype=float).reshape(-1)
-        hist = self.engine_history(sol, theta_of=lambda it: it["theta"], families=self.families)
+        theta = np.asarray(sol.x["theta"], dtype=float).reshape(-1) * self.scale
+        hist = self.engine_history(sol, theta_of=lambda it: np.asarray(it["theta"]).reshape(-1) * self.scale,
+                                   families=self.families)
         return self.solved_outcome(x0, theta, sol, t0, history=hist), sol.status
 
     def run(self, x0: np.ndarray) -> StartOutcome:
@@ -355,7 +405,7 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         def trial(k: int, x: dict[str, Any]) -> bool:
             if threshold is None or k & (k - 1):  # powers of two only: trials cost at most ~log2(k) polishes
                 return False
-            out = polisher.run(np.asarray(x["theta"], dtype=float).reshape(-1))
+            out = polisher.run(np.asarray(x["theta"], dtype=float).reshape(-1) * self.scale)
             trials.append((k, out))
             return bool(np.isfinite(out.cost) and out.cost <= threshold)
 
