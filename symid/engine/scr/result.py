@@ -71,7 +71,8 @@ class SCRSolution:
     history : tuple of Iteration
         Per-iteration record: objective, relaxation value, residuals, time.
     status : str
-        ``"converged"``, ``"max_iter"``, ``"time_limit"``, ``"stopped"`` (by the callback), ``"solver_error"`` or ``"infeasible"``.
+        ``"converged"``, ``"max_iter"``, ``"time_limit"``, ``"stopped"`` (by the callback),
+        ``"solver_error"`` or ``"infeasible"``.
     success : bool
         ``status == "converged"``.
     message : str
