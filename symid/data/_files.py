@@ -377,8 +377,10 @@ def _with_npz(path: PathLike, use: Any) -> Any:
                             f"{str(exc)[:100]}): the file is damaged or not a symid file") from None
 
 
-def read_npz(path: PathLike, kind: str, keys: Sequence[str]) -> dict[str, np.ndarray]:
-    """Read the arrays ``keys`` of a symid .npz file of ``kind`` (other members are not read).
+def read_npz(path: PathLike, kind: str, keys: Sequence[str], *, optional: Sequence[str] = ()
+             ) -> dict[str, np.ndarray]:
+    """Read the arrays ``keys`` of a symid .npz file of ``kind``, and those of ``optional`` it holds
+    (other members are not read).
 
     Raises
     ------
@@ -396,8 +398,9 @@ def read_npz(path: PathLike, kind: str, keys: Sequence[str]) -> dict[str, np.nda
         missing = [k for k in keys if k not in reader.members]
         if missing:
             raise DataError(f"{_where(path)}: the {kind} file lacks the array(s) {', '.join(missing)}")
-        reader.reserve(keys)
-        return {k: reader.read(k) for k in keys}
+        wanted = [*keys, *(k for k in optional if k in reader.members)]
+        reader.reserve(wanted)
+        return {k: reader.read(k) for k in wanted}
 
     return _with_npz(path, use)
 

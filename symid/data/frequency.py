@@ -14,6 +14,23 @@ from symid.errors import DataError
 __all__ = ["FrequencyData"]
 
 
+def _variance(x: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """A per-entry noise variance: real, finite, ≥ 0, of ``shape`` (a 1-D array for a SISO FRF)."""
+    arr = checks.as_array(x, "variance", complex_ok=False)
+    if arr.ndim == 1 and shape[1:] == (1, 1):
+        arr = arr.reshape(-1, 1, 1)
+    if arr.shape != shape:
+        raise DataError(f"variance must have the shape of H, {checks.shape_text(shape)}; got shape "
+                        f"{checks.shape_text(arr.shape)}")
+    checks.check_finite(arr, "variance")
+    neg = np.argwhere(arr < 0)
+    if neg.size:
+        idx = tuple(int(i) for i in neg[0])
+        raise DataError(f"variance must be >= 0 (a noise variance): variance[{', '.join(map(str, idx))}] = "
+                        f"{float(arr[idx])!r} ({len(neg)} negative value(s))")
+    return checks.frozen(arr)
+
+
 @dataclass(frozen=True, init=False, eq=False, repr=False)
 class FrequencyData(DataContainer):
     """Frequency response data H(ω_i) ∈ ℂ^{p×m} at angular frequencies ω_1 < ... < ω_s (rad/s).
@@ -29,12 +46,20 @@ class FrequencyData(DataContainer):
         The frequency response, ``H[i]`` being the p×m matrix at ``w[i]``; real input
         is stored as complex. A 1-D array of length s is accepted for a single-input
         single-output FRF and stored with shape (s, 1, 1). Any other shape is refused.
+    variance : array_like, shape (s, p, m) or (s,), optional
+        The noise variance of each entry of ``H``, ``E|Ĥᵢ − Hᵢ|²`` (real and imaginary
+        parts together; for circular complex noise each part has half of it), as
+        :func:`symid.estimate_frf` estimates it: real, finite and ≥ 0, the shape of ``H``
+        (a 1-D array for a SISO FRF). A zero says the entry is known exactly. ``None``
+        (default): no noise model. It is kept by :meth:`to_csv`, :meth:`to_npz`,
+        pickling and frequency selection (``frf[k]``).
 
     Raises
     ------
     DataError
         On NaN or inf, a wrong number of dimensions, a length mismatch between ``w`` and
-        ``H``, or non-positive, duplicated or unsorted frequencies. The message names the
+        ``H``, or non-positive, duplicated or unsorted frequencies; a ``variance`` that is
+        complex, negative, not finite or not shaped like ``H``. The message names the
         array and what was expected.
 
     Notes
@@ -49,7 +74,12 @@ class FrequencyData(DataContainer):
         <one row per frequency>
         # end
 
-    The H entries run row-major over (output i, input j).
+    The H entries run row-major over (output i, input j). With a ``variance``, the
+    columns ``var[0][0],var[0][1],...`` (same order) follow the H columns.
+
+    ``frf[k]`` with a slice, an integer array or a boolean mask over the frequencies
+    gives a new FrequencyData of those frequencies (in increasing order), variance
+    included.
 
     Examples
     --------
@@ -65,11 +95,12 @@ class FrequencyData(DataContainer):
 
     w: np.ndarray
     H: np.ndarray
+    variance: np.ndarray | None
 
     _kind: ClassVar[str] = "FrequencyData"
     _npz_keys: ClassVar[tuple[str, ...]] = ("w", "H")
 
-    def __init__(self, w: Any, H: Any):
+    def __init__(self, w: Any, H: Any, variance: Any = None):
         w_ = checks.frequencies(w, "w")
         s = w_.size
         H_ = checks.as_array(H, "H", complex_ok=True)
@@ -86,6 +117,55 @@ class FrequencyData(DataContainer):
         checks.check_finite(H_, "H")
         object.__setattr__(self, "w", w_)
         object.__setattr__(self, "H", checks.frozen(H_))
+        object.__setattr__(self, "variance", None if variance is None else _variance(variance, H_.shape))
+
+    # -- optional variance: equality, pickling, files and selection keep it ------------------
+    def _payload(self) -> dict[str, np.ndarray]:
+        out = super()._payload()
+        if self.variance is not None:
+            out["variance"] = self.variance
+        return out
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        mine, theirs = self._payload(), other._payload()
+        return mine.keys() == theirs.keys() and all(np.array_equal(mine[k], theirs[k]) for k in mine)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[type, tuple[Any, ...]]:
+        return (type(self), (self.w, self.H, self.variance))
+
+    def __getitem__(self, index: Any) -> FrequencyData:
+        try:
+            k = np.arange(self.n_frequencies)[index]
+        except (IndexError, TypeError, ValueError) as exc:
+            raise DataError(f"FrequencyData selects frequencies by a slice, an integer array or a boolean mask of "
+                            f"length {self.n_frequencies}; {exc}") from None
+        k = np.atleast_1d(k)
+        if k.ndim != 1:
+            raise DataError(f"FrequencyData selects frequencies along one axis; the index {index!r} adds axes")
+        if k.size == 0:
+            raise DataError("the selection holds no frequency; at least one is needed")
+        return type(self)(self.w[k], self.H[k], None if self.variance is None else self.variance[k])
+
+    @classmethod
+    def from_npz(cls, path: _files.PathLike) -> Self:
+        """Read data written by :meth:`to_npz` (the ``variance`` member is read when present).
+
+        Raises
+        ------
+        DataError
+            If the file is not a symid FrequencyData NPZ file, is damaged or declares more
+            than it can hold, or its arrays fail the constructor's checks (rules in the
+            notes of ``symid.data._files``).
+        FileNotFoundError, IsADirectoryError, PermissionError
+            If the file cannot be opened.
+        """
+        arrays = _files.read_npz(path, cls._kind, cls._npz_keys, optional=("variance",))
+        with naming_file(path):
+            return cls(arrays["w"], arrays["H"], arrays.get("variance"))
 
     # -- properties -----------------------------------------------------------------
     @property
@@ -122,15 +202,20 @@ class FrequencyData(DataContainer):
             f"  outputs p   : {self.n_outputs}",
             f"  inputs m    : {self.n_inputs}",
             f"  |H|         : {mag.min():.4g} to {mag.max():.4g}",
+            *([] if self.variance is None else
+              [f"  noise std   : {np.sqrt(self.variance).min():.4g} to {np.sqrt(self.variance).max():.4g} "
+               "(per entry, from the variance)"]),
         ])
 
     # -- CSV ------------------------------------------------------------------------
     @staticmethod
-    def _columns(p: int, m: int) -> list[str]:
+    def _columns(p: int, m: int, variance: bool = False) -> list[str]:
         cols = ["w"]
         for i in range(p):
             for j in range(m):
                 cols += [f"H[{i}][{j}].re", f"H[{i}][{j}].im"]
+        if variance:
+            cols += [f"var[{i}][{j}]" for i in range(p) for j in range(m)]
         return cols
 
     def to_csv(self, path: _files.PathLike) -> None:
@@ -161,8 +246,11 @@ class FrequencyData(DataContainer):
         flat = self.H.reshape(s, p * m)
         table[:, 1::2] = flat.real
         table[:, 2::2] = flat.imag
+        has_var = self.variance is not None
+        if has_var:
+            table = np.hstack([table, self.variance.reshape(s, p * m)])
         rows = [[_files.fmt(x) for x in row] for row in table.tolist()]
-        _files.write_csv(path, self._kind, {"n_outputs": p, "n_inputs": m}, self._columns(p, m), rows)
+        _files.write_csv(path, self._kind, {"n_outputs": p, "n_inputs": m}, self._columns(p, m, has_var), rows)
 
     @classmethod
     def from_csv(cls, path: _files.PathLike) -> Self:
@@ -185,9 +273,12 @@ class FrequencyData(DataContainer):
         meta, columns, rows = _files.read_csv(path, cls._kind)
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
-        _files.expect_width(columns, 1 + 2 * p * m, path, "1 + 2 × n_outputs × n_inputs")
-        _files.expect_columns(columns, cls._columns(p, m), path)
+        has_var = len(columns) == 1 + 3 * p * m
+        _files.expect_width(columns, 1 + (3 if has_var else 2) * p * m, path,
+                            "1 + 2 × n_outputs × n_inputs, or 1 + 3 × n_outputs × n_inputs with variances")
+        _files.expect_columns(columns, cls._columns(p, m, has_var), path)
         table = _files.parse_float_rows(rows, path, len(columns))
-        H = _files.complex_from_parts(table[:, 1::2], table[:, 2::2]).reshape(-1, p, m)
+        k = 1 + 2 * p * m
+        H = _files.complex_from_parts(table[:, 1:k:2], table[:, 2:k:2]).reshape(-1, p, m)
         with naming_file(path):
-            return cls(table[:, 0], H)
+            return cls(table[:, 0], H, table[:, k:].reshape(-1, p, m) if has_var else None)
