@@ -33,45 +33,29 @@ from __future__ import annotations
 import numpy as np
 
 import symid as si
-from symid.zoo import ZooEntry
 
 W = np.logspace(np.log10(0.4), np.log10(0.6), 10)  # rad/s (the thesis's "Hz" are rad/s, see above)
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """FRF of the truth at the 10 log-spaced frequencies in 0.4–0.6 rad/s."""
     from symid.signal.simulate import simulate_frf
 
     return simulate_frf(model, truth, W, noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The belt drive (3-17) with its truth (3-18) and FRF data recipe.
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (StateSpaceModel, 4 parameters theta1..theta4), ``truth`` (3-18) and
-        ``data()`` a :class:`~symid.data.FrequencyData` with 10 frequencies.
-    """
-    theta1, theta2, theta3, theta4 = si.parameters("theta1 theta2 theta3 theta4")
-    model = si.StateSpaceModel(
-        A=[[0, -1, 0.15], [0.2, 0, 0], [theta1, theta2, theta3]],
-        B=[[0], [0], [theta4]],
-        C=[[0, 1, 0]],
-        name="belt_drive",
-    )
-    truth = {"theta1": -1.0, "theta2": -0.5, "theta3": -0.2, "theta4": -0.15}  # thesis (3-18)
-    return ZooEntry(
-        name="belt_drive",
-        title="Printer belt drive, 3 states, 4 unknown entries (SISO)",
-        source="thesis §3-6, eqs. (3-17), (3-18); Figure 3-1",
-        model=model,
-        truth=truth,
-        recipe="FRF at 10 log-spaced frequencies in 0.4–0.6 rad/s (the thesis writes 'Hz'; the "
-               "resonance it samples is at 0.586 rad/s, so the numbers are rad/s)",
-        make_data=_make_data,
-        notes="Thesis labels the band 0.4–0.6 'Hz'; the spike of Figure 3-1 is at 0.586 rad/s, "
-              "so the band is read as rad/s. θ are negative: parameters are real, not positive.",
-        extra={"w": W, "resonance_rad_s": 0.586},
-    )
+theta1, theta2, theta3, theta4 = si.parameters("theta1 theta2 theta3 theta4")
+model = si.StateSpaceModel(
+    A=[[0, -1, 0.15], [0.2, 0, 0], [theta1, theta2, theta3]],
+    B=[[0], [0], [theta4]],
+    C=[[0, 1, 0]],
+    name="belt_drive",
+)
+truth = {"theta1": -1.0, "theta2": -0.5, "theta3": -0.2, "theta4": -0.15}  # thesis (3-18)
+title = "Printer belt drive, 3 states, 4 unknown entries (SISO)"
+source = "thesis §3-6, eqs. (3-17), (3-18); Figure 3-1"
+recipe = ("FRF at 10 log-spaced frequencies in 0.4–0.6 rad/s (the thesis writes 'Hz'; the "
+          "resonance it samples is at 0.586 rad/s, so the numbers are rad/s)")
+notes = ("Thesis labels the band 0.4–0.6 'Hz'; the spike of Figure 3-1 is at 0.586 rad/s, "
+         "so the band is read as rad/s. θ are negative: parameters are real, not positive.")
+extra = {"w": W, "resonance_rad_s": 0.586}

@@ -44,46 +44,30 @@ from __future__ import annotations
 from symid.zoo_models._common import blackbox_data, random_similarity
 
 import symid as si
-from symid.zoo import ZooEntry
 
 SEED = 638  # seed of the similarity transform of the black-box data
 SIGMA2 = (0.01, 0.1, 1.0, 10.0, 100.0)  # thesis (6-36): variances of the initial-guess offsets
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """Black box: the truth under a seeded random similarity transform (optionally perturbed)."""
     A, B, C, _ = model.state_space(truth)
     return blackbox_data(*random_similarity(A, B, C, seed=SEED), noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The driver belt (6-37) with truth (6-38) and black-box data.
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (StateSpaceModel, 4 parameters theta1..theta4), ``truth`` (all −10)
-        and ``data()`` a :class:`~symid.data.BlackBox` with 3 states.
-    """
-    theta1, theta2, theta3, theta4 = si.parameters("theta1 theta2 theta3 theta4")
-    model = si.StateSpaceModel(
-        A=[[0, 1, -1], [1, 0, 0], [theta1, theta2, theta3]],
-        B=[[0], [0], [theta4]],
-        C=[[0, 1, 0]],
-        name="belt_drive_dorf",
-    )
-    truth = {"theta1": -10.0, "theta2": -10.0, "theta3": -10.0, "theta4": -10.0}  # thesis (6-38)
-    return ZooEntry(
-        name="belt_drive_dorf",
-        title="Driver belt (Dorf), 3 states, 4 unknown entries (SISO), black-box data",
-        source="thesis §6-7-2, eqs. (6-37), (6-38); Figure 6-4",
-        model=model,
-        truth=truth,
-        recipe=f"continuous-time black box: the true (A, B, C) under a seeded (seed {SEED}) random "
-               "well-conditioned similarity transform; initial guesses θ* + N(0, σ²I), "
-               "σ² ∈ {0.01, 0.1, 1, 10, 100}",
-        make_data=_make_data,
-        notes="(6-37)/(6-38) repeat θ2 and skip θ3; read as four distinct parameters (θ3 at A[3,3], "
-              "θ4 in B); the truth is the same either way. Unstable at the truth (eigenvalue +1.844).",
-        extra={"sigma2": SIGMA2, "similarity_seed": SEED},
-    )
+theta1, theta2, theta3, theta4 = si.parameters("theta1 theta2 theta3 theta4")
+model = si.StateSpaceModel(
+    A=[[0, 1, -1], [1, 0, 0], [theta1, theta2, theta3]],
+    B=[[0], [0], [theta4]],
+    C=[[0, 1, 0]],
+    name="belt_drive_dorf",
+)
+truth = {"theta1": -10.0, "theta2": -10.0, "theta3": -10.0, "theta4": -10.0}  # thesis (6-38)
+title = "Driver belt (Dorf), 3 states, 4 unknown entries (SISO), black-box data"
+source = "thesis §6-7-2, eqs. (6-37), (6-38); Figure 6-4"
+recipe = (f"continuous-time black box: the true (A, B, C) under a seeded (seed {SEED}) random "
+          "well-conditioned similarity transform; initial guesses θ* + N(0, σ²I), "
+          "σ² ∈ {0.01, 0.1, 1, 10, 100}")
+notes = ("(6-37)/(6-38) repeat θ2 and skip θ3; read as four distinct parameters (θ3 at A[3,3], "
+         "θ4 in B); the truth is the same either way. Unstable at the truth (eigenvalue +1.844).")
+extra = {"sigma2": SIGMA2, "similarity_seed": SEED}

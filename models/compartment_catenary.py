@@ -49,12 +49,11 @@ from __future__ import annotations
 import numpy as np
 
 import symid as si
-from symid.zoo import ZooEntry
 
 W = np.logspace(np.log10(0.05), np.log10(5), 20)  # rad/s; our choice, the thesis has no data recipe
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """FRF of the truth at 20 log-spaced frequencies in 0.05–5 rad/s."""
     from symid.signal.simulate import simulate_frf
 
@@ -73,34 +72,18 @@ def _model_as_printed():
     )
 
 
-def entry() -> ZooEntry:
-    """The unidentifiable catenary of Bellman and Åström (thesis (1-2) with θ2 at (1, 2)).
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (StateSpaceModel, 4 positive parameters theta1..theta4, not
-        identifiable), ``truth`` (chosen, the thesis has none) and ``data()`` a
-        :class:`~symid.data.FrequencyData` with 20 frequencies.
-    """
-    theta1, theta2, theta3, theta4 = si.parameters("theta1 theta2 theta3 theta4", positive=True)
-    model = si.StateSpaceModel(
-        A=[[-theta1, theta2, 0], [theta1, -(theta2 + theta3), theta4], [0, theta3, -theta4]],
-        B=[[0], [0], [1]],
-        C=[[1, 0, 0]],
-        parameters=[theta1, theta2, theta3, theta4],
-        name="compartment_catenary",
-    )
-    truth = {"theta1": 0.5, "theta2": 0.4, "theta3": 0.3, "theta4": 0.2}  # our choice; the thesis has none
-    return ZooEntry(
-        name="compartment_catenary",
-        title="Closed 3-compartment catenary (Bellman & Åström), 4 rates, NOT identifiable",
-        source="thesis §1-2, eq. (1-2) and ref. [4] (Bellman & Åström 1970)",
-        model=model,
-        truth=truth,
-        recipe="FRF at 20 log-spaced frequencies in 0.05–5 rad/s (our choice; the thesis gives no data)",
-        make_data=_make_data,
-        notes="(1-2) as printed has θ3 at (1,2) and is locally (not globally) identifiable; the classic "
-              "unidentifiable catenary of [4] has θ2 there, which is what this entry carries. Truth values are ours.",
-        extra={"model_as_printed": _model_as_printed(), "w": W},
-    )
+theta1, theta2, theta3, theta4 = si.parameters("theta1 theta2 theta3 theta4", positive=True)
+model = si.StateSpaceModel(
+    A=[[-theta1, theta2, 0], [theta1, -(theta2 + theta3), theta4], [0, theta3, -theta4]],
+    B=[[0], [0], [1]],
+    C=[[1, 0, 0]],
+    parameters=[theta1, theta2, theta3, theta4],
+    name="compartment_catenary",
+)
+truth = {"theta1": 0.5, "theta2": 0.4, "theta3": 0.3, "theta4": 0.2}  # our choice; the thesis has none
+title = "Closed 3-compartment catenary (Bellman & Åström), 4 rates, NOT identifiable"
+source = "thesis §1-2, eq. (1-2) and ref. [4] (Bellman & Åström 1970)"
+recipe = "FRF at 20 log-spaced frequencies in 0.05–5 rad/s (our choice; the thesis gives no data)"
+notes = ("(1-2) as printed has θ3 at (1,2) and is locally (not globally) identifiable; the classic "
+         "unidentifiable catenary of [4] has θ2 there, which is what this entry carries. Truth values are ours.")
+extra = {"model_as_printed": _model_as_printed(), "w": W}

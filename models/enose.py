@@ -44,7 +44,6 @@ import numpy as np
 from symid.zoo_models._common import blackbox_data, similar_to
 
 import symid as si
-from symid.zoo import ZooEntry
 
 A_PRINTED = np.array([[-0.4, 0.2, 0.0], [0.3, -0.6, 0.25], [0.0, 0.4, -0.25]])  # thesis (6-17)
 B_PRINTED = np.array([[1.0], [0.0], [0.0]])  # thesis (6-17)
@@ -57,40 +56,25 @@ B_BB_PRINTED = np.array([[0.1233], [-0.1025], [0.0645]])  # thesis (6-18)
 C_BB_PRINTED = np.array([[2.4717, -0.0417, -2.4254]])  # thesis (6-18)
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """Black box: the similarity transform of the truth closest to the printed (6-18)."""
     A, B, C, _ = model.state_space(truth)
     return blackbox_data(*similar_to(A, B, C, A_BB_PRINTED, B_BB_PRINTED, C_BB_PRINTED), noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The e-nose in its identifiable parameterisation (6-19) with truth (6-16).
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (StateSpaceModel, 6 parameters k01, k21, k12, k32, k23, f),
-        ``truth`` (6-16) and ``data()`` a :class:`~symid.data.BlackBox` with 3 states.
-    """
-    k01, k21, k12, k32, k23, f = si.parameters("k01 k21 k12 k32 k23 f", positive=True)
-    model = si.StateSpaceModel(
-        A=[[-k01 - k21, k12, 0], [k21, -k12 - k32, k23], [0, k32, -k23]],
-        B=[[1], [0], [0]],
-        C=[[f, f, f]],
-        name="enose",
-    )
-    truth = {"k01": 0.1, "k21": 0.3, "k12": 0.2, "k32": 0.4, "k23": 0.25, "f": 0.15}  # thesis (6-16)
-    return ZooEntry(
-        name="enose",
-        title="Three-compartment e-nose sensor, identifiable parameterisation (6 rate constants/gain)",
-        source="thesis §6-6, eqs. (6-15)–(6-20); black box (6-18)",
-        model=model,
-        truth=truth,
-        recipe="continuous-time black box: the similarity transform of the true (A, B, C) closest to the "
-               "thesis's N4SID + d2c estimate (6-18) (printed (6-18) kept in extra)",
-        make_data=_make_data,
-        notes="(6-18) is a noisy estimate (DC gain 0.1526 vs 0.15); data() is an exact transform of the "
-              "truth close to it. Denominator of (6-21) has a typo 'α6 s' for α6.",
-        extra={"A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
-               "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED},
-    )
+k01, k21, k12, k32, k23, f = si.parameters("k01 k21 k12 k32 k23 f", positive=True)
+model = si.StateSpaceModel(
+    A=[[-k01 - k21, k12, 0], [k21, -k12 - k32, k23], [0, k32, -k23]],
+    B=[[1], [0], [0]],
+    C=[[f, f, f]],
+    name="enose",
+)
+truth = {"k01": 0.1, "k21": 0.3, "k12": 0.2, "k32": 0.4, "k23": 0.25, "f": 0.15}  # thesis (6-16)
+title = "Three-compartment e-nose sensor, identifiable parameterisation (6 rate constants/gain)"
+source = "thesis §6-6, eqs. (6-15)–(6-20); black box (6-18)"
+recipe = ("continuous-time black box: the similarity transform of the true (A, B, C) closest to the "
+          "thesis's N4SID + d2c estimate (6-18) (printed (6-18) kept in extra)")
+notes = ("(6-18) is a noisy estimate (DC gain 0.1526 vs 0.15); data() is an exact transform of the "
+         "truth close to it. Denominator of (6-21) has a typo 'α6 s' for α6.")
+extra = {"A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
+         "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED}

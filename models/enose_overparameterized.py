@@ -40,7 +40,6 @@ import numpy as np
 from symid.zoo_models._common import blackbox_data, similar_to
 
 import symid as si
-from symid.zoo import ZooEntry
 
 A_PRINTED = np.array([[-0.4, 0.2, 0.0], [0.3, -0.6, 0.25], [0.0, 0.4, -0.25]])  # thesis (6-17)
 B_PRINTED = np.array([[1.0], [0.0], [0.0]])  # thesis (6-17)
@@ -57,45 +56,30 @@ A_ESTIMATE_PRINTED = np.array([[-0.3732, 0.2024, 0.0],
                                [0.0, 0.3827, -0.3015]])  # thesis (6-24), a point of the solution manifold
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """Black box: the similarity transform of the truth closest to the printed (6-18)."""
     A, B, C, _ = model.state_space(truth)
     return blackbox_data(*similar_to(A, B, C, A_BB_PRINTED, B_BB_PRINTED, C_BB_PRINTED), noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The over-parameterised e-nose (6-22) with the truth implied by (6-16) and (6-23).
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (StateSpaceModel, 7 parameters theta1..theta7, not identifiable),
-        ``truth`` and ``data()`` a :class:`~symid.data.BlackBox` with 3 states.
-    """
-    theta1, theta4 = si.parameters("theta1 theta4")
-    theta2, theta3, theta5, theta6, theta7 = si.parameters("theta2 theta3 theta5 theta6 theta7", positive=True)
-    model = si.StateSpaceModel(
-        A=[[theta1, theta2, 0], [theta3, theta4, theta5], [0, theta6, -theta5]],
-        B=[[1], [0], [0]],
-        C=[[theta7, theta7, theta7]],
-        parameters=[theta1, theta2, theta3, theta4, theta5, theta6, theta7],
-        name="enose_overparameterized",
-    )
-    # thesis (6-23) applied to (6-16): -(k01 + k21), k12, k21, -(k12 + k32), k23, k32, f
-    truth = {"theta1": -0.4, "theta2": 0.2, "theta3": 0.3, "theta4": -0.6,
-             "theta5": 0.25, "theta6": 0.4, "theta7": 0.15}
-    return ZooEntry(
-        name="enose_overparameterized",
-        title="Three-compartment e-nose sensor, over-parameterised (7 parameters, not identifiable)",
-        source="thesis §6-6-3, eqs. (6-22)–(6-28); truth from (6-16); black box (6-18)",
-        model=model,
-        truth=truth,
-        recipe="continuous-time black box: the similarity transform of the true (A, B, C) closest to the "
-               "thesis's N4SID + d2c estimate (6-18) (printed (6-18) kept in extra)",
-        make_data=_make_data,
-        notes="Not identifiable (7 > n(p+m) = 6); the physical point satisfies θ̂2 + θ̂4 + θ̂6 = 0. "
-              "(6-18) is a noisy estimate; data() is an exact transform of the truth close to it.",
-        extra={"A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
-               "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED,
-               "A_estimate_printed": A_ESTIMATE_PRINTED},
-    )
+theta1, theta4 = si.parameters("theta1 theta4")
+theta2, theta3, theta5, theta6, theta7 = si.parameters("theta2 theta3 theta5 theta6 theta7", positive=True)
+model = si.StateSpaceModel(
+    A=[[theta1, theta2, 0], [theta3, theta4, theta5], [0, theta6, -theta5]],
+    B=[[1], [0], [0]],
+    C=[[theta7, theta7, theta7]],
+    parameters=[theta1, theta2, theta3, theta4, theta5, theta6, theta7],
+    name="enose_overparameterized",
+)
+# thesis (6-23) applied to (6-16): -(k01 + k21), k12, k21, -(k12 + k32), k23, k32, f
+truth = {"theta1": -0.4, "theta2": 0.2, "theta3": 0.3, "theta4": -0.6,
+         "theta5": 0.25, "theta6": 0.4, "theta7": 0.15}
+title = "Three-compartment e-nose sensor, over-parameterised (7 parameters, not identifiable)"
+source = "thesis §6-6-3, eqs. (6-22)–(6-28); truth from (6-16); black box (6-18)"
+recipe = ("continuous-time black box: the similarity transform of the true (A, B, C) closest to the "
+          "thesis's N4SID + d2c estimate (6-18) (printed (6-18) kept in extra)")
+notes = ("Not identifiable (7 > n(p+m) = 6); the physical point satisfies θ̂2 + θ̂4 + θ̂6 = 0. "
+         "(6-18) is a noisy estimate; data() is an exact transform of the truth close to it.")
+extra = {"A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
+         "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED,
+         "A_estimate_printed": A_ESTIMATE_PRINTED}

@@ -37,7 +37,6 @@ from __future__ import annotations
 import numpy as np
 
 import symid as si
-from symid.zoo import ZooEntry
 
 W = np.logspace(np.log10(0.5), np.log10(2), 30)  # rad/s, thesis §4-6-2 text
 
@@ -47,45 +46,29 @@ K_TRUE = np.array([[3.0, -1.0], [-1.0, 1.0]])  # from thesis (4-20): k1 + k2, -k
 V_ESTIMATE_PRINTED = np.array([[0.40, -0.10], [-0.10, 0.10]])  # thesis (4-22): c1, c2 swapped
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """FRF of the truth at 30 log-spaced frequencies in 0.5–2 rad/s."""
     from symid.signal.simulate import simulate_frf
 
     return simulate_frf(model, truth, W, noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The 2-DOF mass-damper (4-19)/(4-21) with truth (4-20) and FRF data recipe.
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (SecondOrderModel, 6 positive parameters m1, m2, c1, c2, k1, k2),
-        ``truth`` (4-20) and ``data()`` a :class:`~symid.data.FrequencyData` with 30
-        frequencies, 1 output, 1 input.
-    """
-    m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
-    model = si.SecondOrderModel(
-        M=[[m1, 0], [0, m2]],
-        V=[[c1 + c2, -c2], [-c2, c2]],
-        K=[[k1 + k2, -k2], [-k2, k2]],
-        B=[[1], [0]],
-        C=[[1, 0]],
-        output="position",
-        parameters=[m1, m2, c1, c2, k1, k2],
-        name="mass_damper_2dof",
-    )
-    truth = {"m1": 1.0, "m2": 1.0, "c1": 0.1, "c2": 0.3, "k1": 2.0, "k2": 1.0}  # thesis (4-20)
-    return ZooEntry(
-        name="mass_damper_2dof",
-        title="2-DOF mass-spring-damper, force on m1, position of m1 measured",
-        source="thesis §4-6-2, eqs. (4-19)–(4-22); Figures 4-3, 4-4",
-        model=model,
-        truth=truth,
-        recipe="FRF (position) at 30 log-spaced frequencies in 0.5–2 rad/s",
-        make_data=_make_data,
-        notes="Figure 4-4 caption says 10 points in 0.6–2 rad/s, the text 30 in 0.5–2: text followed. "
-              "Printed estimate (4-22) has c1, c2 swapped relative to the truth (4-20).",
-        extra={"w": W, "M_true": M_TRUE, "V_true": V_TRUE, "K_true": K_TRUE,
-               "V_estimate_printed": V_ESTIMATE_PRINTED},
-    )
+m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+model = si.SecondOrderModel(
+    M=[[m1, 0], [0, m2]],
+    V=[[c1 + c2, -c2], [-c2, c2]],
+    K=[[k1 + k2, -k2], [-k2, k2]],
+    B=[[1], [0]],
+    C=[[1, 0]],
+    output="position",
+    parameters=[m1, m2, c1, c2, k1, k2],
+    name="mass_damper_2dof",
+)
+truth = {"m1": 1.0, "m2": 1.0, "c1": 0.1, "c2": 0.3, "k1": 2.0, "k2": 1.0}  # thesis (4-20)
+title = "2-DOF mass-spring-damper, force on m1, position of m1 measured"
+source = "thesis §4-6-2, eqs. (4-19)–(4-22); Figures 4-3, 4-4"
+recipe = "FRF (position) at 30 log-spaced frequencies in 0.5–2 rad/s"
+notes = ("Figure 4-4 caption says 10 points in 0.6–2 rad/s, the text 30 in 0.5–2: text followed. "
+         "Printed estimate (4-22) has c1, c2 swapped relative to the truth (4-20).")
+extra = {"w": W, "M_true": M_TRUE, "V_true": V_TRUE, "K_true": K_TRUE,
+         "V_estimate_printed": V_ESTIMATE_PRINTED}

@@ -52,7 +52,6 @@ import sympy as sp
 from symid.zoo_models._common import symmetric_by_diagonals, symmetric_truth
 
 import symid as si
-from symid.zoo import ZooEntry
 
 W = np.logspace(np.log10(0.1), np.log10(100), 170)  # rad/s, thesis §5-6
 PHI_UU = (W**-0.5)[:, None, None]  # thesis (5-11), shape (s, 1, 1)
@@ -64,42 +63,26 @@ H_PRINTED = np.eye(3)  # thesis (5-10), output matrix
 F_PRINTED = np.array([[1.0], [0.0], [0.0]])  # thesis (5-10), input matrix
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """Output spectra for the pink input ω^-0.5 at 170 log-spaced frequencies in 0.1–100 rad/s."""
     from symid.signal.simulate import simulate_spectra
 
     return simulate_spectra(model, truth, W, PHI_UU, noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The 3-DOF system (5-9)/(5-10) with full symmetric M, V, K and spectral data.
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (SecondOrderModel, 18 parameters theta1..theta18), ``truth`` (5-9)
-        and ``data()`` a :class:`~symid.data.SpectralData` with 170 frequencies,
-        3 outputs, 1 input.
-    """
-    M, m_syms = symmetric_by_diagonals(3, "theta", 1)
-    V, v_syms = symmetric_by_diagonals(3, "theta", 7)
-    K, k_syms = symmetric_by_diagonals(3, "theta", 13)
-    model = si.SecondOrderModel(M=M, V=V, K=K, B=[[1], [0], [0]], C=sp.eye(3),
-                                output="position", parameters=m_syms + v_syms + k_syms, name="msd3_psd")
-    truth = {**symmetric_truth(M_PRINTED, "theta", 1),  # thesis (5-9)
-             **symmetric_truth(V_PRINTED, "theta", 7),
-             **symmetric_truth(K_PRINTED, "theta", 13)}
-    return ZooEntry(
-        name="msd3_psd",
-        title="3-DOF spring-mass-damper, full symmetric M, V, K (18 parameters), output spectra",
-        source="thesis §5-6, eqs. (5-9)–(5-12); Figures 5-1–5-5",
-        model=model,
-        truth=truth,
-        recipe="output power spectra (3 x 3) at 170 log-spaced frequencies in 0.1–100 rad/s for the "
-               "input spectrum Φuu(ω) = ω^-0.5",
-        make_data=_make_data,
-        notes="(5-10) names the output matrix H and the input matrix F (C and B elsewhere in ch. 5). "
-              "Parameterisation not printed in ch. 5; numbered as (7-20). 'Pink' spectrum is ω^-0.5 as printed.",
-        extra={"w": W, "Phi_uu": PHI_UU, "M_printed": M_PRINTED, "V_printed": V_PRINTED,
-               "K_printed": K_PRINTED, "H_printed": H_PRINTED, "F_printed": F_PRINTED},
-    )
+M, m_syms = symmetric_by_diagonals(3, "theta", 1)
+V, v_syms = symmetric_by_diagonals(3, "theta", 7)
+K, k_syms = symmetric_by_diagonals(3, "theta", 13)
+model = si.SecondOrderModel(M=M, V=V, K=K, B=[[1], [0], [0]], C=sp.eye(3),
+                            output="position", parameters=m_syms + v_syms + k_syms, name="msd3_psd")
+truth = {**symmetric_truth(M_PRINTED, "theta", 1),  # thesis (5-9)
+         **symmetric_truth(V_PRINTED, "theta", 7),
+         **symmetric_truth(K_PRINTED, "theta", 13)}
+title = "3-DOF spring-mass-damper, full symmetric M, V, K (18 parameters), output spectra"
+source = "thesis §5-6, eqs. (5-9)–(5-12); Figures 5-1–5-5"
+recipe = ("output power spectra (3 x 3) at 170 log-spaced frequencies in 0.1–100 rad/s for the "
+          "input spectrum Φuu(ω) = ω^-0.5")
+notes = ("(5-10) names the output matrix H and the input matrix F (C and B elsewhere in ch. 5). "
+         "Parameterisation not printed in ch. 5; numbered as (7-20). 'Pink' spectrum is ω^-0.5 as printed.")
+extra = {"w": W, "Phi_uu": PHI_UU, "M_printed": M_PRINTED, "V_printed": V_PRINTED,
+         "K_printed": K_PRINTED, "H_printed": H_PRINTED, "F_printed": F_PRINTED}

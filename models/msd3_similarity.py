@@ -51,7 +51,6 @@ import numpy as np
 from symid.zoo_models._common import symmetric_by_diagonals, symmetric_truth
 
 import symid as si
-from symid.zoo import ZooEntry
 
 DT = 0.001  # s, thesis §7-6-1
 N = 5000  # samples, thesis §7-6-1
@@ -103,47 +102,31 @@ def _input() -> np.ndarray:
     return np.random.default_rng(INPUT_SEED).standard_normal((N, 2))
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """I/O data: N = 5000 samples at dt = 0.001 s for a seeded white Gaussian input."""
     from symid.signal.simulate import simulate_io
 
     return simulate_io(model, truth, _input(), DT, noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The 3-DOF system (7-17) with full symmetric M, V, K and I/O data.
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (SecondOrderModel, 18 parameters theta1..theta18), ``truth`` (7-17)
-        and ``data()`` an :class:`~symid.data.IOData` with 5000 samples, 2 inputs,
-        2 outputs, dt = 0.001.
-    """
-    M, m_syms = symmetric_by_diagonals(3, "theta", 1)
-    V, v_syms = symmetric_by_diagonals(3, "theta", 7)
-    K, k_syms = symmetric_by_diagonals(3, "theta", 13)
-    model = si.SecondOrderModel(M=M, V=V, K=K, B=[[1, 1], [-1, 1], [0, 0]], C=[[0, 1, 0], [0, 0, 1]],
-                                output="position", parameters=m_syms + v_syms + k_syms, name="msd3_similarity")
-    truth = {**symmetric_truth(M_PRINTED, "theta", 1),  # thesis (7-17)
-             **symmetric_truth(V_PRINTED, "theta", 7),
-             **symmetric_truth(K_PRINTED, "theta", 13)}
-    return ZooEntry(
-        name="msd3_similarity",
-        title="3-DOF spring-mass-damper, full symmetric M, V, K (18 parameters), 2 inputs, y/z positions, I/O data",
-        source="thesis §7-6-1, eqs. (7-17)–(7-22); Figures 7-1–7-3",
-        model=model,
-        truth=truth,
-        recipe=f"I/O data: N = {N} samples at dt = {DT} s, zero-order hold, input seeded white Gaussian "
-               f"noise (seed {INPUT_SEED}; the thesis does not describe the input)",
-        make_data=_make_data,
-        notes="Printed (7-18) −M⁻¹V block matches V11 = 2, not the V11 = 5 of (7-17) and of the estimate "
-              "(7-21); V11 = 5 kept. Input signal is our choice.",
-        extra={"dt": DT, "N": N, "input_seed": INPUT_SEED, "u": _input(),
-               "M_printed": M_PRINTED, "V_printed": V_PRINTED, "K_printed": K_PRINTED,
-               "H_printed": H_PRINTED, "F_printed": F_PRINTED,
-               "A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
-               "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED,
-               "Minv_estimate_printed": MINV_ESTIMATE_PRINTED, "V_estimate_printed": V_ESTIMATE_PRINTED,
-               "K_estimate_printed": K_ESTIMATE_PRINTED, "M_estimate_printed": M_ESTIMATE_PRINTED},
-    )
+M, m_syms = symmetric_by_diagonals(3, "theta", 1)
+V, v_syms = symmetric_by_diagonals(3, "theta", 7)
+K, k_syms = symmetric_by_diagonals(3, "theta", 13)
+model = si.SecondOrderModel(M=M, V=V, K=K, B=[[1, 1], [-1, 1], [0, 0]], C=[[0, 1, 0], [0, 0, 1]],
+                            output="position", parameters=m_syms + v_syms + k_syms, name="msd3_similarity")
+truth = {**symmetric_truth(M_PRINTED, "theta", 1),  # thesis (7-17)
+         **symmetric_truth(V_PRINTED, "theta", 7),
+         **symmetric_truth(K_PRINTED, "theta", 13)}
+title = "3-DOF spring-mass-damper, full symmetric M, V, K (18 parameters), 2 inputs, y/z positions, I/O data"
+source = "thesis §7-6-1, eqs. (7-17)–(7-22); Figures 7-1–7-3"
+recipe = (f"I/O data: N = {N} samples at dt = {DT} s, zero-order hold, input seeded white Gaussian "
+          f"noise (seed {INPUT_SEED}; the thesis does not describe the input)")
+notes = ("Printed (7-18) −M⁻¹V block matches V11 = 2, not the V11 = 5 of (7-17) and of the estimate "
+         "(7-21); V11 = 5 kept. Input signal is our choice.")
+extra = {"dt": DT, "N": N, "input_seed": INPUT_SEED, "u": _input(),
+         "M_printed": M_PRINTED, "V_printed": V_PRINTED, "K_printed": K_PRINTED,
+         "H_printed": H_PRINTED, "F_printed": F_PRINTED,
+         "A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
+         "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED,
+         "Minv_estimate_printed": MINV_ESTIMATE_PRINTED, "V_estimate_printed": V_ESTIMATE_PRINTED,
+         "K_estimate_printed": K_ESTIMATE_PRINTED, "M_estimate_printed": M_ESTIMATE_PRINTED}

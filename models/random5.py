@@ -54,7 +54,6 @@ import numpy as np
 from symid.zoo_models._common import balanced_realisation, blackbox_data
 
 import symid as si
-from symid.zoo import ZooEntry
 
 A_PRINTED = np.array([  # thesis (6-29)
     [-3.486, 3.635, 3.689, -3.899, -1.933],
@@ -118,33 +117,18 @@ def _random_parameterisation(k: int, seed: int):
     return _parameterise([everything[p] for p in picks], name=f"random5_k{k}_seed{seed}")
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """Black box: the balanced realisation of the truth (optionally perturbed)."""
     A, B, C, _ = model.state_space(truth)
     return blackbox_data(*balanced_realisation(A, B, C), noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The random 5th-order system (6-29) with 10 unknown entries and balanced black-box data.
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (StateSpaceModel, 10 parameters theta1..theta10), ``truth`` (6-29)
-        and ``data()`` a :class:`~symid.data.BlackBox` with 5 states.
-    """
-    model, truth = _parameterise(list(UNKNOWN_ENTRIES))
-    return ZooEntry(
-        name="random5",
-        title="Random stable 5th-order SISO system (rss), 10 unknown entries, balanced black box",
-        source="thesis §6-7-1, eqs. (6-29)–(6-33); Figure 6-3",
-        model=model,
-        truth=truth,
-        recipe="continuous-time black box: balanced realisation of the true (A, B, C) (as MATLAB balreal)",
-        make_data=_make_data,
-        notes="The 10 unknown entries are a seeded draw (seed 629). The printed balanced (6-30) is not a "
-              "realisation of (6-29) (CB −0.7833 vs −3.3324); data() balances (6-29) itself.",
-        extra={"A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
-               "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED,
-               "unknown_entries": UNKNOWN_ENTRIES, "random_parameterisation": _random_parameterisation},
-    )
+model, truth = _parameterise(list(UNKNOWN_ENTRIES))
+title = "Random stable 5th-order SISO system (rss), 10 unknown entries, balanced black box"
+source = "thesis §6-7-1, eqs. (6-29)–(6-33); Figure 6-3"
+recipe = "continuous-time black box: balanced realisation of the true (A, B, C) (as MATLAB balreal)"
+notes = ("The 10 unknown entries are a seeded draw (seed 629). The printed balanced (6-30) is not a "
+         "realisation of (6-29) (CB −0.7833 vs −3.3324); data() balances (6-29) itself.")
+extra = {"A_printed": A_PRINTED, "B_printed": B_PRINTED, "C_printed": C_PRINTED,
+         "A_bb_printed": A_BB_PRINTED, "B_bb_printed": B_BB_PRINTED, "C_bb_printed": C_BB_PRINTED,
+         "unknown_entries": UNKNOWN_ENTRIES, "random_parameterisation": _random_parameterisation}

@@ -58,7 +58,6 @@ import sympy as sp
 from symid.zoo_models._common import symmetric_by_diagonals, symmetric_truth
 
 import symid as si
-from symid.zoo import ZooEntry
 
 W = np.logspace(np.log10(5), np.log10(25), 20)  # rad/s, thesis §4-6-1
 
@@ -85,42 +84,26 @@ K_PRINTED = np.array([  # thesis (4-15)
 ])
 
 
-def _make_data(model, truth, noise=None, seed=None):
+def make_data(model, truth, noise=None, seed=None):
     """FRF (8 x 8) of the truth at 20 log-spaced frequencies in 5–25 rad/s."""
     from symid.signal.simulate import simulate_frf
 
     return simulate_frf(model, truth, W, noise=noise, seed=seed)
 
 
-def entry() -> ZooEntry:
-    """The 8-DOF truss (4-15) with the full symmetric parameterisation (4-16), B = C = I₈.
-
-    Returns
-    -------
-    ZooEntry
-        ``model`` (SecondOrderModel, 108 parameters theta1..theta108), ``truth``
-        (4-15) and ``data()`` a :class:`~symid.data.FrequencyData` with 20 frequencies,
-        8 outputs and 8 inputs.
-    """
-    M, m_syms = symmetric_by_diagonals(8, "theta", 1)
-    V, v_syms = symmetric_by_diagonals(8, "theta", 37)
-    K, k_syms = symmetric_by_diagonals(8, "theta", 73)
-    eye = sp.eye(8)
-    model = si.SecondOrderModel(M=M, V=V, K=K, B=eye, C=eye, output="position",
-                                parameters=m_syms + v_syms + k_syms, name="truss8")
-    truth = {**symmetric_truth(M_PRINTED, "theta", 1),  # thesis (4-15)
-             **symmetric_truth(V_PRINTED, "theta", 37),
-             **symmetric_truth(K_PRINTED, "theta", 73)}
-    return ZooEntry(
-        name="truss8",
-        title="2-D truss, 8 DOFs, full symmetric M, V, K (108 parameters), B = C = I8",
-        source="thesis §4-6-1, eqs. (4-15)–(4-18); Figures 4-1, 4-2",
-        model=model,
-        truth=truth,
-        recipe="FRF (position, 8 x 8) at 20 log-spaced frequencies in 5–25 rad/s",
-        make_data=_make_data,
-        notes="(4-16) as printed repeats θ31, θ28, θ24 at (3,8), (4,8), (5,8); each entry gets its own "
-              "parameter (θ33, θ30, θ26). C = I8 is our choice (thesis silent). V and K of (4-15) differ "
-              "in sparsity at (5,8) vs (6,8); kept as printed.",
-        extra={"w": W, "M_printed": M_PRINTED, "V_printed": V_PRINTED, "K_printed": K_PRINTED},
-    )
+M, m_syms = symmetric_by_diagonals(8, "theta", 1)
+V, v_syms = symmetric_by_diagonals(8, "theta", 37)
+K, k_syms = symmetric_by_diagonals(8, "theta", 73)
+eye = sp.eye(8)
+model = si.SecondOrderModel(M=M, V=V, K=K, B=eye, C=eye, output="position",
+                            parameters=m_syms + v_syms + k_syms, name="truss8")
+truth = {**symmetric_truth(M_PRINTED, "theta", 1),  # thesis (4-15)
+         **symmetric_truth(V_PRINTED, "theta", 37),
+         **symmetric_truth(K_PRINTED, "theta", 73)}
+title = "2-D truss, 8 DOFs, full symmetric M, V, K (108 parameters), B = C = I8"
+source = "thesis §4-6-1, eqs. (4-15)–(4-18); Figures 4-1, 4-2"
+recipe = "FRF (position, 8 x 8) at 20 log-spaced frequencies in 5–25 rad/s"
+notes = ("(4-16) as printed repeats θ31, θ28, θ24 at (3,8), (4,8), (5,8); each entry gets its own "
+         "parameter (θ33, θ30, θ26). C = I8 is our choice (thesis silent). V and K of (4-15) differ "
+         "in sparsity at (5,8) vs (6,8); kept as printed.")
+extra = {"w": W, "M_printed": M_PRINTED, "V_printed": V_PRINTED, "K_printed": K_PRINTED}

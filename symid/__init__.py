@@ -25,6 +25,7 @@ from symid.model.lti import StateSpaceMatrices
 from symid.model.secondorder import SecondOrderModel
 from symid.model.statespace import StateSpaceModel
 from symid.model.symbols import parameters
+from symid.modelfile import ModelFile
 from symid.zoo import ZooEntry, list_models, load_model
 
 if TYPE_CHECKING:
@@ -85,6 +86,7 @@ __all__ = [
     "IdentificationResult",
     "MethodStats",
     "ModelError",
+    "ModelFile",
     "NonAffineError",
     "OptionError",
     "SecondOrderModel",

@@ -116,18 +116,29 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return run_demo(out=args.out)
 
 
-def _entry_and_data(model_arg: str, data_arg: str | None):
+def _entry_and_data(model_arg: str, data_arg: str | None, command: str):
     from symid.data import load
-    from symid.zoo import load_model
+    from symid.zoo import ZooEntry, load_model
 
     entry = load_model(model_arg)
     if data_arg:
         data = load(data_arg)
         source = data_arg
-    else:
+    elif isinstance(entry, ZooEntry):
         data = entry.data()
         source = f"the zoo recipe: {entry.recipe}"
+    else:
+        raise _UsageError(f"symid {command}: error: {model_arg} is a model file without a data recipe: give the "
+                          f"measurements with --data FILE")
     return entry, data, source
+
+
+def _truth(entry, args) -> dict | None:
+    """The true values of the free parameters: for a zoo entry on its own recipe only."""
+    truth = getattr(entry, "truth", None)
+    if truth is None or args.data is not None:
+        return None
+    return {k: v for k, v in truth.items() if k not in entry.known}
 
 
 def _method_options(args: argparse.Namespace) -> dict:
@@ -143,27 +154,30 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     from symid.fit.identify import identify
 
     out = _output_dir(args.out, "identify")
-    entry, data, source = _entry_and_data(args.model, args.data)
+    entry, data, source = _entry_and_data(args.model, args.data, "identify")
     print(f"model: {entry.name}   data: {source}")
+    if entry.known:
+        print("known: " + ", ".join(f"{k} = {v:.6g}" for k, v in entry.known.items()))
     opts = _method_options(args) if args.method == "scr" else {}
-    truth = entry.truth if args.data is None else None
+    truth = _truth(entry, args)
+    model = entry.free_model()
     try:
-        res = identify(entry.model, data, method=args.method, starts=args.starts, seed=args.seed,
+        res = identify(model, data, method=args.method, x0=entry.start, starts=args.starts, seed=args.seed,
                        polish=args.polish, progress=True if args.starts > 1 else None, **opts)
     except Interrupted as exc:  # keep the finished starts
         res = exc.partial
         print(res.summary(truth=truth))
         if out is not None:
-            _write_identify(out, entry, data, res, truth)
+            _write_identify(out, entry, model, data, res, truth)
         raise
     print(res.summary(truth=truth))
     if out is not None:
-        _write_identify(out, entry, data, res, truth)
+        _write_identify(out, entry, model, data, res, truth)
     final = res.polished if res.polished is not None else res
     return 0 if final.success else 1
 
 
-def _write_identify(out, entry, data, res, truth) -> None:
+def _write_identify(out, entry, model, data, res, truth) -> None:
     """result.json, summary.txt and the plots, each written atomically."""
     from symid.plots import bode_plot, start_convergence_plot
     from symid.runlog import write_atomic, write_json_atomic
@@ -173,14 +187,14 @@ def _write_identify(out, entry, data, res, truth) -> None:
         fh.write(res.summary(truth=truth) + "\n")
     written = [out / "result.json", out / "summary.txt"]
     if hasattr(data, "H"):
-        curves = {f"{res.method} estimate": (entry.model, res.theta_vector)}
+        curves = {f"{res.method} estimate": (model, res.theta_vector)}
         if res.polished is not None:
-            curves["after polish"] = (entry.model, res.polished.theta_vector)
+            curves["after polish"] = (model, res.polished.theta_vector)
         written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate"))
     best = res.best_start
     if best.history and best.history[0].families:  # SCR: thesis Figure 3-2 for the reported start
         written.append(start_convergence_plot(
-            best, out / "convergence.png", truth=None if truth is None else entry.model.theta_vector(truth),
+            best, out / "convergence.png", truth=None if truth is None else model.theta_vector(truth),
             title=f"{entry.name}: SCR convergence of the reported start"))
     print("wrote " + ", ".join(str(p) for p in written))
 
@@ -189,15 +203,16 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from symid.fit.compare import compare
 
     out = _output_dir(args.out, "compare")
-    entry, data, source = _entry_and_data(args.model, args.data)
+    entry, data, source = _entry_and_data(args.model, args.data, "compare")
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
     if not methods:
         raise _UsageError(f"symid compare: error: --methods {args.methods!r} names no method")
-    truth = entry.truth if args.data is None else None
+    truth = _truth(entry, args)
     print(f"model: {entry.name}   data: {source}")
     scr_opts = _method_options(args)
     try:
-        cmp = compare(entry.model, data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
+        cmp = compare(entry.free_model(), data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
+                      x0=entry.start,
                       progress=True,
                       options={"scr": scr_opts} if scr_opts and {"scr", "scr+polish"} & set(methods) else None)
     except Interrupted as exc:  # keep the finished starts
@@ -224,9 +239,10 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
     from symid.structural import identifiability
     from symid.zoo import load_model
 
-    known = _known_values(args.known, "identifiability")
+    spec = load_model(args.model)
+    known = {**spec.known, **_known_values(args.known, "identifiability")}
     positive = {"declared": None, "all": True, "ignore": False}[args.positive]
-    report = identifiability(load_model(args.model).model, known=known, positive=positive,
+    report = identifiability(spec.model, known=known, positive=positive,
                              timeout=args.timeout, exact_count=args.exact_count, seed=args.seed)
     print(report.summary())
     return 0

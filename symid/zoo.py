@@ -1,7 +1,11 @@
 """The model zoo: systems from the thesis with their true values and data recipes.
 
 Each zoo model is one Python file in the top-level ``models/`` folder (shipped in the
-wheel as the package ``symid.zoo_models``). A file defines ``entry() -> ZooEntry``.
+wheel as the package ``symid.zoo_models``), written in the model-file format of
+:mod:`symid.modelfile` (``model``, optionally ``known``, ``start``, ``scale``,
+``bounds``, units) plus what only a simulation study has: ``truth``,
+``make_data(model, truth, noise=None, seed=None)`` and ``recipe``.
+:func:`load_model` reads a zoo name or the path of any model file.
 """
 
 from __future__ import annotations
@@ -16,13 +20,14 @@ from pathlib import Path
 from typing import Any
 
 from symid.errors import ModelError
+from symid.modelfile import ModelFile, from_module, read_model_file
 
 __all__ = ["ZooEntry", "list_models", "load_model"]
 
 
-@dataclass(frozen=True)
-class ZooEntry:
-    """A model with its true parameter values and the recipe of its data.
+@dataclass(frozen=True, kw_only=True)
+class ZooEntry(ModelFile):
+    """A zoo model: a model file (:class:`~symid.modelfile.ModelFile`) plus its truth and data recipe.
 
     Attributes
     ----------
@@ -55,14 +60,9 @@ class ZooEntry:
     (30, 1, 1)
     """
 
-    name: str
-    title: str
-    source: str
-    model: Any
     truth: dict[str, float]
     recipe: str
     make_data: Callable[..., Any] = field(repr=False)
-    notes: str = ""
     extra: dict[str, Any] = field(default_factory=dict, repr=False)
 
     def data(self, noise: float | None = None, seed: int | None = None) -> Any:
@@ -87,10 +87,14 @@ class ZooEntry:
         """Model, truth and recipe as readable text."""
         truth = "\n".join(f"  {k:>10s} = {v:.6g}" for k, v in self.truth.items())
         parts = [f"{self.name}: {self.title}", f"source: {self.source}", self.model.summary(),
-                 f"truth:\n{truth}", f"data recipe: {self.recipe}"]
+                 *self._spec_lines(), f"truth:\n{truth}", f"data recipe: {self.recipe}"]
         if self.notes:
             parts.append(f"notes: {self.notes}")
         return "\n".join(parts)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The entry's declarations, truth and recipe as plain JSON-ready values."""
+        return {**super().to_dict(), "truth": dict(self.truth), "recipe": self.recipe, "notes": self.notes}
 
 
 _ZOO_PACKAGE = "symid.zoo_models"
@@ -139,23 +143,28 @@ def list_models() -> list[str]:
     return sorted(m.name for m in pkgutil.iter_modules(pkg.__path__) if not m.name.startswith("_"))
 
 
-def load_model(name_or_path: str | Path) -> ZooEntry:
-    """Load a zoo model by name (``"belt_drive"``) or from a Python file defining ``entry()``.
+def load_model(name_or_path: str | Path) -> ModelFile:
+    """Load a zoo model by name (``"belt_drive"``) or a model file by its path.
 
     Parameters
     ----------
     name_or_path : str or pathlib.Path
-        A name listed by :func:`list_models`, or the path of a ``.py`` file whose
-        ``entry()`` returns a :class:`ZooEntry`.
+        A name listed by :func:`list_models`, or the path of a ``.py`` model file
+        (format in :mod:`symid.modelfile`). A model file is Python code and is run:
+        load only files you trust.
 
     Returns
     -------
-    ZooEntry
+    ModelFile
+        A :class:`ZooEntry` (a ModelFile with ``truth``, ``recipe`` and ``data()``) for
+        a zoo name or a file that defines ``truth`` and ``make_data``; otherwise a
+        :class:`~symid.modelfile.ModelFile`.
 
     Raises
     ------
     ModelError
-        If no such model exists or the file does not define ``entry()``.
+        If no such zoo model exists, or the file is missing, fails when run, defines no
+        model or several, or declares values that do not fit its model.
 
     Examples
     --------
@@ -166,23 +175,11 @@ def load_model(name_or_path: str | Path) -> ZooEntry:
     """
     text = str(name_or_path)
     path = Path(text)
-    if text.endswith(".py") or path.is_file():
-        if not path.is_file():
-            raise ModelError(f"model file {text!r} does not exist")
-        spec = importlib.util.spec_from_file_location(f"symid_user_model_{path.stem}", path)
-        if spec is None or spec.loader is None:
-            raise ModelError(f"cannot import model file {text!r}")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    else:
-        names = list_models()
-        if text not in names:
-            raise ModelError(f"no zoo model named {text!r}; available: {', '.join(names)}")
-        module = importlib.import_module(f"{_ZOO_PACKAGE}.{text}")
-    factory = getattr(module, "entry", None)
-    if not callable(factory):
-        raise ModelError(f"{text!r} does not define entry() returning a ZooEntry")
-    result = factory()
-    if not isinstance(result, ZooEntry):
-        raise ModelError(f"entry() of {text!r} returned {type(result).__name__}, not a ZooEntry")
-    return result
+    if text.endswith(".py") or path.is_file() or "/" in text or "\\" in text:
+        return read_model_file(path)
+    names = list_models()
+    if text not in names:
+        raise ModelError(f"no zoo model named {text!r}; available: {', '.join(names)} (or give the path of a "
+                         "model file, ending in .py)")
+    module = importlib.import_module(f"{_ZOO_PACKAGE}.{text}")
+    return from_module(module, name=text, where=f"zoo model {text!r}", path=module.__file__)

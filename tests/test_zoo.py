@@ -76,7 +76,7 @@ def test_zoo_file_has_a_docstring_with_the_thesis_equations(name):
 
     module = importlib.import_module(f"symid.zoo_models.{name}")
     assert module.__doc__ and "thesis" in module.__doc__
-    assert module.entry.__doc__
+    assert module.make_data.__doc__ and module.recipe
 
 
 def test_positive_parameters_follow_physics():

@@ -1,0 +1,186 @@
+"""Model files (symid.modelfile): the user's model in a Python file, from Python and the command line.
+
+What a file may declare, what each declaration does, and the named errors for files that do not fit.
+"""
+
+from __future__ import annotations
+
+import json
+import textwrap
+
+import numpy as np
+import pytest
+
+import symid as si
+from symid.cli import main
+from symid.modelfile import EXAMPLE, ModelFile, substitute_known
+
+CHAIN = '''
+import symid as si
+
+m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+model = si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
+                            K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[1, 0]])
+'''
+
+
+def write(tmp_path, text, name="chain.py"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_a_file_with_only_a_model(tmp_path):
+    spec = si.load_model(write(tmp_path, CHAIN))
+    assert type(spec) is ModelFile and spec.name == "chain"
+    assert spec.model.parameter_names == ("m1", "m2", "c1", "c2", "k1", "k2")
+    assert spec.known == {} and spec.start is None and spec.free_model() is spec.model
+    assert "chain" in spec.summary() and "M =" in spec.summary()
+
+
+def test_every_optional_declaration(tmp_path):
+    path = write(tmp_path, CHAIN + '''
+known = {"m1": 0.5}
+start = {"m2": 1.0, "c1": 0.5, "c2": 0.5, "k1": 100.0, "k2": 100.0}
+scale = {"m2": 1.0, "c1": 0.5, "c2": 0.5, "k1": 100.0, "k2": 100.0}
+bounds = {"k1": (10, 1000), "k2": (10, None)}
+title = "two masses"
+input_units, output_units = "N", "m"
+''')
+    spec = si.load_model(str(path))
+    assert spec.known == {"m1": 0.5} and spec.title == "two masses"
+    assert spec.bounds == {"k1": (10.0, 1000.0), "k2": (10.0, float("inf"))}
+    assert spec.h_unit() == "m/N"
+    free = spec.free_model()
+    assert free.parameter_names == ("m2", "c1", "c2", "k1", "k2")
+    theta = {"m2": 2.0, "c1": 0.3, "c2": 0.4, "k1": 50.0, "k2": 70.0}
+    full = {**theta, "m1": 0.5}
+    w = np.array([0.5, 3.0, 20.0])
+    np.testing.assert_allclose(free.frequency_response(theta, w), spec.model.frequency_response(full, w),
+                               rtol=1e-14, atol=0)  # substitution is exact
+    assert spec.outside_bounds({**theta, "k1": 5000.0}) == {"k1": (5000.0, 10.0, 1000.0)}
+    for line in ("known (substituted before estimation): m1 = 0.5", "10 ≤ k1 ≤ 1000", "units: inputs N"):
+        assert line in spec.summary()
+
+
+def test_substitute_known_keeps_an_affine_initial_state():
+    k10, k12, d = si.parameters("k10 k12 d", positive=True)
+    pk = si.StateSpaceModel(A=[[-k10 - k12]], B=[[0]], C=[[1]], x0=[d * 2])
+    free = substitute_known(pk, {"k12": 0.1})
+    assert free.parameter_names == ("k10", "d") and free.initial_state_kind == "affine"
+    np.testing.assert_array_equal(free.initial_state({"k10": 1.0, "d": 3.0}), [6.0])
+    with pytest.raises(si.ModelError, match="'q', not a parameter"):
+        substitute_known(pk, {"q": 1.0})
+
+
+BAD_FILES = {
+    "no model": ("x = 1\n", "defines no model"),
+    "several models": (CHAIN.replace("model =", "chain =") + "one = si.SecondOrderModel(M=[[m1]], V=[[c1]], "
+                       "K=[[k1]], B=[[1]], C=[[1]])\n", "defines several models (chain, one); name the one to use"),
+    "model not a model": ("model = 3\n", "`model` is a int, not a si.StateSpaceModel"),
+    "old entry() format": ("def entry():\n    return None\n", "defines entry(), the format of older"),
+    "syntax error": ("model = (\n", "line 1: syntax error"),
+    "error when run": ("import symid as si\nmodel = si.SecondOrderModel(M=[[1]], V=[[1]], K=[['k/m']], B=[[1]], "
+                       "C=[[1]])\n", "line 2: NonAffineError"),
+    "name error": ("import symid as si\nk = si.parameters('k')\nmodel = undefined_name\n",
+                   "line 3: NameError: name 'undefined_name' is not defined"),
+    "known not a parameter": (CHAIN + "known = {'mass': 1.0}\n", "known names 'mass', not a parameter"),
+    "known nan": (CHAIN + "known = {'m1': float('nan')}\n", "known m1 must be finite"),
+    "start partial": (CHAIN + "start = {'m1': 1.0}\n", "start lacks m2, c1, c2, k1, k2"),
+    "start on known": (CHAIN + "known = {'m1': 1.0}\nstart = {'m1': 1.0}\n", "declared known"),
+    "scale negative": (CHAIN + "scale = -1\n", "a typical magnitude is a positive number"),
+    "bounds reversed": (CHAIN + "bounds = {'k1': (100, 10)}\n", "the low end must be below the high end"),
+    "bounds not a pair": (CHAIN + "bounds = {'k1': 10}\n", "must be a pair (low, high)"),
+    "start outside bounds": (CHAIN + "start = dict(m1=1, m2=1, c1=1, c2=1, k1=1, k2=1)\nbounds = {'k1': (10, 20)}\n",
+                             "lies outside its bounds"),
+    "units of one side": (CHAIN + "input_units = 'N'\n", "give both input_units and output_units"),
+    "units count": (CHAIN + "input_units, output_units = ['N', 'N'], 'm'\n", "gives 2 unit(s); the model has 1"),
+    "truth without recipe": (CHAIN + "truth = {}\n", "defines truth but not make_data"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_FILES))
+def test_bad_model_files_are_named_errors(case, tmp_path):
+    text, expected = BAD_FILES[case]
+    path = write(tmp_path, text, "bad.py")
+    with pytest.raises(si.ModelError) as info:
+        si.load_model(path)
+    assert expected in str(info.value)
+    assert "bad.py" in str(info.value)
+
+
+@pytest.mark.parametrize("case", ["no model", "several models", "model not a model"])
+def test_missing_model_errors_quote_a_two_line_example(case, tmp_path):
+    with pytest.raises(si.ModelError) as info:
+        si.load_model(write(tmp_path, BAD_FILES[case][0], "bad.py"))
+    assert str(info.value).endswith(EXAMPLE) and len(EXAMPLE.splitlines()) == 2
+    namespace: dict = {}
+    exec("import symid as si\n" + "\n".join(line.strip() for line in EXAMPLE.splitlines()), namespace)
+    assert isinstance(namespace["model"], si.SecondOrderModel)  # the quoted example is a working model file
+
+
+def test_missing_files_and_other_suffixes(tmp_path):
+    with pytest.raises(si.ModelError, match="does not exist"):
+        si.load_model(tmp_path / "missing.py")
+    (tmp_path / "model.txt").write_text(CHAIN)
+    with pytest.raises(si.ModelError, match=r"ending in \.py"):
+        si.load_model(tmp_path / "model.txt")
+
+
+def test_the_zoo_is_the_same_format_plus_truth_and_recipe():
+    entry = si.load_model("mass_damper_2dof")
+    assert isinstance(entry, ModelFile) and isinstance(entry, si.ZooEntry)
+    assert entry.truth["k1"] == 2.0 and entry.recipe and entry.data().H.shape == (30, 1, 1)
+
+
+# -- the command line on a model file ---------------------------------------------------------------------
+
+@pytest.fixture
+def chain_files(tmp_path):
+    """A user's model file with a known mass and a start, and a measured FRF saved by symid (1 % noise)."""
+    path = write(tmp_path, CHAIN + '''
+known = {"m1": 1.0}
+start = {"m2": 0.8, "c1": 0.2, "c2": 0.2, "k1": 1.5, "k2": 1.5}
+''')
+    truth = {"m1": 1.0, "m2": 1.0, "c1": 0.1, "c2": 0.3, "k1": 2.0, "k2": 1.0}
+    spec = si.load_model(path)
+    w = np.logspace(np.log10(0.3), np.log10(3.0), 40)
+    data = tmp_path / "frf.npz"
+    si.simulate_frf(spec.model, truth, w).to_npz(data)
+    return path, data, truth
+
+
+def test_cli_show_and_identifiability_on_a_model_file(chain_files, capsys):
+    path, _, _ = chain_files
+    assert main(["show", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "known (substituted before estimation): m1 = 1" in out and "start: m2 = 0.8" in out
+    assert main(["identifiability", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "m1" in out and "known" in out  # the file's known value is honoured
+
+
+def test_cli_identify_and_compare_on_a_model_file(chain_files, tmp_path, capsys):
+    path, data, truth = chain_files
+    code = main(["identify", str(path), "--data", str(data), "--method", "ipopt", "--out", str(tmp_path / "o")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "known: m1 = 1" in out
+    result = json.loads((tmp_path / "o" / "result.json").read_text())
+    assert result["parameter_names"] == ["m2", "c1", "c2", "k1", "k2"]
+    np.testing.assert_allclose(result["theta"]["k1"], truth["k1"], rtol=1e-6)  # exact data, identifiable
+    np.testing.assert_allclose(result["starts"][0]["start"], [0.8, 0.2, 0.2, 1.5, 1.5], rtol=0)  # the file's start
+    assert main(["compare", str(path), "--data", str(data), "--methods", "ipopt", "--starts", "2"]) == 0
+
+
+def test_cli_model_file_without_data_is_a_usage_error(chain_files, capsys):
+    path, _, _ = chain_files
+    assert main(["identify", str(path)]) == 2
+    assert "without a data recipe: give the measurements with --data FILE" in capsys.readouterr().err
+
+
+def test_cli_bad_model_file_is_status_2(tmp_path, capsys):
+    path = write(tmp_path, "x = 1\n", "empty.py")
+    assert main(["show", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "defines no model" in err and "Traceback" not in err
