@@ -31,6 +31,7 @@ from symid.zoo import ZooEntry, list_models, load_model
 if TYPE_CHECKING:
     from symid.fit.compare import Comparison, MethodStats, compare
     from symid.fit.identify import identify
+    from symid.signal.frf import estimate_coherence, estimate_frf
     from symid.signal.simulate import simulate_frf, simulate_io, simulate_spectra
     from symid.signal.spectra import estimate_spectra
     from symid.signal.subspace import n4sid
@@ -50,6 +51,8 @@ _LAZY = {
     "simulate_io": "symid.signal.simulate",
     "simulate_spectra": "symid.signal.simulate",
     "estimate_spectra": "symid.signal.spectra",
+    "estimate_frf": "symid.signal.frf",
+    "estimate_coherence": "symid.signal.frf",
     "IdentifiabilityReport": "symid.structural",
     "identifiability": "symid.structural",
 }
@@ -100,6 +103,8 @@ __all__ = [
     "ZooEntry",
     "compare",
     "d2c",
+    "estimate_coherence",
+    "estimate_frf",
     "estimate_spectra",
     "identifiability",
     "identify",

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["bode_plot", "convergence_plot", "start_convergence_plot"]
+__all__ = ["bode_plot", "convergence_plot", "frf_estimate_plot", "start_convergence_plot"]
 
 
 def _pyplot():
@@ -186,3 +186,102 @@ def start_convergence_plot(outcome: Any, path: str | Path, *, truth: Any = None,
         error = [float(np.linalg.norm(np.asarray(h.theta) - t)) for h in hist]
     return convergence_plot(groups, path, error=error, error_label="‖θ_k − θ*‖₂",
                             title=title or f"SCR convergence from θ0 = {np.array2string(outcome.start, precision=2)}")
+
+
+def frf_estimate_plot(frf: Any, path: str | Path, *, coherence: Any = None, output: int = 0, input: int = 0,
+                      confidence: float = 0.95, hz: bool = True, unit: str | None = None,
+                      estimates: Mapping[str, tuple[Any, Any]] | None = None, title: str | None = None) -> Path:
+    """An estimated frequency response: |H| with its confidence band, the phase and the coherence, saved as PNG.
+
+    Parameters
+    ----------
+    frf : FrequencyData
+        The estimate, e.g. from :func:`symid.estimate_frf`; with a ``variance`` the band
+        |Ĥ| ± z·σ/√2 is shaded (σ² = the entry's variance, half of it in the direction
+        of Ĥ for circular noise; z the normal quantile of ``confidence``) and the noise
+        level σ drawn dotted.
+    path : str or pathlib.Path
+        Where to write the PNG.
+    coherence : array_like, shape (s,) or (s, p), optional
+        The coherence at ``frf.w`` (:func:`symid.estimate_coherence`), drawn in a third panel.
+    output, input : int
+        The entry drawn.
+    confidence : float
+        Level of the shaded band (default 0.95).
+    hz : bool
+        Frequency axis in Hz (default) or in rad/s.
+    unit : str, optional
+        The unit of H for the axis label, e.g. ``"(m/s²)/N"``.
+    estimates : mapping of label to (model, theta), optional
+        Model responses drawn over the data on a fine grid of the data's band.
+    title : str, optional
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.plots import frf_estimate_plot
+    >>> w = np.linspace(1.0, 10.0, 50)
+    >>> frf = si.FrequencyData(w, 1 / (5 - 0.05 * w**2 + 0.1j * w), variance=np.full(50, 1e-4))
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "frf.png"
+    >>> frf_estimate_plot(frf, out, coherence=np.full(50, 0.99)).is_file()
+    True
+    """
+    from scipy.stats import norm
+
+    plt = _pyplot()
+    w = np.asarray(frf.w, dtype=float)
+    H = np.asarray(frf.H)[:, output, input]
+    scale = 1 / (2 * np.pi) if hz else 1.0
+    x = w * scale
+    coh = None
+    if coherence is not None:
+        coh = np.asarray(coherence, dtype=float)
+        coh = coh[:, output] if coh.ndim == 2 else coh
+        if coh.shape != w.shape:
+            raise ValueError(f"coherence must have one value per frequency of frf ({w.size}); got shape {coh.shape}")
+    rows = 3 if coh is not None else 2
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(8, 2.6 * rows + 0.6),
+                             gridspec_kw={"height_ratios": [2.2, 1.2, 1.0][:rows]})
+    ax_m, ax_p = axes[0], axes[1]
+    mag = np.abs(H)
+    log_x = x[-1] / x[0] > 20
+    plot = ax_m.loglog if log_x else ax_m.semilogy
+    plot(x, mag, "k.-", ms=3, lw=0.8, label="estimate |Ĥ|")
+    if frf.variance is not None:
+        sigma = np.sqrt(np.asarray(frf.variance)[:, output, input])
+        z = float(norm.ppf(0.5 + confidence / 2))
+        half = z * sigma / np.sqrt(2)
+        lo = np.where(mag - half > 0, mag - half, np.nan)
+        ax_m.fill_between(x, lo, mag + half, color="tab:blue", alpha=0.3, lw=0,
+                          label=f"{100 * confidence:g} % confidence band")
+        plot(x, _positive(sigma), ":", color="tab:red", lw=1.2, label="noise std σ")
+    ax_p.plot(x, np.degrees(np.unwrap(np.angle(H))), "k.-", ms=3, lw=0.8, label="estimate")
+    if estimates:
+        grid = np.geomspace(w[0], w[-1], 800) if log_x else np.linspace(w[0], w[-1], 800)
+        for k, (label, (model, theta)) in enumerate(estimates.items()):
+            Hm = model.frequency_response(theta, grid)[:, output, input]
+            style = ["-", "--", "-.", ":"][k % 4]
+            ax_m.plot(grid * scale, np.abs(Hm), style, lw=1.5, label=label)
+            ax_p.plot(grid * scale, np.degrees(np.unwrap(np.angle(Hm))), style, lw=1.5, label=label)
+    if log_x:
+        ax_p.set_xscale("log")
+    ax_m.set_ylabel(f"|H| {unit}" if unit else "|H|")
+    ax_p.set_ylabel("phase (deg)")
+    ax_m.legend(loc="best", fontsize=8)
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+    if coh is not None:
+        ax_c = axes[2]
+        ax_c.plot(x, coh, "g.-", ms=3, lw=0.8)
+        ax_c.set_ylim(-0.02, 1.02)
+        ax_c.set_ylabel("coherence γ²")
+    axes[-1].set_xlabel("frequency (Hz)" if hz else "ω (rad/s)")
+    ax_m.set_title(title or f"Estimated frequency response, output {output}, input {input}")
+    fig.tight_layout()
+    return _save(fig, path, dpi=110)
