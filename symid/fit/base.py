@@ -37,7 +37,7 @@ import numpy as np
 from symid.errors import OptionError
 from symid.fit.options import check_bool, check_choice, check_float, check_int, check_known_names, check_time_limit
 from symid.fit.result import ScrIteration, StartOutcome
-from symid.fit.success import fit_test
+from symid.fit.success import fit_test, physical_check
 
 __all__ = [
     "Estimator",
@@ -126,19 +126,24 @@ class Estimator(abc.ABC):
 
     def outcome(self, x0: np.ndarray, theta: np.ndarray, *, finished: bool, status: str, message: str,
                 iterations: int, wall_time: float, history: tuple[ScrIteration, ...] = ()) -> StartOutcome:
-        """A :class:`StartOutcome` with its cost and the success rule applied (:mod:`symid.fit.success`)."""
+        """A :class:`StartOutcome` with its cost and the success rule applied (:mod:`symid.fit.success`:
+        :func:`~symid.fit.success.fit_test` and :func:`~symid.fit.success.physical_check`)."""
         theta = np.asarray(theta, dtype=float).reshape(-1)
         finite = bool(np.all(np.isfinite(theta)))
         cost = self.misfit(theta) if finite else float("inf")
         res = self.residuals(theta) if finite and np.isfinite(cost) else None
         test = fit_test(cost, n_data=self.n_data(), n_parameters=int(theta.size), residuals=res,
                         noise_floor=self.noise_floor)
+        fits, fit_text = test.fits, test.text
+        unphysical = physical_check(self.model, theta)  # never a success against the model's declarations
+        if unphysical is not None:
+            fits, fit_text = False, f"{fit_text}; not physical: {unphysical}"
         if not finite:
             message = f"{message}; the estimate is not finite"
         return StartOutcome(start=np.asarray(x0, dtype=float), theta=theta, cost=cost,
-                            success=bool(finished and test.fits), finished=bool(finished), status=status,
+                            success=bool(finished and fits), finished=bool(finished), status=status,
                             iterations=int(iterations), wall_time=float(wall_time), message=message,
-                            fit=test.text, history=history)
+                            fit=fit_text, history=history)
 
 
 # -- SCR ---------------------------------------------------------------------------------------

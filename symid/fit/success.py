@@ -27,15 +27,33 @@ order:
 4. Otherwise (a black box as data, no floor given): only an exact fit counts.
 
 The floor used and the statistic are reported in the outcome's ``fit`` text.
+
+A fit is not enough: an estimate the model's own declarations rule out is never a
+success either (:func:`physical_check`, applied to every method's outcome by
+:meth:`symid.fit.base.Estimator.outcome`):
+
+* a parameter declared ``positive=True`` that came out negative;
+* negative mass, damping or stiffness: in a second-order model, a symmetric M, V or K
+  whose parameters are all declared positive, with a negative eigenvalue at the
+  estimate (for V, negative damping: the model creates energy);
+* unstable poles (an eigenvalue of A with a positive real part) in a model whose
+  parameters are all declared positive: such a model describes a passive or
+  compartmental system, stable for every admissible θ. A model meant to be unstable
+  for positive values declares some parameter without ``positive=True``.
+
+The tolerances are relative (1e-9 of the largest |θ|, and for M, V, K of what such a
+change of θ can do to them or of ‖X‖₂; 1e-8 of the largest |pole|), so that rounding
+at an active bound θ = 0 or a rigid-body mode (a pole at 0) does not count.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-__all__ = ["CEILING", "EXACT_FIT", "WHITENESS_LIMIT", "FitTest", "fit_test", "whiteness"]
+__all__ = ["CEILING", "EXACT_FIT", "WHITENESS_LIMIT", "FitTest", "fit_test", "physical_check", "whiteness"]
 
 EXACT_FIT = 1e-10
 """A relative misfit at or below this reproduces the data as noise-free data are reproduced."""
@@ -105,6 +123,86 @@ def whiteness(residuals: np.ndarray) -> float:
     num = float(np.real(np.sum(np.conj(r[:-1]) * r[1:])))
     samples = (s - 1) * r.shape[1] * (2 if np.iscomplexobj(residuals) else 1)
     return float(num / den * np.sqrt(samples))
+
+
+_NEGATIVE_RTOL = 1e-9
+"""A declared-positive θₖ (or an eigenvalue of M, V, K) below −1e-9 × the largest |θ| (‖X‖₂) is negative."""
+
+_UNSTABLE_RTOL = 1e-8
+"""A pole with real part above 1e-8 × the largest |pole| is unstable."""
+
+
+def physical_check(model: Any, theta: Any) -> str | None:
+    """Why an estimate contradicts what the model declares, or ``None`` when it does not.
+
+    The rules (module notes): declared-positive parameters not negative; in a
+    second-order model, symmetric M, V, K whose parameters are all declared positive
+    positive semidefinite; in a model whose parameters are all declared positive, no
+    unstable pole. Every estimator's outcome is held to it; a method may call it itself.
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+        Any symid model with ``positive``, ``parameter_names``, ``maps`` and ``state_space``.
+    theta : array_like
+        The estimate, in ``model.parameter_names`` order.
+
+    Returns
+    -------
+    str or None
+        One line naming what is wrong (for the outcome's ``fit`` text), or ``None``.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.fit.success import physical_check
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> physical_check(model, [2.0, 0.5, 3.0]) is None
+    True
+    >>> physical_check(model, [2.0, -0.5, 3.0])
+    'parameters declared positive are negative: c = -0.5'
+    """
+    th = np.asarray(theta, dtype=float).reshape(-1)
+    names = tuple(getattr(model, "parameter_names", ()))
+    positive = tuple(getattr(model, "positive", ()))
+    if th.size != len(names) or len(positive) != len(names) or not np.all(np.isfinite(th)):
+        return None  # nothing to judge (a non-finite estimate fails the fit test already)
+    big = float(np.max(np.abs(th), initial=0.0))
+    neg = [f"{n} = {v:.6g}" for n, pos, v in zip(names, positive, th, strict=True)
+           if pos and v < -_NEGATIVE_RTOL * big]
+    if neg:
+        return f"parameters declared positive are negative: {', '.join(neg)}"
+    maps = getattr(model, "maps", {})
+    if all(k in maps for k in "MVK"):
+        what = {"M": "mass", "V": "damping", "K": "stiffness"}
+        for name in "MVK":
+            amap = maps[name]
+            dep = amap.depends_on
+            if not dep or not all(positive[i] for i in dep):
+                continue
+            if not (np.allclose(amap.X0, amap.X0.T) and np.allclose(amap.Xi, np.swapaxes(amap.Xi, 1, 2))):
+                continue
+            X = amap(th)
+            lam = np.linalg.eigvalsh(0.5 * (X + X.T))
+            # as much as rounding θ at the parameter tolerance can move it, or 1e-9 of ‖X‖₂
+            coef = max(float(np.linalg.norm(amap.Xi[i], 2)) for i in dep)
+            if lam[0] < -_NEGATIVE_RTOL * max(float(np.abs(lam).max()), big * coef, np.finfo(float).tiny):
+                return (f"negative {what[name]}: {name}(θ) has eigenvalue {lam[0]:.6g} although its parameters "
+                        f"are declared positive")
+    if names and all(positive):
+        try:
+            A = np.asarray(model.state_space(th).A, dtype=float)
+            poles = np.linalg.eigvals(A) if A.size else np.zeros(0)
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+            return None  # a singular M: the misfit is infinite and the fit test fails already
+        if poles.size and np.all(np.isfinite(poles)):
+            top = float(np.abs(poles).max())
+            bad = poles[poles.real > _UNSTABLE_RTOL * top]
+            if bad.size:
+                return (f"unstable: pole {bad[np.argmax(bad.real)]:.6g} in the right half-plane although every "
+                        "parameter is declared positive (a passive or compartmental model is stable)")
+    return None
 
 
 def _chi2_bound(n_data: int, n_parameters: int) -> float:
