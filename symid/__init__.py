@@ -10,7 +10,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from symid.data import BlackBox, FrequencyData, IOData, SpectralData, TimeSeries
+from symid.data import BlackBox, FrequencyData, IOData, SpectralData, TimeSeries, read_data
 from symid.errors import (
     DataError,
     IdentifiabilityWarning,
@@ -112,6 +112,7 @@ __all__ = [
     "load_model",
     "n4sid",
     "parameters",
+    "read_data",
     "simulate_frf",
     "simulate_io",
     "simulate_spectra",

@@ -116,19 +116,52 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return run_demo(out=args.out)
 
 
-def _entry_and_data(model_arg: str, data_arg: str | None, command: str):
-    from symid.data import load
+def _pairs(items: Sequence[str] | None, flag: str, command: str, repeatable: tuple[str, ...] = ()) -> dict:
+    """``ROLE=VALUE`` tokens as a dict; roles in ``repeatable`` collect a list."""
+    out: dict = {}
+    for item in items or []:
+        role, sep, value = item.partition("=")
+        role, value = role.strip(), value.strip()
+        if not sep or not role or not value:
+            raise _UsageError(f"symid {command}: error: {flag} expects ROLE=NAME items, got {item!r}")
+        if role in repeatable:
+            out.setdefault(role, []).append(value)
+        elif role in out:
+            raise _UsageError(f"symid {command}: error: {flag} gives {role!r} twice")
+        else:
+            out[role] = value
+    return out
+
+
+def _read_data(args: argparse.Namespace, command: str):
+    """The data of --data: a symid file as it is, or a table with --columns and --units."""
+    from symid.data import read_data
+
+    if args.columns is None:
+        extra = [f for f, v in (("--units", args.units), ("--dt", args.dt), ("--kind", args.kind)) if v is not None]
+        if extra:
+            raise _UsageError(f"symid {command}: error: {', '.join(extra)} describe a table: give --columns too")
+        return read_data(args.data)
+    columns = _pairs(args.columns, "--columns", command, repeatable=("input", "output"))
+    units = _pairs(args.units, "--units", command)
+    return read_data(args.data, columns=columns, units=units or None, dt=args.dt, kind=args.kind,
+                     time_unit=args.time_unit, delimiter="\t" if args.delimiter == "tab" else args.delimiter)
+
+
+def _entry_and_data(args: argparse.Namespace, command: str):
     from symid.zoo import ZooEntry, load_model
 
-    entry = load_model(model_arg)
-    if data_arg:
-        data = load(data_arg)
-        source = data_arg
+    entry = load_model(args.model)
+    if args.data:
+        data = _read_data(args, command)
+        source = args.data
+    elif args.columns is not None or args.units is not None:
+        raise _UsageError(f"symid {command}: error: --columns and --units describe the table given with --data")
     elif isinstance(entry, ZooEntry):
         data = entry.data()
         source = f"the zoo recipe: {entry.recipe}"
     else:
-        raise _UsageError(f"symid {command}: error: {model_arg} is a model file without a data recipe: give the "
+        raise _UsageError(f"symid {command}: error: {args.model} is a model file without a data recipe: give the "
                           f"measurements with --data FILE")
     return entry, data, source
 
@@ -154,7 +187,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     from symid.fit.identify import identify
 
     out = _output_dir(args.out, "identify")
-    entry, data, source = _entry_and_data(args.model, args.data, "identify")
+    entry, data, source = _entry_and_data(args, "identify")
     print(f"model: {entry.name}   data: {source}")
     if entry.known:
         print("known: " + ", ".join(f"{k} = {v:.6g}" for k, v in entry.known.items()))
@@ -203,7 +236,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from symid.fit.compare import compare
 
     out = _output_dir(args.out, "compare")
-    entry, data, source = _entry_and_data(args.model, args.data, "compare")
+    entry, data, source = _entry_and_data(args, "compare")
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
     if not methods:
         raise _UsageError(f"symid compare: error: --methods {args.methods!r} names no method")
@@ -248,6 +281,30 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_data_arguments(p: argparse.ArgumentParser, default: str) -> None:
+    g = p.add_argument_group(
+        "data", "--data alone reads a file written by symid (CSV or NPZ). A table of your own (plain CSV, MATLAB "
+                ".mat) needs --columns and --units: e.g. --columns frequency=f magnitude=mag phase=ph --units "
+                "frequency=Hz magnitude=dB phase=deg, or --columns time=t input=u output=y --units time=ms")
+    g.add_argument("--data", metavar="FILE", help=f"the measurements; default: {default}")
+    g.add_argument("--columns", nargs="+", metavar="ROLE=NAME",
+                   help="which column plays which role: frequency, real, imag, magnitude, phase (real[i][j] ... "
+                        "for several inputs or outputs); or time, input, output (repeat input=/output= for "
+                        "several channels; NAME[k] picks channel k of a 2-D .mat variable)")
+    g.add_argument("--units", nargs="+", metavar="ROLE=UNIT",
+                   help="units, never guessed: frequency=Hz|kHz|rad/s, magnitude=dB|linear, phase=deg|rad, "
+                        "time=s|ms|us|min|h|d")
+    g.add_argument("--dt", type=_positive_seconds, metavar="DT",
+                   help="sample time of a table without a time column (in the time unit of --units)")
+    g.add_argument("--time-unit", dest="time_unit", default="s", metavar="UNIT",
+                   help="time unit of the record built, i.e. of the model (default: s)")
+    g.add_argument("--kind", choices=("FrequencyData", "IOData", "TimeSeries"),
+                   help="what the table holds (default: FrequencyData with a frequency column, else IOData; "
+                        "TimeSeries for unevenly spaced times)")
+    g.add_argument("--delimiter", default=",", choices=(",", ";", "tab", "|", " "), metavar="SEP",
+                   help="separator of a CSV table: , ; tab | or a space (default: ,)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``symid`` command."""
     parser = _Parser(
@@ -267,10 +324,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_show)
 
     p = sub.add_parser("identify", help="estimate a model's parameters from data",
-                       description="Estimate the parameters of a zoo model (or model file) from a data file "
-                                   "(CSV or NPZ written by symid); without --data, from the zoo's own recipe.")
+                       description="Estimate the parameters of a zoo model or model file from measurements: a file "
+                                   "written by symid, or a table of your own (CSV, MATLAB .mat) with --columns and "
+                                   "--units; without --data, from the zoo's own recipe.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
-    p.add_argument("--data", metavar="FILE", help="data file (CSV or NPZ); default: simulate the zoo recipe")
+    _add_data_arguments(p, "simulate the zoo recipe")
     p.add_argument("--method", choices=all_methods(), default="scr",
                    help="estimator (default: scr); als and gb (alternating least squares, gradient-based BFGS, "
                         "thesis appendix C) take black-box or I/O data")
@@ -289,7 +347,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Run several estimators from identical starts and tabulate success rate, "
                                    "median time per start, time to solution and best cost.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
-    p.add_argument("--data", metavar="FILE", help="data file; default: simulate the zoo recipe (truth known)")
+    _add_data_arguments(p, "simulate the zoo recipe (truth known)")
     per_kind = "; ".join(f"{k.name}: {', '.join(k.methods)}" for k in data_kinds())
     p.add_argument("--methods", default="scr,ipopt",
                    help=f"comma-separated methods ({per_kind}); 'scr+polish' is SCR then IPOPT from its "

@@ -175,7 +175,6 @@ BAD_COMMAND_LINES = {  # issue 12 item 6, and the same kinds found while fixing 
     "float seed": (["identifiability", "belt_drive", "--seed", "1.5"], "'1.5' is not an integer"),
     "missing data file": (["identify", "belt_drive", "--data", "{missing}"], "No such file"),
     "data is a folder": (["identify", "belt_drive", "--data", "{dir}"], "Is a directory"),
-    "data not symid": (["identify", "belt_drive", "--data", "{file}"], "{file}"),
     "out is a file": (["identify", "belt_drive", "--out", "{file}"], "exists and is not a folder"),
     "out unwritable": (["identify", "belt_drive", "--out", "/proc/x"], "cannot write to --out"),
     "compare out is a file": (["compare", "belt_drive", "--out", "{file}"], "exists and is not a folder"),
@@ -205,6 +204,13 @@ def test_bad_command_lines_give_one_line_and_status_2(case, bad_paths, capsys):
     assert "Traceback" not in err
     assert len(err.strip().splitlines()) == 1, err
     assert expected.format(**bad_paths) in err
+
+
+def test_a_plain_file_without_columns_is_explained(bad_paths, capsys):
+    assert _exit_code(["identify", "belt_drive", "--data", bad_paths["file"]]) == 2
+    err = capsys.readouterr().err
+    assert f"'{bad_paths['file']}' is not a symid CSV file" in err and "Traceback" not in err
+    assert "--columns frequency=f magnitude=mag phase=ph --units frequency=Hz" in err  # how to read it instead
 
 
 def test_version_is_printed(capsys):

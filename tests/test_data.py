@@ -265,6 +265,7 @@ def test_csv_layout_is_documented_text(tmp_path):
     assert path.read_text().splitlines() == [
         "# symid IOData csv v2",
         "# dt: 0.01",
+        "# time_unit: s",
         "# n_inputs: 2",
         "# n_outputs: 1",
         "# n_rows: 2",

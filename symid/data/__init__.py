@@ -4,6 +4,9 @@ Every container is an immutable dataclass holding read-only numpy arrays, valida
 construction (any problem raises :class:`symid.errors.DataError` naming the array), and
 reads and writes CSV (``to_csv`` / ``from_csv``) and NPZ (``to_npz`` / ``from_npz``)
 files exactly. :func:`load` reads any symid data file, whichever kind it holds.
+Measurements made elsewhere (plain CSV, MATLAB ``.mat``, pandas DataFrames) come in
+through ``from_table`` or :func:`read_data`, their columns and units declared
+(:mod:`symid.data.table`, :mod:`symid.data.units`).
 """
 
 from __future__ import annotations
@@ -13,12 +16,13 @@ from symid.data.blackbox import BlackBox
 from symid.data.frequency import FrequencyData
 from symid.data.iodata import IOData
 from symid.data.spectral import SpectralData
+from symid.data.table import read_data
 from symid.data.timeseries import TimeSeries
 from symid.errors import DataError
 
-__all__ = ["BlackBox", "FrequencyData", "IOData", "SpectralData", "TimeSeries", "load"]
+__all__ = ["BlackBox", "FrequencyData", "IOData", "SpectralData", "TimeSeries", "load", "read_data"]
 
-_KINDS = {cls._kind: cls for cls in (FrequencyData, SpectralData, IOData, BlackBox)}
+_KINDS = {cls._kind: cls for cls in (FrequencyData, SpectralData, IOData, BlackBox, TimeSeries)}
 
 
 def load(path: PathLike) -> FrequencyData | SpectralData | IOData | BlackBox:
@@ -53,4 +57,6 @@ def load(path: PathLike) -> FrequencyData | SpectralData | IOData | BlackBox:
         raise DataError(f"{str(path)!r} holds an unknown kind of data {kind!r}; "
                         f"known kinds are {', '.join(_KINDS)}")
     cls = _KINDS[kind]
+    if fmt == "csv" and not hasattr(cls, "from_csv"):
+        raise DataError(f"{str(path)!r}: {kind} files are NPZ only")
     return cls.from_npz(path) if fmt == "npz" else cls.from_csv(path)

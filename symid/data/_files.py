@@ -449,7 +449,7 @@ def _read_text(path: PathLike) -> str:
                         f"file was expected") from None
 
 
-def read_csv(path: PathLike, kind: str, *, complete_by_content: bool = False
+def read_csv(path: PathLike, kind: str, *, complete_by_content: bool = False, meta_keys: Sequence[str] | None = None
              ) -> tuple[dict[str, str], list[str], list[tuple[int, str]]]:
     """Read a symid CSV file of ``kind``, refusing one that is cut short (rules in the module notes).
 
@@ -462,6 +462,9 @@ def read_csv(path: PathLike, kind: str, *, complete_by_content: bool = False
     complete_by_content : bool
         Whether the caller checks itself that no row is missing (BlackBox: every entry
         once); a version-1 file then reads without a warning.
+    meta_keys : sequence of str, optional
+        The metadata keys the kind has (``n_rows`` besides); any other ``# key: value``
+        line is refused, never ignored (``# units: Hz`` would otherwise pass unread).
 
     Returns
     -------
@@ -490,6 +493,11 @@ def read_csv(path: PathLike, kind: str, *, complete_by_content: bool = False
             if key.strip() in meta:
                 raise DataError(f"{_where(path)}, line {i + 1}: the metadata '# {_clip(key.strip())}' "
                                 f"is given twice")
+            if meta_keys is not None and key.strip() not in (*meta_keys, "n_rows"):
+                raise DataError(f"{_where(path)}, line {i + 1}: unknown metadata '# {_clip(key.strip())}': a symid "
+                                f"{kind} file carries {', '.join((*meta_keys, 'n_rows'))} and nothing else, so this "
+                                f"line would be ignored; remove it (frequencies here are rad/s), or read a table "
+                                f"of your own with {kind}.from_table(..., columns=..., units=...)")
             meta[key.strip()] = value.strip()
         i += 1
     if i >= len(lines):

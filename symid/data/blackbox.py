@@ -206,7 +206,8 @@ class BlackBox(DataContainer):
         FileNotFoundError, IsADirectoryError, PermissionError
             If the file cannot be opened.
         """
-        meta, columns, rows = _files.read_csv(path, cls._kind, complete_by_content=True)
+        meta, columns, rows = _files.read_csv(path, cls._kind, complete_by_content=True,
+                                              meta_keys=("n_states", "n_inputs", "n_outputs"))
         n = _files.meta_int(meta, "n_states", path, at_most=len(rows))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(rows))
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(rows))

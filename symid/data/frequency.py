@@ -253,6 +253,50 @@ class FrequencyData(DataContainer):
         _files.write_csv(path, self._kind, {"n_outputs": p, "n_inputs": m}, self._columns(p, m, has_var), rows)
 
     @classmethod
+    def from_table(cls, table: Any, *, columns: dict[str, Any], units: dict[str, str] | None = None,
+                   delimiter: str = ",") -> Self:
+        """Read a frequency response from the user's own table, its columns and units declared.
+
+        Parameters
+        ----------
+        table : str, os.PathLike, pandas.DataFrame or dict
+            A plain CSV file, a MATLAB ``.mat`` file, a DataFrame or a dict of arrays
+            (:mod:`symid.data.table`).
+        columns : dict
+            Role → column: ``"frequency"``, and ``"real"``/``"imag"`` or
+            ``"magnitude"``/``"phase"``; for several inputs or outputs ``"real[i][j]"``
+            etc. per entry, or a nested list of names.
+        units : dict
+            ``"frequency"``: ``"Hz"``, ``"kHz"`` or ``"rad/s"``; with magnitude and phase,
+            ``"magnitude"``: ``"dB"`` or ``"linear"`` and ``"phase"``: ``"deg"`` or
+            ``"rad"``. Converted here (ω = 2π f, |H| = 10^(dB/20)); none is guessed.
+        delimiter : str
+            Separator of a CSV file (default ``","``).
+
+        Returns
+        -------
+        FrequencyData
+
+        Raises
+        ------
+        DataError
+            On a column the table does not hold, a role or unit missing or unknown, a unit
+            stated in the file that contradicts the declared one, or values that fail the
+            constructor's checks; the message gives a two-line example.
+
+        Examples
+        --------
+        >>> from symid.data import FrequencyData
+        >>> table = {"f_Hz": [1.0, 2.0], "re": [0.5, 0.1], "im": [-0.5, -0.3]}
+        >>> FrequencyData.from_table(table, columns={"frequency": "f_Hz", "real": "re", "imag": "im"},
+        ...                          units={"frequency": "Hz"})
+        FrequencyData(2 frequencies in [6.283, 12.57] rad/s, 1 output(s), 1 input(s))
+        """
+        from symid.data.table import frequency_data_from_table
+
+        return frequency_data_from_table(table, columns=columns, units=units, delimiter=delimiter)
+
+    @classmethod
     def from_csv(cls, path: _files.PathLike) -> Self:
         """Read a file written by :meth:`to_csv`.
 
@@ -270,7 +314,7 @@ class FrequencyData(DataContainer):
         UserWarning
             For a version-1 file, whose completeness cannot be checked.
         """
-        meta, columns, rows = _files.read_csv(path, cls._kind)
+        meta, columns, rows = _files.read_csv(path, cls._kind, meta_keys=("n_outputs", "n_inputs"))
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
         has_var = len(columns) == 1 + 3 * p * m

@@ -9,6 +9,7 @@ import numpy as np
 
 from symid.data import _files, checks
 from symid.data._base import DataContainer, naming_file
+from symid.data.units import canonical_unit
 from symid.errors import DataError
 
 __all__ = ["IOData"]
@@ -38,7 +39,11 @@ class IOData(DataContainer):
     y : array_like, shape (N, p) or (N,)
         Output samples, one row per sample; a 1-D array is a single output.
     dt : float
-        Sample time in seconds, finite and > 0.
+        Sample time, finite and > 0, in ``time_unit``.
+    time_unit : str
+        Unit of ``dt`` and of the times (``"s"``, the default, ``"ms"``, ``"us"``,
+        ``"min"``, ``"h"``, ``"d"``): the model's time unit, since rates and frequencies
+        estimated from the record are per this unit. Reported by :meth:`summary`, kept in files.
 
     Raises
     ------
@@ -57,6 +62,7 @@ class IOData(DataContainer):
 
         # symid IOData csv v2
         # dt: 0.01
+        # time_unit: s
         # n_inputs: m
         # n_outputs: p
         # n_rows: N
@@ -78,11 +84,12 @@ class IOData(DataContainer):
     u: np.ndarray
     y: np.ndarray
     dt: float
+    time_unit: str
 
     _kind: ClassVar[str] = "IOData"
     _npz_keys: ClassVar[tuple[str, ...]] = ("u", "y", "dt")
 
-    def __init__(self, u: Any, y: Any, dt: Any = None):
+    def __init__(self, u: Any, y: Any, dt: Any = None, time_unit: str = "s"):
         u_ = _signal(u, "u", "m")
         y_ = _signal(y, "y", "p")
         if u_.shape[0] != y_.shape[0]:
@@ -102,10 +109,89 @@ class IOData(DataContainer):
         object.__setattr__(self, "u", checks.frozen(u_))
         object.__setattr__(self, "y", checks.frozen(y_))
         object.__setattr__(self, "dt", dt_)
+        object.__setattr__(self, "time_unit", _time_unit(time_unit))
+
+    # -- the time unit: equality, pickling and files keep it ----------------------------------
+    def _payload(self) -> dict[str, np.ndarray]:
+        return {**super()._payload(), "time_unit": np.array(self.time_unit)}
+
+    def __eq__(self, other: object) -> bool:
+        return super().__eq__(other) and self.time_unit == other.time_unit  # type: ignore[union-attr]
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[type, tuple[Any, ...]]:
+        return (type(self), (self.u, self.y, self.dt, self.time_unit))
 
     @classmethod
-    def _from_npz_arrays(cls, arrays: dict[str, np.ndarray]) -> Self:
-        return cls(arrays["u"], arrays["y"], arrays["dt"])
+    def from_npz(cls, path: _files.PathLike) -> Self:
+        """Read data written by :meth:`to_npz` (a file without ``time_unit``, from older symid, is in seconds).
+
+        Raises
+        ------
+        DataError
+            If the file is not a symid IOData NPZ file, is damaged or declares more than
+            it can hold, or its arrays fail the constructor's checks.
+        FileNotFoundError, IsADirectoryError, PermissionError
+            If the file cannot be opened.
+        """
+        arrays = _files.read_npz(path, cls._kind, cls._npz_keys, optional=("time_unit",))
+        with naming_file(path):
+            unit = arrays.get("time_unit", np.array("s"))
+            if unit.dtype.kind != "U" or unit.ndim != 0:
+                raise DataError(f"'time_unit' must be a text scalar; got {unit.dtype} of shape {unit.shape}")
+            return cls(arrays["u"], arrays["y"], arrays["dt"], str(unit[()]))
+
+    @classmethod
+    def from_table(cls, table: Any, *, columns: dict[str, Any], units: dict[str, str] | None = None,
+                   dt: float | None = None, time_unit: str = "s", delimiter: str = ",") -> Self:
+        """Read an equally spaced input/output record from the user's own table, its columns and units declared.
+
+        Parameters
+        ----------
+        table : str, os.PathLike, pandas.DataFrame or dict
+            A plain CSV file, a MATLAB ``.mat`` file, a DataFrame or a dict of arrays
+            (:mod:`symid.data.table`).
+        columns : dict
+            ``"input"`` and ``"output"``: a column name or a list of names (a 2-D
+            variable of a .mat file or dict is several channels); ``"time"``: the sample
+            times, unless ``dt`` is given.
+        units : dict
+            ``{"time": unit}``, the unit of the time column or of ``dt`` (``"s"``,
+            ``"ms"``, ``"us"``, ``"min"``, ``"h"``, ``"d"``); required, never guessed.
+        dt : float, optional
+            Sample time, when the table has no time column.
+        time_unit : str
+            The record's time unit, to which the times are converted (default ``"s"``).
+        delimiter : str
+            Separator of a CSV file (default ``","``).
+
+        Returns
+        -------
+        IOData
+            Times that are not equally spaced (beyond 0.1 % of a sample of jitter) are
+            refused: read them with :meth:`TimeSeries.from_table
+            <symid.data.TimeSeries.from_table>`.
+
+        Raises
+        ------
+        DataError
+            On a column the table does not hold, a unit missing or unknown, uneven
+            times, or values that fail the constructor's checks; the message gives a
+            two-line example.
+
+        Examples
+        --------
+        >>> from symid.data import IOData
+        >>> table = {"t": [0.0, 0.5, 1.0, 1.5], "u": [1.0, 1.0, 0.0, 0.0], "y": [0.0, 0.4, 0.6, 0.5]}
+        >>> io = IOData.from_table(table, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "min"})
+        >>> io.dt, io.time_unit
+        (30.0, 's')
+        """
+        from symid.data.table import series_from_table
+
+        return series_from_table(table, columns=columns, units=units, dt=dt, time_unit=time_unit, uniform=True,
+                                 delimiter=delimiter)
 
     # -- properties -----------------------------------------------------------------
     @property
@@ -135,7 +221,7 @@ class IOData(DataContainer):
 
     # -- text -----------------------------------------------------------------------
     def __repr__(self) -> str:
-        return (f"IOData({self.n_samples} samples, dt = {self.dt:.4g} s, "
+        return (f"IOData({self.n_samples} samples, dt = {self.dt:.4g} {self.time_unit}, "
                 f"{self.n_inputs} input(s), {self.n_outputs} output(s))")
 
     def summary(self) -> str:
@@ -145,7 +231,7 @@ class IOData(DataContainer):
         return "\n".join([
             "IOData",
             f"  samples N   : {self.n_samples}",
-            f"  dt          : {self.dt:.6g} s (duration {self.duration:.6g} s)",
+            f"  dt          : {self.dt:.6g} {self.time_unit} (duration {self.duration:.6g} {self.time_unit})",
             f"  inputs m    : {self.n_inputs}, rms {', '.join(f'{v:.4g}' for v in rms_u)}",
             f"  outputs p   : {self.n_outputs}, rms {', '.join(f'{v:.4g}' for v in rms_y)}",
         ])
@@ -159,7 +245,8 @@ class IOData(DataContainer):
         """Write the data as CSV text (layout in the class notes); the round trip is exact."""
         table = np.hstack([self.u, self.y])
         rows = [[_files.fmt(x) for x in row] for row in table.tolist()]
-        meta = {"dt": _files.fmt(self.dt), "n_inputs": self.n_inputs, "n_outputs": self.n_outputs}
+        meta = {"dt": _files.fmt(self.dt), "time_unit": self.time_unit, "n_inputs": self.n_inputs,
+                "n_outputs": self.n_outputs}
         _files.write_csv(path, self._kind, meta, self._columns(self.n_inputs, self.n_outputs), rows)
 
     @classmethod
@@ -180,7 +267,7 @@ class IOData(DataContainer):
         UserWarning
             For a version-1 file, whose completeness cannot be checked.
         """
-        meta, columns, rows = _files.read_csv(path, cls._kind)
+        meta, columns, rows = _files.read_csv(path, cls._kind, meta_keys=("dt", "time_unit", "n_inputs", "n_outputs"))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
         _files.expect_width(columns, m + p, path, "n_inputs + n_outputs")
@@ -188,4 +275,9 @@ class IOData(DataContainer):
         _files.expect_columns(columns, cls._columns(m, p), path)
         table = _files.parse_float_rows(rows, path, len(columns))
         with naming_file(path):
-            return cls(table[:, :m], table[:, m:], dt)
+            return cls(table[:, :m], table[:, m:], dt, meta.get("time_unit", "s"))
+
+
+def _time_unit(unit: Any) -> str:
+    """A canonical time unit name (``"s"``, ``"ms"``, ...)."""
+    return canonical_unit(unit, "time", "time_unit")

@@ -167,7 +167,7 @@ class SpectralData(DataContainer):
         UserWarning
             For a version-1 file, whose completeness cannot be checked.
         """
-        meta, columns, rows = _files.read_csv(path, cls._kind)
+        meta, columns, rows = _files.read_csv(path, cls._kind, meta_keys=("n_outputs", "n_inputs"))
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
         _files.expect_width(columns, 1 + 2 * (p * p + m * m), path, "1 + 2 (n_outputs² + n_inputs²)")

@@ -7,8 +7,9 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from symid.data import checks
-from symid.data._base import DataContainer
+from symid.data import _files, checks
+from symid.data._base import DataContainer, naming_file
+from symid.data.units import canonical_unit
 from symid.errors import DataError
 
 __all__ = ["TimeSeries"]
@@ -17,7 +18,7 @@ __all__ = ["TimeSeries"]
 def _times(t: Any) -> np.ndarray:
     arr = checks.as_array(t, "t", complex_ok=False)
     if arr.ndim != 1:
-        raise DataError(f"t must be a 1-D array of sample times (seconds); got shape {checks.shape_text(arr.shape)}")
+        raise DataError(f"t must be a 1-D array of sample times; got shape {checks.shape_text(arr.shape)}")
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
         raise DataError(f"t[{bad[0]}] is {arr[bad[0]]}; sample times must be finite (drop that sample)")
@@ -66,6 +67,9 @@ class TimeSeries(DataContainer):
         Input samples; ``u[k]`` acts on [t_k, t_{k+1}).
     y : array_like, shape (N, p) or (N,)
         Output samples.
+    time_unit : str
+        Unit of ``t`` (``"s"``, the default, ``"ms"``, ``"us"``, ``"min"``, ``"h"``,
+        ``"d"``): the model's time unit. Reported by :meth:`summary`, kept in files.
 
     Raises
     ------
@@ -89,11 +93,12 @@ class TimeSeries(DataContainer):
     t: np.ndarray
     u: np.ndarray
     y: np.ndarray
+    time_unit: str
 
     _kind: ClassVar[str] = "TimeSeries"
     _npz_keys: ClassVar[tuple[str, ...]] = ("t", "u", "y")
 
-    def __init__(self, t: Any, u: Any, y: Any):
+    def __init__(self, t: Any, u: Any, y: Any, time_unit: str = "s"):
         t_ = _times(t)
         if t_.size < 2:
             raise DataError(f"a time series needs at least 2 samples; got {t_.size}")
@@ -102,15 +107,85 @@ class TimeSeries(DataContainer):
         object.__setattr__(self, "t", checks.frozen(t_))
         object.__setattr__(self, "u", checks.frozen(u_))
         object.__setattr__(self, "y", checks.frozen(y_))
+        object.__setattr__(self, "time_unit", canonical_unit(time_unit, "time", "time_unit"))
+
+    # -- the time unit: equality, pickling and files keep it ----------------------------------
+    def _payload(self) -> dict[str, np.ndarray]:
+        return {**super()._payload(), "time_unit": np.array(self.time_unit)}
+
+    def __eq__(self, other: object) -> bool:
+        return super().__eq__(other) and self.time_unit == other.time_unit  # type: ignore[union-attr]
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[type, tuple[Any, ...]]:
+        return (type(self), (self.t, self.u, self.y, self.time_unit))
 
     @classmethod
-    def _from_npz_arrays(cls, arrays: dict[str, np.ndarray]) -> Self:
-        return cls(arrays["t"], arrays["u"], arrays["y"])
+    def from_npz(cls, path: _files.PathLike) -> Self:
+        """Read data written by :meth:`to_npz` (a file without ``time_unit``, from older symid, is in seconds).
+
+        Raises
+        ------
+        DataError
+            If the file is not a symid TimeSeries NPZ file, is damaged or declares more
+            than it can hold, or its arrays fail the constructor's checks.
+        FileNotFoundError, IsADirectoryError, PermissionError
+            If the file cannot be opened.
+        """
+        arrays = _files.read_npz(path, cls._kind, cls._npz_keys, optional=("time_unit",))
+        with naming_file(path):
+            unit = arrays.get("time_unit", np.array("s"))
+            if unit.dtype.kind != "U" or unit.ndim != 0:
+                raise DataError(f"'time_unit' must be a text scalar; got {unit.dtype} of shape {unit.shape}")
+            return cls(arrays["t"], arrays["u"], arrays["y"], str(unit[()]))
 
     @classmethod
     def from_iodata(cls, io: Any) -> TimeSeries:
-        """The same samples at times k·dt."""
-        return cls(io.t, io.u, io.y)
+        """The same samples at times k·dt (in the record's time unit)."""
+        return cls(io.t, io.u, io.y, io.time_unit)
+
+    @classmethod
+    def from_table(cls, table: Any, *, columns: dict[str, Any], units: dict[str, str] | None = None,
+                   time_unit: str = "s", delimiter: str = ",") -> Self:
+        """Read input/output samples at any increasing times from the user's own table.
+
+        Parameters
+        ----------
+        table : str, os.PathLike, pandas.DataFrame or dict
+            A plain CSV file, a MATLAB ``.mat`` file, a DataFrame or a dict of arrays
+            (:mod:`symid.data.table`).
+        columns : dict
+            ``"time"``, ``"input"`` and ``"output"`` (a name or a list of names each).
+        units : dict
+            ``{"time": unit}``, the unit of the time column; required, never guessed.
+        time_unit : str
+            The record's time unit, to which the times are converted (default ``"s"``).
+        delimiter : str
+            Separator of a CSV file (default ``","``).
+
+        Returns
+        -------
+        TimeSeries
+
+        Raises
+        ------
+        DataError
+            On a column the table does not hold, a unit missing or unknown, or values that
+            fail the constructor's checks; the message gives a two-line example.
+
+        Examples
+        --------
+        >>> from symid.data import TimeSeries
+        >>> table = {"t_h": [0.0, 0.5, 2.0], "dose": [0.0, 0.0, 0.0], "c": [1.0, 0.7, 0.2]}
+        >>> TimeSeries.from_table(table, columns={"time": "t_h", "input": "dose", "output": "c"},
+        ...                       units={"time": "h"}, time_unit="h")
+        TimeSeries(3 samples over 0…2 h, 1 input(s), 1 output(s))
+        """
+        from symid.data.table import series_from_table
+
+        return series_from_table(table, columns=columns, units=units, time_unit=time_unit, uniform=False,
+                                 delimiter=delimiter)
 
     @property
     def n_samples(self) -> int:
@@ -134,7 +209,7 @@ class TimeSeries(DataContainer):
         return float(step.mean()) if np.ptp(step) <= 1e-12 * step.mean() else None
 
     def __repr__(self) -> str:
-        return (f"TimeSeries({self.n_samples} samples over {self.t[0]:g}…{self.t[-1]:g} s, "
+        return (f"TimeSeries({self.n_samples} samples over {self.t[0]:g}…{self.t[-1]:g} {self.time_unit}, "
                 f"{self.n_inputs} input(s), {self.n_outputs} output(s))")
 
     def summary(self) -> str:
@@ -142,8 +217,8 @@ class TimeSeries(DataContainer):
         step = np.diff(self.t)
         return "\n".join([
             "TimeSeries",
-            f"  samples N   : {self.n_samples} over {self.t[0]:.6g} … {self.t[-1]:.6g} s",
-            f"  spacing     : {step.min():.4g} … {step.max():.4g} s",
+            f"  samples N   : {self.n_samples} over {self.t[0]:.6g} … {self.t[-1]:.6g} {self.time_unit}",
+            f"  spacing     : {step.min():.4g} … {step.max():.4g} {self.time_unit}",
             f"  inputs m    : {self.n_inputs}, rms {', '.join(f'{v:.4g}' for v in np.sqrt(np.mean(self.u**2, 0)))}",
             f"  outputs p   : {self.n_outputs}, rms {', '.join(f'{v:.4g}' for v in np.sqrt(np.mean(self.y**2, 0)))}",
         ])

@@ -1,0 +1,578 @@
+"""Reading the user's own measurements: plain CSV with named columns, pandas DataFrames, MATLAB files, dicts.
+
+symid's own CSV and NPZ files (``to_csv``/``from_csv``, :func:`symid.data.load`) are
+the lossless round-trip format. Measurements made elsewhere come in through a *table*
+and a declaration of which column plays which role, in which unit:
+
+>>> import numpy as np
+>>> from symid.data import FrequencyData
+>>> table = {"f": [0.1, 0.2, 0.4], "mag": [0.0, -3.0, -12.0], "ph": [-10.0, -45.0, -80.0]}
+>>> frf = FrequencyData.from_table(table, columns={"frequency": "f", "magnitude": "mag", "phase": "ph"},
+...                                units={"frequency": "Hz", "magnitude": "dB", "phase": "deg"})
+>>> frf.w.round(4)                                   # converted at the door: ω = 2π f
+array([0.6283, 1.2566, 2.5133])
+
+A table is one of
+
+* the path of a plain CSV file: one header line of column names (``"quoted"`` names
+  are unquoted), then one row of numbers per sample; ``delimiter=`` sets the separator
+  (``","`` by default, ``";"`` and tab work too). Lines starting with ``#`` are comments.
+  A comment that states units (``# units: Hz, dB``) is checked against the declared
+  units, never ignored: a unit it names that contradicts the declaration, or any unit
+  stated while ``units`` is not given, is an error. Only the declared columns are
+  parsed, so other columns may hold anything (dates, text). At most
+  :data:`MAX_TABLE_BYTES`;
+* the path of a MATLAB ``.mat`` file (level 5, what ``save`` writes): columns are
+  variable names; a 2-D variable holds several channels (its axis whose length is the
+  number of samples is the sample axis) and ``name[k]`` picks channel k. Sizes are
+  checked before anything is read (:mod:`symid.data._matfile`);
+* a pandas ``DataFrame`` (read through its ``columns`` and ``to_numpy``; pandas is not a
+  dependency of symid) or any mapping of names to arrays.
+
+Roles and units
+---------------
+Frequency response (:meth:`FrequencyData.from_table <symid.data.FrequencyData.from_table>`):
+``frequency`` with its unit, and H as ``real`` and ``imag`` (no unit), or as
+``magnitude`` (unit ``dB`` or ``linear``) and ``phase`` (``deg`` or ``rad``). For a
+system with several inputs or outputs, name each entry: ``"real[i][j]"`` (output i,
+input j), or give a nested list of names.
+
+Time series (:meth:`IOData.from_table <symid.data.IOData.from_table>`,
+:meth:`TimeSeries.from_table <symid.data.TimeSeries.from_table>`): ``input`` and
+``output`` (a name or a list of names), and the sample times as a ``time`` column or as
+a sample time ``dt=``, either with its unit ``units={"time": ...}``. Times are converted
+to ``time_unit`` (seconds by default), which the record keeps and reports.
+
+The units are those of :mod:`symid.data.units`. Every unit that matters must be given:
+symid never guesses one.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from symid.data import _files, checks
+from symid.data.units import DIMENSIONS, canonical_unit, time_factor, unit_tokens
+from symid.errors import DataError
+
+__all__ = ["FRF_ROLES", "MAX_TABLE_BYTES", "SERIES_ROLES", "frequency_data_from_table", "read_data",
+           "series_from_table"]
+
+MAX_TABLE_BYTES = 2**30
+"""Largest plain CSV file read as a table (1 GiB): larger files are refused before they are read."""
+
+FRF_ROLES = ("frequency", "real", "imag", "magnitude", "phase")
+"""Column roles of a frequency-response table."""
+
+SERIES_ROLES = ("time", "input", "output")
+"""Column roles of a time-series table."""
+
+_UNIT_DIMENSION = {"frequency": "frequency", "magnitude": "magnitude", "phase": "phase", "time": "time"}
+_INDEXED = re.compile(r"^(real|imag|magnitude|phase)\[(\d{1,4})\]\[(\d{1,4})\]$")
+_CHANNEL = re.compile(r"^(.*)\[(\d{1,6})\]$")
+
+FRF_EXAMPLE = ('    columns={"frequency": "f", "magnitude": "mag", "phase": "ph"}, '
+               'units={"frequency": "Hz", "magnitude": "dB", "phase": "deg"}   (Python)\n'
+               '    --columns frequency=f magnitude=mag phase=ph --units frequency=Hz magnitude=dB phase=deg   '
+               '(command line)')
+"""Two lines, Python and command line, quoted by errors about a frequency-response table."""
+
+SERIES_EXAMPLE = ('    columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"}   (Python)\n'
+                  '    --columns time=t input=u output=y --units time=s   (command line)')
+"""Two lines, Python and command line, quoted by errors about a time-series table."""
+
+
+def _fail(where: str, what: str, example: str) -> DataError:
+    return DataError(f"{where}: {what}. For example:\n{example}")
+
+
+# -- sources ------------------------------------------------------------------------------------------
+
+class _Csv:
+    """A plain CSV file: header of names, rows of text cells parsed column by column on demand."""
+
+    def __init__(self, path: _files.PathLike, delimiter: str):
+        if delimiter not in (",", ";", "\t", "|", " "):
+            raise DataError(f"delimiter must be one of ',', ';', tab, '|' or ' '; got {delimiter!r}")
+        self.where = repr(os.fspath(path))
+        with _files._open_regular(path) as fh:
+            size = os.fstat(fh.fileno()).st_size
+            if size > MAX_TABLE_BYTES:
+                raise DataError(f"{self.where} has {size} bytes, more than the {MAX_TABLE_BYTES} symid reads as a "
+                                "CSV table; save the measurements as .npz (numpy) or .mat instead")
+            raw = fh.read(MAX_TABLE_BYTES + 1)
+        if raw.startswith(_files._ZIP_SIGNATURES) or raw.startswith(_files._NPY_MAGIC):
+            raise DataError(f"{self.where} is a zip or .npy file, not a CSV table; symid's own .npz files are read "
+                            "without columns (symid.data.load)")
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise DataError(f"{self.where} is not a UTF-8 text file (byte {exc.start}); save the table as UTF-8 "
+                            "CSV") from None
+        if text.startswith(_files._CSV_MAGIC):
+            raise DataError(f"{self.where} is a symid CSV file: read it without columns and units "
+                            "(symid.data.load, or --data alone); its layout is fixed by symid")
+        self.comments: list[tuple[int, str]] = []
+        self.rows: list[tuple[int, list[str]]] = []
+        header = None
+        split = (lambda line: line.split()) if delimiter == " " else (lambda line: line.split(delimiter))
+        for k, line in enumerate(text.splitlines(), start=1):
+            if not line.strip():
+                continue
+            if line.lstrip().startswith("#"):
+                self.comments.append((k, line.strip()))
+                continue
+            cells = [c.strip() for c in split(line)]
+            if header is None:
+                header = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in cells]
+                self.header_line = k
+                continue
+            if len(cells) != len(header):
+                raise DataError(f"{self.where}, line {k}: {len(cells)} cells; the header (line {self.header_line}) "
+                                f"has {len(header)} columns (delimiter {delimiter!r})")
+            self.rows.append((k, cells))
+        if header is None:
+            raise DataError(f"{self.where} holds no header line of column names")
+        dup = sorted({c for c in header if header.count(c) > 1})
+        if dup:
+            raise DataError(f"{self.where}: the header names column {_files._show(dup[0])} twice")
+        if not self.rows:
+            raise DataError(f"{self.where} holds a header but no data rows")
+        self.names = header
+
+    def has(self, name: str) -> bool:
+        return name in self.names
+
+    def get(self, name: str) -> np.ndarray:
+        c = self.names.index(name)
+        out = np.empty(len(self.rows))
+        for r, (line, cells) in enumerate(self.rows):
+            cell = cells[c]
+            if not cell:
+                raise DataError(f"{self.where}, line {line}, column {name!r}: the value is missing")
+            try:
+                if not cell.isascii() or "_" in cell:
+                    raise ValueError(cell)
+                out[r] = float(cell)
+            except ValueError:
+                raise DataError(f"{self.where}, line {line}, column {name!r}: {_files._show(cell)} is not a "
+                                "number") from None
+            if not np.isfinite(out[r]):
+                raise DataError(f"{self.where}, line {line}, column {name!r}: {cell} is not a finite number; "
+                                "drop or fill that row")
+        return out
+
+    def check_unit_comments(self, declared: Mapping[str, str], example: str) -> None:
+        """A comment that states units must agree with the declared ones (and units must be declared)."""
+        for line, comment in self.comments:
+            if not re.search(r"\bunits?\b", comment, flags=re.IGNORECASE):
+                continue
+            if not declared:
+                raise _fail(f"{self.where}, line {line}", f"the file states units ({_files._show(comment, 60)}) but "
+                            "none were declared; symid never guesses units from a comment: declare them", example)
+            for dimension, unit in unit_tokens(comment):
+                mine = {u for role, u in declared.items() if _UNIT_DIMENSION.get(role) == dimension}
+                if mine and unit not in mine:
+                    raise DataError(f"{self.where}, line {line}: the file states {unit} ({_files._show(comment, 60)}) "
+                                    f"but the {dimension} unit declared is {', '.join(sorted(mine))}; check which "
+                                    "is right")
+
+
+class _Arrays:
+    """Named arrays: a dict, a DataFrame's columns, or the variables of a .mat file."""
+
+    def __init__(self, arrays: Mapping[str, Any], where: str):
+        self.where = where
+        self.arrays = arrays
+        self.names = list(arrays)
+
+    def has(self, name: str) -> bool:
+        return name in self.arrays
+
+    def get(self, name: str) -> np.ndarray:
+        arr = checks.as_array(self.arrays[name], f"{self.where} column {name!r}", complex_ok=True)
+        if np.any(arr.imag != 0):
+            raise DataError(f"{self.where}: column {name!r} holds complex numbers; give H as real and imag columns")
+        arr = arr.real.copy()
+        if arr.ndim > 2:
+            raise DataError(f"{self.where}: column {name!r} has {arr.ndim} dimensions; a column is 1-D or "
+                            "samples × channels")
+        bad = np.argwhere(~np.isfinite(arr))
+        if bad.size:
+            raise DataError(f"{self.where}: column {name!r} is not finite at index {tuple(int(i) for i in bad[0])}")
+        return arr
+
+
+def _frame(table: Any) -> dict[str, Any] | None:
+    """A DataFrame-like object's columns by name (duck-typed: ``columns`` and ``__getitem__`` with ``to_numpy``)."""
+    cols = getattr(table, "columns", None)
+    if cols is None or not hasattr(table, "__getitem__") or isinstance(table, Mapping):
+        return None
+    labels = list(cols)
+    names = [str(c) for c in labels]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise DataError(f"the DataFrame has two columns named {dup[0]!r}")
+    out = {}
+    for label, name in zip(labels, names, strict=True):
+        column = table[label]
+        out[name] = column.to_numpy() if hasattr(column, "to_numpy") else np.asarray(column)
+    return out
+
+
+def _source(table: Any, names: Sequence[str], delimiter: str) -> _Csv | _Arrays:
+    if isinstance(table, (str, os.PathLike)):
+        path = os.fspath(table)
+        if str(path).lower().endswith(".mat"):
+            from symid.data._matfile import read_mat_variables
+
+            # MATLAB names cannot hold brackets: "acc[0]" is channel 0 of the variable acc
+            wanted = sorted({_CHANNEL.match(n).group(1) if _CHANNEL.match(n) else n for n in names})
+            return _Arrays(read_mat_variables(path, wanted), repr(path))
+        return _Csv(path, delimiter)
+    frame = _frame(table)
+    if frame is not None:
+        return _Arrays(frame, "the DataFrame")
+    if isinstance(table, Mapping):
+        return _Arrays({str(k): v for k, v in table.items()}, "the table")
+    raise DataError(f"a table is a CSV or .mat file path, a pandas DataFrame or a dict of arrays; got "
+                    f"{type(table).__name__}")
+
+
+# -- columns ------------------------------------------------------------------------------------------
+
+class _Columns:
+    """Resolves column names to 1-D arrays of one common length N, expanding 2-D arrays into channels."""
+
+    def __init__(self, src: _Csv | _Arrays, example: str):
+        self.src = src
+        self.example = example
+        self.n: int | None = None
+
+    def _missing(self, name: str) -> DataError:
+        shown = ", ".join(self.src.names[:30]) + (" ..." if len(self.src.names) > 30 else "")
+        return _fail(self.src.where, f"no column named {name!r} (it has: {shown or 'none'}); declare the columns "
+                     "the table holds", self.example)
+
+    def _length(self, name: str, n: int) -> None:
+        if self.n is None:
+            self.n = n
+        elif n != self.n:
+            raise DataError(f"{self.src.where}: column {name!r} has {n} samples, the columns before it {self.n}")
+
+    def vector(self, name: str) -> np.ndarray:
+        """One column as a 1-D array."""
+        chans = self.channels(name)
+        if chans.shape[1] != 1:
+            raise DataError(f"{self.src.where}: {name!r} holds {chans.shape[1]} channels where one column is "
+                            f"expected; pick one with {name}[k]")
+        return chans[:, 0]
+
+    def channels(self, name: str) -> np.ndarray:
+        """A column, or a 2-D array's channels, as (N, channels)."""
+        if not isinstance(name, str):
+            raise DataError(f"column names are text; got {name!r}")
+        if self.src.has(name):
+            arr = self.src.get(name)
+            index = None
+        else:
+            match = _CHANNEL.match(name)
+            if not match or not isinstance(self.src, _Arrays) or not self.src.has(match.group(1)):
+                raise self._missing(name)
+            arr = self.src.get(match.group(1))
+            index = int(match.group(2))
+        if arr.ndim == 0:
+            raise DataError(f"{self.src.where}: {name!r} is a single number, not a column of samples")
+        if arr.ndim == 1:
+            arr = arr.reshape(-1, 1)
+        elif 1 in arr.shape:
+            arr = arr.reshape(-1, 1)
+        else:
+            rows, cols = arr.shape
+            if self.n is None:
+                raise DataError(f"{self.src.where}: cannot tell samples from channels in {name!r} of shape "
+                                f"{checks.shape_text(arr.shape)}: list a 1-D column (the time or frequency) first")
+            if rows == cols:
+                raise DataError(f"{self.src.where}: {name!r} is square ({rows} × {cols}): samples and channels "
+                                "cannot be told apart")
+            if cols == self.n:
+                arr = arr.T
+            elif rows != self.n:
+                raise DataError(f"{self.src.where}: {name!r} has shape {checks.shape_text(arr.shape)}; neither "
+                                f"axis has the {self.n} samples of the other columns")
+        if index is not None:
+            if index >= arr.shape[1]:
+                raise DataError(f"{self.src.where}: {name!r}: channel {index} does not exist ({arr.shape[1]} "
+                                "channel(s), counted from 0)")
+            arr = arr[:, index:index + 1]
+        self._length(name, arr.shape[0])
+        return arr
+
+
+def _role_map(columns: Any, roles: Sequence[str], where: str, example: str) -> dict[str, Any]:
+    if not isinstance(columns, Mapping) or not columns:
+        raise _fail(where, "columns= must be a dict from role to column name", example)
+    out = {}
+    for role, name in columns.items():
+        base = _INDEXED.match(str(role)).group(1) if _INDEXED.match(str(role)) else role
+        if base not in roles:
+            raise _fail(where, f"unknown column role {role!r}; the roles here are {', '.join(roles)}", example)
+        out[str(role)] = name
+    return out
+
+
+def _units(units: Any, needed: Sequence[str], where: str, example: str) -> dict[str, str]:
+    given = {} if units is None else units
+    if not isinstance(given, Mapping):
+        raise _fail(where, "units= must be a dict from role to unit", example)
+    out = {}
+    for role, unit in given.items():
+        if role not in _UNIT_DIMENSION:
+            raise _fail(where, f"units for {role!r}: only frequency, magnitude, phase and time carry units",
+                        example)
+        if role not in needed:
+            raise _fail(where, f"units for {role!r}, but the table has no {role} column", example)
+        out[role] = canonical_unit(unit, _UNIT_DIMENSION[role], f"{where}: units of {role!r}")
+    for role in needed:
+        if role not in out:
+            options = ", ".join(DIMENSIONS[_UNIT_DIMENSION[role]])
+            raise _fail(where, f"the unit of {role!r} is missing ({options}); symid never guesses units", example)
+    return out
+
+
+# -- frequency response -------------------------------------------------------------------------------
+
+def _entry_names(roles: Mapping[str, Any], role: str, where: str) -> dict[tuple[int, int], str]:
+    """{(i, j): column} for one part of H, from "role": name / nested list, or "role[i][j]": name."""
+    out: dict[tuple[int, int], str] = {}
+    if role in roles:
+        value = roles[role]
+        if isinstance(value, str):
+            out[(0, 0)] = value
+        else:
+            rows = list(value) if isinstance(value, Sequence) else None
+            if not rows or any(isinstance(r, str) or not isinstance(r, Sequence) for r in rows):
+                raise DataError(f"{where}: columns[{role!r}] is a column name, or a nested list of names "
+                                "[[H00, H01], [H10, H11]] (outputs × inputs)")
+            for i, r in enumerate(rows):
+                for j, name in enumerate(r):
+                    out[(i, j)] = name
+    for key, name in roles.items():
+        m = _INDEXED.match(key)
+        if m and m.group(1) == role:
+            ij = (int(m.group(2)), int(m.group(3)))
+            if ij in out:
+                raise DataError(f"{where}: H entry {ij} of {role} is named twice")
+            out[ij] = name
+    return out
+
+
+def frequency_data_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[str, str] | None = None,
+                              delimiter: str = ",") -> Any:
+    """A :class:`~symid.data.FrequencyData` from a table (module notes); see ``FrequencyData.from_table``."""
+    from symid.data.frequency import FrequencyData
+
+    where = repr(os.fspath(table)) if isinstance(table, (str, os.PathLike)) else "the table"
+    roles = _role_map(columns, FRF_ROLES, where, FRF_EXAMPLE)
+    if "frequency" not in roles:
+        raise _fail(where, "no frequency column declared", FRF_EXAMPLE)
+    parts = {r: _entry_names(roles, r, where) for r in ("real", "imag", "magnitude", "phase")}
+    cartesian, polar = bool(parts["real"] or parts["imag"]), bool(parts["magnitude"] or parts["phase"])
+    if cartesian == polar:
+        raise _fail(where, "declare H either as real and imag columns or as magnitude and phase columns"
+                    if not cartesian else "H is declared both as real/imag and as magnitude/phase: choose one",
+                    FRF_EXAMPLE)
+    a, b = ("real", "imag") if cartesian else ("magnitude", "phase")
+    if set(parts[a]) != set(parts[b]):
+        odd = sorted(set(parts[a]) ^ set(parts[b]))[0]
+        raise _fail(where, f"H entry {odd} has a {a if odd in parts[a] else b} column but no "
+                    f"{b if odd in parts[a] else a} column", FRF_EXAMPLE)
+    p = 1 + max(i for i, _ in parts[a])
+    m = 1 + max(j for _, j in parts[a])
+    if len(parts[a]) != p * m:
+        missing = sorted({(i, j) for i in range(p) for j in range(m)} - set(parts[a]))
+        raise _fail(where, f"H is {p} × {m} but entry {missing[0]} has no column", FRF_EXAMPLE)
+    needed = ["frequency"] + ([] if cartesian else ["magnitude", "phase"])
+    names = [roles["frequency"], *parts[a].values(), *parts[b].values()]
+    src = _source(table, [n for n in names if isinstance(n, str)], delimiter)
+    if isinstance(src, _Csv) and not units:
+        src.check_unit_comments({}, FRF_EXAMPLE)  # a file that states units, read without any declared
+    declared = _units(units, needed, where, FRF_EXAMPLE)
+    if isinstance(src, _Csv):
+        src.check_unit_comments(declared, FRF_EXAMPLE)
+    cols = _Columns(src, FRF_EXAMPLE)
+    w = cols.vector(roles["frequency"]) * DIMENSIONS["frequency"][declared["frequency"]]
+    H = np.empty((w.size, p, m), dtype=np.complex128)
+    for (i, j), name in parts[a].items():
+        x, y = cols.vector(name), cols.vector(parts[b][(i, j)])
+        if cartesian:
+            H[:, i, j] = _files.complex_from_parts(x, y)
+            continue
+        if declared["magnitude"] == "linear" and np.any(x < 0):
+            k = int(np.argmax(x < 0))
+            raise DataError(f"{src.where}: magnitude {name!r} is negative at sample {k} ({x[k]:g}); a linear "
+                            "magnitude is |H| ≥ 0 (is it in dB?)")
+        mag = 10.0 ** (x / 20.0) if declared["magnitude"] == "dB" else x
+        H[:, i, j] = mag * np.exp(1j * y * DIMENSIONS["phase"][declared["phase"]])
+    with _naming(src.where):
+        return FrequencyData(w, H)
+
+
+# -- time series --------------------------------------------------------------------------------------
+
+def _name_list(value: Any, role: str, where: str) -> list[str]:
+    names = [value] if isinstance(value, str) else value
+    if not isinstance(names, Sequence) or isinstance(names, str) or not names or \
+            not all(isinstance(n, str) for n in names):
+        raise _fail(where, f"columns[{role!r}] is a column name or a list of names", SERIES_EXAMPLE)
+    return list(names)
+
+
+def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[str, str] | None = None,
+                      dt: float | None = None, time_unit: str = "s", uniform: bool = True,
+                      delimiter: str = ",") -> Any:
+    """An :class:`~symid.data.IOData` (``uniform``) or :class:`~symid.data.TimeSeries` from a table (module notes)."""
+    from symid.data.iodata import IOData
+    from symid.data.timeseries import TimeSeries
+
+    where = repr(os.fspath(table)) if isinstance(table, (str, os.PathLike)) else "the table"
+    roles = _role_map(columns, SERIES_ROLES, where, SERIES_EXAMPLE)
+    for role in ("input", "output"):
+        if role not in roles:
+            raise _fail(where, f"no {role} column declared", SERIES_EXAMPLE)
+    inputs, outputs = _name_list(roles["input"], "input", where), _name_list(roles["output"], "output", where)
+    has_time = "time" in roles
+    if has_time and dt is not None:
+        raise _fail(where, "both a time column and dt= are given: give one", SERIES_EXAMPLE)
+    if not has_time and (dt is None or not uniform):
+        raise _fail(where, "no time column declared" + ("" if uniform else " (a TimeSeries needs one)")
+                    + ("" if not uniform else " and no dt= given"), SERIES_EXAMPLE)
+    target = canonical_unit(time_unit, "time", "time_unit")
+    names = ([roles["time"]] if has_time else []) + inputs + outputs
+    src = _source(table, names, delimiter)
+    if isinstance(src, _Csv) and not units:
+        src.check_unit_comments({}, SERIES_EXAMPLE)
+    declared = _units(units, ["time"], where, SERIES_EXAMPLE)
+    if isinstance(src, _Csv):
+        src.check_unit_comments(declared, SERIES_EXAMPLE)
+    cols = _Columns(src, SERIES_EXAMPLE)
+    factor = time_factor(declared["time"], target)
+    t = cols.vector(roles["time"]) * factor if has_time else None
+    u = np.hstack([cols.channels(n) for n in inputs])
+    y = np.hstack([cols.channels(n) for n in outputs])
+    with _naming(src.where):
+        if not uniform:
+            return TimeSeries(t, u, y, time_unit=target)
+        if t is None:
+            step = checks.check_positive_scalar(dt, "dt") * factor
+        else:
+            step = _uniform_step(t, src.where)
+        return IOData(u, y, step, time_unit=target)
+
+
+def _uniform_step(t: np.ndarray, where: str) -> float:
+    """The sample time of equally spaced times: jitter up to 0.1 % of a sample is rounding, more is refused."""
+    if t.size < 2:
+        raise DataError(f"{where}: a record needs at least 2 samples; got {t.size}")
+    step = (t[-1] - t[0]) / (t.size - 1)
+    if not step > 0:
+        raise DataError(f"{where}: the times do not increase (first {t[0]:g}, last {t[-1]:g})")
+    dev = np.abs(t - (t[0] + step * np.arange(t.size)))
+    k = int(np.argmax(dev))
+    if dev[k] > 1e-3 * step:
+        raise DataError(f"{where}: the samples are not equally spaced: sample {k} is at {t[k]:.9g}, "
+                        f"{dev[k] / step:.3g} sample times away from an even grid of step {step:.6g}; read "
+                        "the table as a TimeSeries (TimeSeries.from_table, or kind='TimeSeries') for uneven times")
+    return float(step)
+
+
+class _naming:
+    """Prefix the constructor's DataError with the table it came from."""
+
+    def __init__(self, where: str):
+        self.where = where
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind, exc, tb) -> bool:
+        if isinstance(exc, DataError) and not str(exc).startswith(self.where):
+            raise DataError(f"{self.where}: {exc}") from None
+        return False
+
+
+# -- one entry point ----------------------------------------------------------------------------------
+
+def read_data(source: Any, *, columns: Mapping[str, Any] | None = None, units: Mapping[str, str] | None = None,
+              kind: str | None = None, dt: float | None = None, time_unit: str = "s", delimiter: str = ",") -> Any:
+    """Read measurements: a symid data file as it is, or the user's own table with declared columns and units.
+
+    Parameters
+    ----------
+    source : str, os.PathLike, pandas.DataFrame or dict
+        A symid CSV/NPZ file (without ``columns``), or a table (module notes): a plain
+        CSV file, a MATLAB ``.mat`` file, a DataFrame or a dict of arrays.
+    columns : dict, optional
+        Role → column name (:data:`FRF_ROLES`, :data:`SERIES_ROLES`); required for a table.
+    units : dict, optional
+        Role → unit (:mod:`symid.data.units`) for the frequency, magnitude, phase and time.
+    kind : {"FrequencyData", "IOData", "TimeSeries"}, optional
+        What to build from a table; by default ``FrequencyData`` when a frequency column is
+        declared, else ``IOData`` (equally spaced samples; ``TimeSeries`` for uneven ones).
+    dt : float, optional
+        Sample time of a time series without a time column, in ``units["time"]``.
+    time_unit : str
+        The time unit of the record built (default ``"s"``).
+    delimiter : str
+        Separator of a CSV table (default ``","``).
+
+    Returns
+    -------
+    FrequencyData, SpectralData, IOData, TimeSeries or BlackBox
+
+    Raises
+    ------
+    DataError
+        On a file that is neither, columns that do not match the table, missing or
+        unknown units, or values that fail the data's checks.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> table = {"t_ms": np.arange(5) * 10.0, "u": np.ones(5), "y": np.linspace(0, 1, 5)}
+    >>> si.read_data(table, columns={"time": "t_ms", "input": "u", "output": "y"}, units={"time": "ms"})
+    IOData(5 samples, dt = 0.01 s, 1 input(s), 1 output(s))
+    """
+    if columns is None:
+        if units is not None or dt is not None or kind is not None:
+            raise DataError("units=, dt= and kind= describe a table: give columns= too (a symid file carries its own)")
+        if not isinstance(source, (str, os.PathLike)):
+            raise DataError("a DataFrame or dict is read as a table: give columns= and units=")
+        from symid.data import load
+
+        if str(os.fspath(source)).lower().endswith(".mat"):
+            raise _fail(repr(os.fspath(source)), "a MATLAB file is read as a table: declare its columns and units",
+                        SERIES_EXAMPLE)
+        try:
+            return load(source)
+        except DataError as exc:
+            if "is not a symid CSV file" in str(exc) or "not a UTF-8" in str(exc):
+                raise DataError(f"{exc}. A plain table is read with its columns and units declared, e.g.\n"
+                                f"{FRF_EXAMPLE}\n{SERIES_EXAMPLE}") from None
+            raise
+    if kind is None:
+        kind = "FrequencyData" if isinstance(columns, Mapping) and "frequency" in columns else "IOData"
+    if kind == "FrequencyData":
+        if dt is not None:
+            raise DataError("dt= belongs to a time series, not to a frequency response")
+        return frequency_data_from_table(source, columns=columns, units=units, delimiter=delimiter)
+    if kind in ("IOData", "TimeSeries"):
+        return series_from_table(source, columns=columns, units=units, dt=dt, time_unit=time_unit,
+                                 uniform=kind == "IOData", delimiter=delimiter)
+    raise DataError(f"kind must be 'FrequencyData', 'IOData' or 'TimeSeries' for a table; got {kind!r}")

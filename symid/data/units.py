@@ -1,0 +1,96 @@
+"""Units symid reads in the user's tables: named explicitly, converted where the data come in, never guessed.
+
+Inside symid, angular frequencies are in rad/s (rad per time unit of the model) and a
+frequency response is a complex number; times are in the record's ``time_unit``
+(seconds unless chosen otherwise). A table may hold any of the units below; the reader
+(:mod:`symid.data.table`) converts them once, where the data come in.
+
+=============  ==================================================  ==========================
+role           units                                               converted to
+=============  ==================================================  ==========================
+frequency      ``Hz``, ``kHz``, ``rad/s``                          rad/s (ω = 2π f for Hz)
+magnitude      ``dB`` (20 log10 |H|), ``linear`` (|H| itself)       |H|
+phase          ``deg``, ``rad``                                    radians
+time, dt       ``s``, ``ms``, ``us``, ``min``, ``h``, ``d``        the record's ``time_unit``
+=============  ==================================================  ==========================
+
+Spellings are matched without regard to case, and a few aliases are accepted
+(``degrees``, ``µs``, ``sec``, ``hour``, ...); anything else is a
+:class:`~symid.errors.DataError` listing the units above.
+"""
+
+from __future__ import annotations
+
+import math
+
+from symid.errors import DataError
+
+__all__ = ["DIMENSIONS", "TIME_UNITS", "canonical_unit", "time_factor"]
+
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0, "h": 3600.0, "d": 86400.0}
+"""Time units and their length in seconds."""
+
+DIMENSIONS = {
+    "frequency": {"Hz": 2 * math.pi, "kHz": 2e3 * math.pi, "rad/s": 1.0},
+    "magnitude": {"dB": None, "linear": None},
+    "phase": {"deg": math.pi / 180, "rad": 1.0},
+    "time": TIME_UNITS,
+}
+"""Each dimension's units with the factor to symid's unit (``None``: converted by a formula)."""
+
+_ALIASES = {
+    "hz": "Hz", "hertz": "Hz", "khz": "kHz", "rad/s": "rad/s", "rad/sec": "rad/s", "rad s^-1": "rad/s",
+    "db": "dB", "decibel": "dB", "linear": "linear", "lin": "linear", "abs": "linear",
+    "deg": "deg", "degree": "deg", "degrees": "deg", "°": "deg", "rad": "rad", "radian": "rad", "radians": "rad",
+    "s": "s", "sec": "s", "second": "s", "seconds": "s", "ms": "ms", "millisecond": "ms", "milliseconds": "ms",
+    "us": "us", "µs": "us", "μs": "us", "microsecond": "us", "microseconds": "us", "min": "min", "minute": "min",
+    "minutes": "min", "h": "h", "hr": "h", "hour": "h", "hours": "h", "d": "d", "day": "d", "days": "d",
+}
+
+
+def canonical_unit(text: str, dimension: str, what: str) -> str:
+    """The canonical name of a unit of ``dimension`` (``"hz"`` → ``"Hz"``), or a :class:`DataError`.
+
+    Examples
+    --------
+    >>> from symid.data.units import canonical_unit
+    >>> canonical_unit("hz", "frequency", "units of 'frequency'")
+    'Hz'
+    >>> canonical_unit("rpm", "frequency", "units of 'frequency'")
+    Traceback (most recent call last):
+    ...
+    symid.errors.DataError: units of 'frequency': unknown unit 'rpm'; symid reads Hz, kHz, rad/s
+    """
+    if not isinstance(text, str):
+        raise DataError(f"{what}: a unit is a name such as {', '.join(DIMENSIONS[dimension])}; got {text!r}")
+    name = _ALIASES.get(text.strip().lower()) if len(text) <= 40 else None
+    if name is None or name not in DIMENSIONS[dimension]:
+        shown = repr(text) if len(text) <= 40 else f"{text[:40]!r}..."
+        raise DataError(f"{what}: unknown unit {shown}; symid reads {', '.join(DIMENSIONS[dimension])}")
+    return name
+
+
+def time_factor(unit: str, target: str) -> float:
+    """The factor that converts a time in ``unit`` to ``target`` (both canonical).
+
+    Examples
+    --------
+    >>> from symid.data.units import time_factor
+    >>> time_factor("ms", "s"), time_factor("min", "h")
+    (0.001, 0.016666666666666666)
+    """
+    return TIME_UNITS[unit] / TIME_UNITS[target]
+
+
+def unit_tokens(text: str) -> list[tuple[str, str]]:
+    """The units recognisable in free text (a comment line), as (dimension, canonical name) pairs."""
+    import re
+
+    out = []
+    for token in re.findall(r"rad\s*/\s*s(?:ec)?\b|[A-Za-zµμ°]+", text):
+        name = _ALIASES.get(re.sub(r"\s+", "", token).lower())
+        if name is None or name in ("s", "h", "d", "min", "rad", "linear", "abs"):
+            continue  # one-letter and common words are too ambiguous in free text
+        dimension = next(d for d, units in DIMENSIONS.items() if name in units)
+        out.append((dimension, name))
+    return out

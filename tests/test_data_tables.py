@@ -1,0 +1,379 @@
+"""The user's own measurements (symid.data.table): plain CSV, MATLAB .mat, pandas DataFrames, dicts.
+
+Units are declared and converted where the data come in; a unit stated in a file is checked, never
+ignored; columns that do not match the declaration, missing or unknown units are named errors with a
+two-line example. Reference values: the conversions' definitions (ω = 2π f, |H| = 10^(dB/20)).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.io
+
+import symid as si
+from symid.cli import main
+from symid.data import FrequencyData, IOData, TimeSeries, read_data
+from symid.data.table import FRF_EXAMPLE, MAX_TABLE_BYTES, SERIES_EXAMPLE
+
+F_HZ = np.array([0.1, 0.2, 0.5, 1.0, 2.0])
+H_TRUE = 1.0 / (1.0 - (2 * np.pi * F_HZ) ** 2 * 0.01 + 0.02j * 2 * np.pi * F_HZ)  # a lightly damped mode
+
+
+def write_csv(path: Path, lines: list[str]) -> Path:
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def polar_csv(tmp_path):
+    """An FRF as measuring equipment exports it: Hz, dB, degrees, extra text column, a comment."""
+    lines = ["# exported by analyser X", "freq_Hz,mag_dB,phase_deg,comment"]
+    for f, h in zip(F_HZ, H_TRUE, strict=True):
+        lines.append(f"{float(f)!r},{float(20 * np.log10(abs(h)))!r},{float(np.degrees(np.angle(h)))!r},ok; fine")
+    return write_csv(tmp_path / "frf.csv", lines)
+
+
+POLAR = {"frequency": "freq_Hz", "magnitude": "mag_dB", "phase": "phase_deg"}
+POLAR_UNITS = {"frequency": "Hz", "magnitude": "dB", "phase": "deg"}
+
+
+def test_magnitude_phase_in_hz_db_degrees(polar_csv):
+    frf = FrequencyData.from_table(polar_csv, columns=POLAR, units=POLAR_UNITS)
+    np.testing.assert_allclose(frf.w, 2 * np.pi * F_HZ, rtol=1e-15)  # ω = 2π f
+    np.testing.assert_allclose(frf.H[:, 0, 0], H_TRUE, rtol=1e-12)  # |H| = 10^(dB/20), phase in degrees
+    assert si.read_data(polar_csv, columns=POLAR, units=POLAR_UNITS) == frf
+
+
+def test_real_imaginary_in_rad_per_s_with_semicolons(tmp_path):
+    w = 2 * np.pi * F_HZ
+    lines = ['"w";"Re H";"Im H"'] + [f"{float(a)!r};{float(h.real)!r};{float(h.imag)!r}"
+                                     for a, h in zip(w, H_TRUE, strict=True)]
+    path = write_csv(tmp_path / "frf.csv", lines)
+    frf = FrequencyData.from_table(path, columns={"frequency": "w", "real": "Re H", "imag": "Im H"},
+                                   units={"frequency": "rad/s"}, delimiter=";")
+    np.testing.assert_array_equal(frf.w, w)  # rad/s: no conversion, bit for bit
+    np.testing.assert_array_equal(frf.H[:, 0, 0], H_TRUE)
+
+
+def test_mimo_entries_by_index_and_by_nested_list():
+    H = np.arange(1, 13, dtype=float).reshape(3, 2, 2) * (1 - 0.5j)
+    table = {"f": [1.0, 2.0, 3.0]}
+    for i in range(2):
+        for j in range(2):
+            table[f"re{i}{j}"], table[f"im{i}{j}"] = H[:, i, j].real, H[:, i, j].imag
+    indexed = {"frequency": "f", **{f"real[{i}][{j}]": f"re{i}{j}" for i in range(2) for j in range(2)},
+               **{f"imag[{i}][{j}]": f"im{i}{j}" for i in range(2) for j in range(2)}}
+    nested = {"frequency": "f", "real": [["re00", "re01"], ["re10", "re11"]],
+              "imag": [["im00", "im01"], ["im10", "im11"]]}
+    a = FrequencyData.from_table(table, columns=indexed, units={"frequency": "rad/s"})
+    b = FrequencyData.from_table(table, columns=nested, units={"frequency": "rad/s"})
+    assert a == b and a.shape == (3, 2, 2)
+    np.testing.assert_array_equal(a.H, H)
+
+
+def test_linear_magnitude_and_radians():
+    mag, ph = np.abs(H_TRUE), np.angle(H_TRUE)
+    frf = FrequencyData.from_table({"f": F_HZ, "m": mag, "p": ph},
+                                   columns={"frequency": "f", "magnitude": "m", "phase": "p"},
+                                   units={"frequency": "kHz", "magnitude": "linear", "phase": "rad"})
+    np.testing.assert_allclose(frf.w, 2e3 * np.pi * F_HZ, rtol=1e-15)
+    np.testing.assert_allclose(frf.H[:, 0, 0], H_TRUE, rtol=1e-14)
+
+
+def test_io_record_with_time_in_ms_converted_to_seconds(tmp_path):
+    lines = ["t_ms,force,position"] + [f"{k * 2.5},{float(np.sin(k))!r},{float(np.cos(k))!r}" for k in range(50)]
+    path = write_csv(tmp_path / "io.csv", lines)
+    io = IOData.from_table(path, columns={"time": "t_ms", "input": "force", "output": "position"},
+                           units={"time": "ms"})
+    assert io.dt == pytest.approx(2.5e-3, rel=1e-12) and io.time_unit == "s"
+    np.testing.assert_array_equal(io.u[:, 0], np.sin(np.arange(50)))
+    assert "dt          : 0.0025 s" in io.summary()
+    hours = IOData.from_table(path, columns={"time": "t_ms", "input": "force", "output": "position"},
+                              units={"time": "ms"}, time_unit="h")
+    assert hours.time_unit == "h" and hours.dt == pytest.approx(2.5e-3 / 3600, rel=1e-12)
+    assert "dt          : 6.94444e-07 h (duration" in hours.summary()
+
+
+def test_io_record_from_dt_and_several_channels():
+    table = {"u1": np.ones(6), "u2": np.zeros(6), "y": np.arange(6.0)}
+    io = read_data(table, columns={"input": ["u1", "u2"], "output": "y"}, units={"time": "min"}, dt=0.5)
+    assert io.n_inputs == 2 and io.dt == 30.0  # 0.5 min
+
+
+def test_uneven_times_are_refused_for_iodata_and_read_as_time_series():
+    table = {"t": [0.0, 0.5, 1.0, 2.0, 4.0], "u": np.zeros(5), "c": [1.0, 0.8, 0.6, 0.4, 0.2]}
+    cols = {"time": "t", "input": "u", "output": "c"}
+    with pytest.raises(si.DataError, match=r"not equally spaced.*TimeSeries"):
+        IOData.from_table(table, columns=cols, units={"time": "h"})
+    ts = TimeSeries.from_table(table, columns=cols, units={"time": "h"}, time_unit="h")
+    np.testing.assert_array_equal(ts.t, table["t"])
+    assert ts.time_unit == "h" and "over 0 … 4 h" in ts.summary()
+    assert read_data(table, columns=cols, units={"time": "h"}, kind="TimeSeries") == TimeSeries.from_table(
+        table, columns=cols, units={"time": "h"})
+
+
+def test_rounded_times_are_still_even():
+    t = np.round(np.arange(1000) * 0.001, 3)  # printed with 3 decimals
+    io = IOData.from_table({"t": t, "u": np.ones(1000), "y": np.ones(1000)},
+                           columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
+    assert io.dt == pytest.approx(1e-3, rel=1e-12)
+
+
+# -- units in the file are never ignored ----------------------------------------------------------------
+
+def test_a_units_comment_that_agrees_is_accepted(tmp_path, polar_csv):
+    text = polar_csv.read_text().replace("# exported by analyser X", "# units: Hz, dB, degrees")
+    path = tmp_path / "agree.csv"
+    path.write_text(text)
+    assert FrequencyData.from_table(path, columns=POLAR, units=POLAR_UNITS) == FrequencyData.from_table(
+        polar_csv, columns=POLAR, units=POLAR_UNITS)
+
+
+def test_a_units_comment_that_contradicts_is_an_error(tmp_path, polar_csv):
+    path = tmp_path / "contradict.csv"
+    path.write_text(polar_csv.read_text().replace("# exported by analyser X", "# units: Hz"))
+    with pytest.raises(si.DataError, match=r"line 1: the file states Hz .* the frequency unit declared is rad/s"):
+        FrequencyData.from_table(path, columns=POLAR, units={**POLAR_UNITS, "frequency": "rad/s"})
+
+
+def test_a_units_comment_without_declared_units_is_an_error(tmp_path):
+    path = write_csv(tmp_path / "plain.csv", ["# units: Hz", "f,re,im", "1.0,0.5,-0.5", "2.0,0.2,-0.4"])
+    with pytest.raises(si.DataError) as info:
+        FrequencyData.from_table(path, columns={"frequency": "f", "real": "re", "imag": "im"})
+    assert "states units ('# units: Hz') but none were declared" in str(info.value)
+    assert str(info.value).endswith(FRF_EXAMPLE)
+
+
+def test_units_metadata_in_a_symid_csv_file_is_refused_not_ignored(tmp_path):
+    path = tmp_path / "frf.csv"
+    FrequencyData([1.0, 2.0], [0.5 - 0.5j, 0.2 - 0.4j]).to_csv(path)
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join([lines[0], "# units: Hz", *lines[1:]]) + "\n")
+    with pytest.raises(si.DataError, match=r"line 2: unknown metadata '# units'.*would be ignored"):
+        FrequencyData.from_csv(path)
+    with pytest.raises(si.DataError, match="unknown metadata"):
+        si.data.load(path)
+
+
+# -- bad declarations: named errors with a two-line example -----------------------------------------------
+
+BAD_DECLARATIONS = {
+    "missing frequency unit": (dict(columns=POLAR, units={"magnitude": "dB", "phase": "deg"}),
+                               "the unit of 'frequency' is missing (Hz, kHz, rad/s); symid never guesses", True),
+    "no units at all": (dict(columns=POLAR, units=None), "the unit of 'frequency' is missing", True),
+    "unknown unit": (dict(columns=POLAR, units={**POLAR_UNITS, "frequency": "rpm"}),
+                     "unknown unit 'rpm'; symid reads Hz, kHz, rad/s", False),
+    "column not in file": (dict(columns={**POLAR, "phase": "phase"}, units=POLAR_UNITS),
+                           "no column named 'phase' (it has: freq_Hz, mag_dB, phase_deg, comment)", True),
+    "unknown role": (dict(columns={**POLAR, "freq": "freq_Hz"}, units=POLAR_UNITS),
+                     "unknown column role 'freq'", True),
+    "magnitude without phase": (dict(columns={"frequency": "freq_Hz", "magnitude": "mag_dB"},
+                                     units={"frequency": "Hz", "magnitude": "dB"}),
+                                "has a magnitude column but no phase column", True),
+    "both forms": (dict(columns={**POLAR, "real": "mag_dB", "imag": "phase_deg"}, units=POLAR_UNITS),
+                   "both as real/imag and as magnitude/phase", True),
+    "unit of an absent role": (dict(columns={"frequency": "freq_Hz", "real": "mag_dB", "imag": "phase_deg"},
+                                    units=POLAR_UNITS), "units for 'magnitude', but the table has no", True),
+    "text column": (dict(columns={**POLAR, "phase": "comment"}, units=POLAR_UNITS),
+                    "column 'comment': 'ok; fine' is not a number", False),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_DECLARATIONS))
+def test_bad_declarations_are_named_errors(case, polar_csv):
+    kwargs, expected, with_example = BAD_DECLARATIONS[case]
+    with pytest.raises(si.DataError) as info:
+        FrequencyData.from_table(polar_csv, **kwargs)
+    assert expected in str(info.value)
+    if with_example:
+        assert str(info.value).endswith(FRF_EXAMPLE) and len(FRF_EXAMPLE.splitlines()) == 2
+
+
+def test_series_errors_quote_the_series_example():
+    with pytest.raises(si.DataError) as info:
+        IOData.from_table({"u": [1.0, 2.0], "y": [1.0, 2.0]}, columns={"input": "u", "output": "y"})
+    assert "no time column declared and no dt= given" in str(info.value)
+    assert str(info.value).endswith(SERIES_EXAMPLE)
+
+
+def test_hostile_csv_tables(tmp_path):
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_TABLE_BYTES + 1)  # sparse: the size is refused before anything is read
+    with pytest.raises(si.DataError, match="more than the 1073741824 symid reads"):
+        FrequencyData.from_table(big, columns=POLAR, units=POLAR_UNITS)
+    ragged = write_csv(tmp_path / "ragged.csv", ["f,re,im", "1,2,3", "4,5"])
+    with pytest.raises(si.DataError, match=r"line 3: 2 cells; the header .* has 3 columns"):
+        FrequencyData.from_table(ragged, columns={"frequency": "f", "real": "re", "imag": "im"},
+                                 units={"frequency": "Hz"})
+    nan = write_csv(tmp_path / "nan.csv", ["f,re,im", "1,2,3", "4,nan,5"])
+    with pytest.raises(si.DataError, match="line 3, column 're': nan is not a finite number"):
+        FrequencyData.from_table(nan, columns={"frequency": "f", "real": "re", "imag": "im"},
+                                 units={"frequency": "Hz"})
+    dup = write_csv(tmp_path / "dup.csv", ["f,re,re", "1,2,3"])
+    with pytest.raises(si.DataError, match="names column 're' twice"):
+        FrequencyData.from_table(dup, columns={"frequency": "f", "real": "re", "imag": "re"},
+                                 units={"frequency": "Hz"})
+    if os.name == "posix":
+        fifo = tmp_path / "fifo"
+        os.mkfifo(fifo)
+        with pytest.raises(si.DataError, match="not a regular file"):
+            FrequencyData.from_table(fifo, columns=POLAR, units=POLAR_UNITS)
+    symid_own = tmp_path / "own.csv"
+    FrequencyData([1.0], [1.0]).to_csv(symid_own)
+    with pytest.raises(si.DataError, match="is a symid CSV file: read it without columns"):
+        FrequencyData.from_table(symid_own, columns=POLAR, units=POLAR_UNITS)
+
+
+def test_read_data_without_columns_reads_symid_files_and_explains_plain_ones(polar_csv, tmp_path):
+    own = tmp_path / "own.npz"
+    IOData(np.ones(3), np.arange(3.0), dt=0.1, time_unit="ms").to_npz(own)
+    assert read_data(own) == IOData(np.ones(3), np.arange(3.0), dt=0.1, time_unit="ms")
+    with pytest.raises(si.DataError) as info:
+        read_data(polar_csv)
+    assert "is not a symid CSV file" in str(info.value) and FRF_EXAMPLE in str(info.value)
+
+
+# -- the time unit travels with the record ---------------------------------------------------------------
+
+def test_time_unit_round_trips_through_csv_npz_and_pickle(tmp_path):
+    import pickle
+
+    io = IOData(np.ones((4, 1)), np.arange(4.0), dt=0.25, time_unit="h")
+    io.to_csv(tmp_path / "io.csv")
+    io.to_npz(tmp_path / "io.npz")
+    assert IOData.from_csv(tmp_path / "io.csv") == io == IOData.from_npz(tmp_path / "io.npz")
+    assert pickle.loads(pickle.dumps(io)) == io
+    assert io != IOData(np.ones((4, 1)), np.arange(4.0), dt=0.25)  # same numbers, other unit
+    assert repr(io) == "IOData(4 samples, dt = 0.25 h, 1 input(s), 1 output(s))"
+    with pytest.raises(si.DataError, match="unknown unit 'fortnight'"):
+        IOData(np.ones(2), np.ones(2), dt=1.0, time_unit="fortnight")
+    ts = TimeSeries([0.0, 1.0], [0.0, 0.0], [1.0, 0.5], time_unit="min")
+    ts.to_npz(tmp_path / "ts.npz")
+    assert TimeSeries.from_npz(tmp_path / "ts.npz") == ts and si.data.load(tmp_path / "ts.npz") == ts
+
+
+def test_files_without_a_time_unit_are_in_seconds(tmp_path):
+    """NPZ and CSV files written before the time unit existed read as seconds (format unchanged otherwise)."""
+    np.savez(tmp_path / "old.npz", kind=np.array("IOData"), format_version=np.array(1), u=np.ones((3, 1)),
+             y=np.zeros((3, 1)), dt=np.array(0.1))
+    assert IOData.from_npz(tmp_path / "old.npz").time_unit == "s"
+    write_csv(tmp_path / "old.csv", ["# symid IOData csv v2", "# dt: 0.1", "# n_inputs: 1", "# n_outputs: 1",
+                                     "# n_rows: 2", "u[0],y[0]", "1.0,0.0", "1.0,0.5", "# end"])
+    assert IOData.from_csv(tmp_path / "old.csv").time_unit == "s"
+
+
+# -- MATLAB files -----------------------------------------------------------------------------------------
+
+def test_mat_file_vectors_and_matrices(tmp_path):
+    path = tmp_path / "rec.mat"
+    t = np.arange(200) * 1e-3
+    acc = np.vstack([np.sin(t), np.cos(t), t])  # 3 channels in rows, as the F-16 benchmark stores them
+    scipy.io.savemat(path, {"t": t.reshape(-1, 1), "force": t.reshape(1, -1), "acc": acc}, do_compression=True)
+    io = IOData.from_table(path, columns={"time": "t", "input": "force", "output": "acc"}, units={"time": "s"})
+    assert io.n_outputs == 3 and io.dt == pytest.approx(1e-3, rel=1e-12)
+    np.testing.assert_array_equal(io.y, acc.T)  # samples × channels, transposed by its sample axis
+    one = IOData.from_table(path, columns={"time": "t", "input": "force", "output": "acc[1]"}, units={"time": "s"})
+    np.testing.assert_array_equal(one.y[:, 0], np.cos(t))
+
+
+def test_real_measurements_from_a_mat_file():
+    """The EMPS benchmark's own file (shared data, MATLAB v5, compressed): 24 841 samples at 1 ms."""
+    path = Path(os.environ.get("SYMID_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+    path = path / "emps" / "DATA_EMPS.mat"
+    if not path.is_file():
+        pytest.skip(f"the EMPS data are not beside the repository ({path})")
+    io = IOData.from_table(path, columns={"time": "t", "input": "vir", "output": "qm"}, units={"time": "s"})
+    assert io.n_samples == 24841 and io.dt == pytest.approx(1e-3, rel=1e-9)  # the data set's README
+
+
+def test_hostile_mat_files(tmp_path):
+    cells = tmp_path / "cells.mat"
+    scipy.io.savemat(cells, {"t": np.arange(3.0), "c": np.array([[1.0], "x"], dtype=object),
+                             "s": {"a": 1.0}})
+    for name, kind in (("c", "cell"), ("s", "struct")):
+        with pytest.raises(si.DataError, match=f"variable '{name}' is a MATLAB {kind}, not a numeric array"):
+            IOData.from_table(cells, columns={"time": "t", "input": name, "output": "t"}, units={"time": "s"})
+    with pytest.raises(si.DataError, match="has no variable 'u'"):
+        IOData.from_table(cells, columns={"time": "t", "input": "u", "output": "t"}, units={"time": "s"})
+    # a compression bomb: 256 MB of zeros in a file of a few hundred kB
+    bomb = tmp_path / "bomb.mat"
+    scipy.io.savemat(bomb, {"t": np.arange(3.0), "z": np.zeros((4096, 8192))}, do_compression=True)
+    assert bomb.stat().st_size < 2**20
+    with pytest.raises(si.DataError, match="expand to more than"):
+        IOData.from_table(bomb, columns={"time": "t", "input": "t", "output": "t"}, units={"time": "s"})
+    hdf5 = tmp_path / "v73.mat"
+    hdf5.write_bytes(b"MATLAB 7.3 MAT-file, Platform: x" + b" " * 96 + b"\x89HDF\r\n\x1a\n" + b"\0" * 64)
+    with pytest.raises(si.DataError, match=r"v7.3 .HDF5. file; save it with save"):
+        IOData.from_table(hdf5, columns={"time": "t", "input": "t", "output": "t"}, units={"time": "s"})
+    lying = tmp_path / "lying.mat"
+    good = tmp_path / "good.mat"
+    scipy.io.savemat(good, {"t": np.arange(3.0)})
+    raw = bytearray(good.read_bytes())
+    raw[132:136] = (2**31).to_bytes(4, "little")  # the first element claims 2 GB
+    lying.write_bytes(bytes(raw))
+    with pytest.raises(si.DataError, match=r"more than the .* left in the file"):
+        IOData.from_table(lying, columns={"time": "t", "input": "t", "output": "t"}, units={"time": "s"})
+
+
+# -- pandas DataFrames (pandas is a test dependency, not one of symid) ------------------------------------
+
+def test_pandas_dataframe():
+    pd = pytest.importorskip("pandas", reason="pandas is in the test extra")
+    df = pd.DataFrame({"f": F_HZ, "mag": 20 * np.log10(np.abs(H_TRUE)), "ph": np.degrees(np.angle(H_TRUE)),
+                       "note": ["a", "b", "c", "d", "e"]})
+    frf = FrequencyData.from_table(df, columns={"frequency": "f", "magnitude": "mag", "phase": "ph"},
+                                   units=POLAR_UNITS)
+    np.testing.assert_allclose(frf.H[:, 0, 0], H_TRUE, rtol=1e-12)
+    with pytest.raises(si.DataError, match="must hold numbers"):
+        FrequencyData.from_table(df, columns={"frequency": "f", "magnitude": "mag", "phase": "note"},
+                                 units=POLAR_UNITS)
+
+
+def test_duck_typed_frame_without_pandas():
+    class Column:
+        def __init__(self, values):
+            self.values = values
+
+        def to_numpy(self):
+            return np.asarray(self.values)
+
+    class Frame:
+        columns = ("t", "u", "y")
+
+        def __getitem__(self, key):
+            return Column({"t": [0.0, 1.0, 2.0], "u": [1.0, 0.0, 0.0], "y": [0.0, 0.5, 0.7]}[key])
+
+    io = IOData.from_table(Frame(), columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
+    assert io.dt == 1.0 and io.n_samples == 3
+
+
+# -- the command line -------------------------------------------------------------------------------------
+
+def test_cli_identifies_from_a_plain_csv_table(tmp_path, capsys):
+    entry = si.load_model("mass_damper_2dof")
+    frf = entry.data()
+    lines = ["# units: Hz, dB, deg", "f,mag,ph"] + [
+        f"{float(w / (2 * np.pi))!r},{float(20 * np.log10(abs(h)))!r},{float(np.degrees(np.angle(h)))!r}"
+        for w, h in zip(frf.w, frf.H[:, 0, 0], strict=True)]
+    path = write_csv(tmp_path / "plain.csv", lines)
+    argv = ["identify", "mass_damper_2dof", "--data", str(path), "--method", "ipopt", "--seed", "3",
+            "--columns", "frequency=f", "magnitude=mag", "phase=ph", "--units", "frequency=Hz", "magnitude=dB",
+            "phase=deg"]
+    assert main(argv) == 0
+    assert "data: " + str(path) in capsys.readouterr().out
+    argv_bad = [*argv[:-3], "frequency=rad/s", "magnitude=dB", "phase=deg"]
+    assert main(argv_bad) == 2
+    err = capsys.readouterr().err
+    assert "the file states Hz" in err and "Traceback" not in err
+
+
+def test_cli_table_flags_need_columns(tmp_path, capsys):
+    assert main(["identify", "belt_drive", "--data", "x.csv", "--units", "frequency=Hz"]) == 2
+    assert "--units describe a table: give --columns too" in capsys.readouterr().err
+    assert main(["identify", "belt_drive", "--columns", "frequency=f"]) == 2
+    assert "describe the table given with --data" in capsys.readouterr().err
