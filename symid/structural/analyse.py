@@ -16,11 +16,47 @@ from symid.structural.local import local_analysis
 from symid.structural.numeric import numeric_local_check
 from symid.structural.report import IdentifiabilityReport, NecessaryCondition
 from symid.structural.steps import limit_reason, raise_on_error, run_global
-from symid.structural.summary import free_parameters, model_kind
+from symid.structural.summary import exhaustive_summary, free_parameters, model_kind
 
 _EXACT_LIMIT = 400
 
 __all__ = ["DEFAULT_TIMEOUT", "check_local", "identifiability", "warn_if_not_identifiable"]
+
+LOCAL = "local"
+UNDETERMINED = "local, global undetermined"
+
+
+def _verdicts_from_groebner(glob, names, loc, full_rank: bool, *, admissible: bool) -> tuple[str, dict[str, str]]:
+    """Model and per-parameter verdicts from the (generic, confirmed) global step.
+
+    "global" needs a single value over every *complex* solution (a generic property,
+    confirmed at θ**); "local" needs two admissible (or, ``admissible=False``, real)
+    solutions at θ* that differ (proven: the solutions are simple, so they persist on a
+    neighbourhood of θ*); anything between is "local, global undetermined".
+    """
+    single = glob.global_admissible if admissible else glob.global_real
+    count = glob.n_admissible if admissible else glob.n_real
+    verdicts = {}
+    for nm in names:
+        if not loc[nm]:
+            verdicts[nm] = "none"
+        elif glob.global_complex.get(nm, False):
+            verdicts[nm] = "global"
+        elif glob.zero_dimensional and full_rank and not single.get(nm, True):
+            verdicts[nm] = LOCAL
+        else:
+            verdicts[nm] = UNDETERMINED
+    if not full_rank:
+        verdict = "none"
+    elif not glob.zero_dimensional:
+        verdict = UNDETERMINED
+    elif glob.n_complex == 1:
+        verdict = "global"
+    elif count is not None and count >= 2:
+        verdict = LOCAL
+    else:
+        verdict = UNDETERMINED
+    return verdict, verdicts
 
 DEFAULT_TIMEOUT = 30.0
 """Default wall-time budget (s) of :func:`identifiability`."""
@@ -64,13 +100,29 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     Local identifiability comes from the exact rank of the Jacobian of an exhaustive
     summary (the transfer matrix at 2N + 1 + r rational frequencies, equivalent to the
     Markov parameters; see :mod:`symid.structural.local`) at two random rational points
-    (cheap, always computed). Global
-    identifiability comes from solving summary(θ) = summary(θ*) exactly at a random
-    rational θ* with a Gröbner basis, where the summary is the normalised
-    transfer-function coefficients (Markov parameters for a non-minimal realisation).
-    One admissible solution → global; k > 1 → local (k reported); infinitely many →
-    not identifiable. For parameters that are not identifiable the report lists
-    identifiable combinations and a reparameterisation.
+    (cheap, always computed). Global identifiability comes from solving
+    summary(θ) = summary(θ*) exactly with a Gröbner basis, where the summary is the
+    normalised transfer-function coefficients (Markov parameters for a non-minimal
+    realisation), at a random rational θ* that is checked to be generic: drawn from a
+    wide set (p/q, p ≤ 10⁵, q ≤ 10³), redrawn unless the Jacobian has its generic rank
+    at θ* itself and summary(θ) = summary(θ*) has no multiple solution (where solutions
+    merge, a count would be too small). Every global claim is confirmed at a second
+    independent generic point θ**.
+
+    The verdicts (model and per parameter; :data:`~symid.structural.report.VERDICTS`):
+
+    * ``"global"``: a single complex solution (model), or a single value over every
+      complex solution (parameter), at θ* and at θ**;
+    * ``"local"``: locally identifiable and *proven* not globally: two admissible
+      (real, positive where declared) solutions at θ* that differ (in that parameter),
+      from the Gröbner basis or certified by the Krawczyk test; both are simple
+      solutions, so they persist for every θ* nearby;
+    * ``"local, global undetermined"``: locally identifiable, the global question open
+      (the Gröbner step did not finish, or only positivity or realness at θ* separates
+      θ* from the other complex solutions: a count of positive solutions holds at that
+      θ* only, so it never makes a verdict "global");
+    * ``"none"``: not locally identifiable (infinitely many solutions); the report
+      then lists identifiable combinations and a reparameterisation.
 
     Parameters
     ----------
@@ -94,9 +146,10 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         (measured: under 0.1 s on the zoo models). The exact local step comes first (if
         even it does not finish, the local verdicts come from a floating-point rank,
         flagged as a screen). For a locally identifiable model the Gröbner step and a
-        numerical search for other solutions of summary(θ) = summary(θ*) (about 0.5 s)
-        then run side by side; each solution found is certified by the Krawczyk interval
-        test when the summary system is square (as many equations as unknowns).
+        numerical search for other solutions of summary(θ) = summary(θ*) (a fixed
+        number of starts, 384) then run side by side; each solution found is certified
+        by the Krawczyk interval test when the summary system is square (as many
+        equations as unknowns).
         Certified solutions that move every parameter prove the model locally but not
         globally identifiable: the report stops there, with ``n_solutions_at_least`` in
         place of the exact count. Otherwise the Gröbner step has the rest of the budget;
@@ -109,12 +162,19 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         Keep the Gröbner step running for the exact solution count k even when
         certified witnesses settle the verdicts sooner. Default False.
     seed : int, optional
-        Seed of the random rational points, an integer in [0, 2⁶³ − 1] (default 0). The
-        same model and seed give the same report, except for what wall time decides
-        (whether the Gröbner step finishes within ``timeout``, how many witnesses the
-        0.5 s search finds); the verdicts are generic, so the seed only matters on a
-        measure-zero set. ``None`` is refused rather than read as "a fresh random seed",
-        so that a report can always be reproduced.
+        Seed of the random rational points, an integer in [0, 2⁶³ − 1] (default 0).
+        The report is a deterministic function of the model, the options and the seed:
+        the same on any machine, except ``timing``. Wall time decides only how complete
+        it is, never what it asserts: whether the Gröbner step finishes within
+        ``timeout`` (else the global verdicts read ``"local, global undetermined"``,
+        or ``"local"`` where certified witnesses prove it, with a lower bound on the
+        count), and whether the exact count arrives before certified witnesses settle
+        the verdicts. The witness search runs a fixed number of starts (not a time
+        limit), so the witnesses and the lower bound do not depend on the machine's
+        speed (up to floating-point rounding of the Gauss–Newton starts, which can
+        only change which witnesses are found, each of them certified exactly). ``None``
+        is refused rather than read as "a fresh random seed", so that a report can
+        always be reproduced.
 
     Raises
     ------
@@ -140,6 +200,9 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     >>> rep = si.identifiability(model)
     >>> rep.verdict, rep.verdicts
     ('none', {'a': 'global', 'b': 'none', 'c': 'none'})
+    >>> th = si.parameters("th")
+    >>> si.identifiability(si.StateSpaceModel(A=[[-1]], B=[[th]], C=[[th]])).verdicts  # θ and −θ
+    {'th': 'local'}
     >>> [c["expression"] for c in rep.combinations]
     ['b*c']
     >>> si.identifiability(model, known={"b": 2}).verdict
@@ -174,35 +237,39 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     # One budget: the Gröbner step and, for a locally identifiable model, the witness
     # search side by side in two child processes (symid/structural/steps.py).
     out = run_global(model, known_exact, names=names, positive=pos, seed=seed, extra_candidates=monos,
-                     full_rank=full_rank, exact_count=args.exact_count, left=left)
+                     full_rank=full_rank, exact_count=args.exact_count, left=left, rank=local.rank)
     glob = out.result
     notes.extend(out.notes)
     determined = glob is not None
     witnesses, certified, theta_star = out.witnesses, out.certified, out.theta_star
-    proven_by_witnesses = out.proven_by_witnesses and not determined
+    n_cert = sum(certified)
     if determined:
         global_status = "determined"
-    elif proven_by_witnesses:
-        why = (f"Gröbner basis stopped after {out.seconds:.2g} s; exact_count=True keeps it running until the "
-               "timeout" if not args.exact_count else
-               f"Gröbner basis did not finish within the timeout of {timeout:g} s")
+    else:
         if out.limit is not None:
             why = out.limit
-        global_status = (f"NOT globally identifiable, proven by {sum(certified)} certified solution(s) θ ≠ θ* of "
-                         f"summary(θ) = summary(θ*); exact count not computed ({why})")
-    elif out.limit is not None:
-        global_status = f"undetermined ({out.limit})"
-    else:
-        global_status = f"undetermined (timeout after {timeout:g} s)"
-    if not determined and not proven_by_witnesses and witnesses:
-        global_status += (f"; {len(witnesses)} other admissible solution(s) of summary(θ) = summary(θ*) "
-                          "found numerically: NOT globally identifiable")
+        elif n_cert and not args.exact_count:
+            why = "the Gröbner basis was stopped once certified solutions settled the verdicts; exact_count=True " \
+                  "keeps it running until the timeout"
+        elif n_cert:
+            why = f"the Gröbner basis did not finish within the timeout of {timeout:g} s"
+        else:
+            why = f"timeout after {timeout:g} s"
+        if n_cert:
+            global_status = (f"NOT globally identifiable, proven by {n_cert} certified solution(s) θ ≠ θ* of "
+                             f"summary(θ) = summary(θ*); exact count not computed ({why})")
+        else:
+            global_status = f"undetermined ({why})"
+            if witnesses:
+                global_status += (f"; {len(witnesses)} other admissible solution(s) of summary(θ) = summary(θ*) "
+                                  "found numerically (not certified): evidence that the model is NOT globally "
+                                  "identifiable")
     if witnesses and not determined:
-        n_cert = sum(certified)
         notes.append(f"the {len(witnesses)} solution(s) θ ≠ θ* in `witnesses` were found by Gauss–Newton from random "
                      "starts and refined by Newton's method at 60 digits (residual < 1e-40); "
                      f"{n_cert} of them certified by the Krawczyk test in interval arithmetic (an exact real "
-                     "admissible solution within relative 1e-20, distinct from θ* and from each other)")
+                     "admissible solution within relative 1e-20, distinct from θ* and from each other, simple, so "
+                     "it persists for every θ near θ*)")
     t_global = out.seconds
 
     loc = dict(zip(names, local.identifiable, strict=True))
@@ -211,49 +278,55 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     positivity_changed = False
     solutions: tuple = ()
     if not determined:
+        star_f = {k: float(sp.Rational(v)) for k, v in theta_star.items()}
+        moved = {nm for w, ok in zip(witnesses, certified, strict=True) if ok for nm in names
+                 if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
         for nm in names:
-            verdicts[nm] = "local" if loc[nm] else "none"
-        verdict = "local" if full_rank else "none"
+            verdicts[nm] = "none" if not loc[nm] else (LOCAL if nm in moved else UNDETERMINED)
+        verdict = "none" if not full_rank else (LOCAL if n_cert else UNDETERMINED)
+        count = (f"at least {1 + n_cert} admissible solutions at θ* (certified lower bound: θ* and {n_cert} "
+                 f"solution(s) certified by the Krawczyk test; exact count not computed: {why})") if n_cert else \
+            f"not computed ({why})"
     else:
         notes.extend(glob.notes)
         n_sol, n_real, n_complex = glob.n_admissible, glob.n_real, glob.n_complex
         solutions = glob.solutions
-        for nm in names:
-            if not loc[nm]:
-                verdicts[nm] = "none"
-            else:
-                verdicts[nm] = "global" if glob.global_admissible.get(nm, False) else "local"
+        verdict, verdicts = _verdicts_from_groebner(glob, names, loc, full_rank, admissible=True)
         if not full_rank:
-            verdict = "none"
+            count = "infinitely many (the Jacobian is rank deficient: a positive-dimensional solution set)"
         elif not glob.zero_dimensional:
-            verdict = "local"
+            count = "infinitely many at θ* (a positive-dimensional part at θ* although the Jacobian has full rank)"
             notes.append("the Jacobian has full rank but the solution set has a positive-dimensional part "
                          "(non-generic points)")
         else:
-            verdict = "global" if n_sol == 1 else "local"
+            count = (f"exact: {n_complex} complex solution(s) (generic: the same at every generic θ*); at this θ*, "
+                     f"{n_real} real and {n_sol} admissible (real and positive where declared: these two "
+                     "counts depend on θ*)")
         if glob.zero_dimensional and full_rank:
-            real_verdict = "global" if n_real == 1 else "local"
-            real_params = {nm: ("global" if glob.global_real[nm] else "local") for nm in names if loc[nm]}
-            adm_params = {nm: verdicts[nm] for nm in names if loc[nm]}
-            if real_verdict != verdict or real_params != adm_params:
+            real_verdict, real_params = _verdicts_from_groebner(glob, names, loc, full_rank, admissible=False)
+            if real_verdict != verdict or real_params != verdicts:
                 positivity_changed = True
                 pos_names = [nm for nm, f in zip(names, pos, strict=True) if f]
-                changed = [nm for nm in real_params if real_params[nm] != adm_params[nm]]
+                changed = [nm for nm in names if real_params[nm] != verdicts[nm]]
                 what = f"model verdict {real_verdict} → {verdict}" if real_verdict != verdict else \
-                    f"verdict of {', '.join(changed)} local → global"
+                    f"verdict of {', '.join(changed)} {real_params[changed[0]]} → {verdicts[changed[0]]}"
                 notes.append(f"positivity ({', '.join(pos_names)} > 0) discarded {n_real - n_sol} of {n_real} real "
-                             f"solutions: {what}")
+                             f"solutions at θ*: {what}")
             elif n_real is not None and n_sol is not None and n_real > n_sol:
-                notes.append(f"positivity discarded {n_real - n_sol} of {n_real} real solutions (verdict unchanged)")
+                notes.append(f"positivity discarded {n_real - n_sol} of {n_real} real solutions at θ* (verdict "
+                             "unchanged)")
             if n_complex and n_real is not None and n_complex > n_real:
-                cplx_verdict = "global" if n_complex == 1 else "local"
-                msg = f"{n_complex - n_real} of {n_complex} complex solutions are not real and were discarded"
-                if cplx_verdict != real_verdict:
-                    msg += f" (over ℂ the verdict would be {cplx_verdict})"
-                notes.append(msg)
-            if verdict == "local":
-                notes.append("counts of real and positive solutions are at the random point θ*; elsewhere they "
+                notes.append(f"{n_complex - n_real} of {n_complex} complex solutions are not real at θ* and were "
+                             "discarded")
+            if n_complex is not None and n_complex > 1 and n_sol == 1:
+                notes.append(f"only θ* itself is admissible at θ*, but summary(θ) = summary(θ*) has {n_complex} "
+                             "complex solutions: whether the others become admissible elsewhere depends on θ*, so "
+                             "the global verdict is undetermined (not 'global': that would hold at this θ* only)")
+            if n_complex is not None and n_complex > 1:
+                notes.append("counts of real and admissible solutions are at the random point θ*; elsewhere they "
                              f"can differ (the complex count, {n_complex}, is generic)")
+        if glob.confirmed and glob.theta_confirm:
+            notes.append("global verdicts confirmed at a second independent random point θ** (same result)")
 
     # -- combinations and reparameterisation -------------------------------------
     combos, reparam, fix = [], {}, ()
@@ -264,6 +337,12 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
             candidates += [(e, "groebner", True) for e in gb]
             sm = sorted(glob.summary_expressions, key=_complexity)
             candidates += [(e, "summary", True) for e in sm]
+        else:  # the summary entries are identifiable functions: no Gröbner basis needed
+            status_s, exprs = run_with_deadline(_summary_expressions, {"model": model, "known": known_exact}, left())
+            if status_s == "ok":
+                candidates += [(e, "summary", True) for e in sorted(exprs, key=_complexity)]
+            else:
+                notes.append("the summary entries were not computed within the budget: no combinations from them")
         chosen = select_combinations(local, candidates)
         combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global} for c in chosen]
         reparam = {f"phi{i + 1}": c["expression"] for i, c in enumerate(combos)}
@@ -291,8 +370,14 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         necessary_condition=necessary, combinations=tuple(combos), reparameterisation=reparam, fix=fix,
         positivity_changed=positivity_changed, notes=tuple(notes), theta_star=theta_star,
         solutions=tuple(solutions), witnesses=witnesses, witnesses_certified=tuple(certified),
-        n_solutions_at_least=(1 + sum(certified)) if proven_by_witnesses else None,
-        verdicts_proven=determined or proven_by_witnesses, timing=timing)
+        n_solutions_at_least=(1 + n_cert) if (n_cert and not determined) else None,
+        verdicts_proven=verdict != UNDETERMINED and UNDETERMINED not in verdicts.values(), timing=timing,
+        theta_confirm=dict(glob.theta_confirm) if determined else {}, solution_count=count)
+
+
+def _summary_expressions(model, known) -> list:
+    """The exhaustive summary's entries as sympy expressions (run in a child process)."""
+    return exhaustive_summary(model, known).expressions()
 
 
 def _check_fix(model, known_exact, fix: tuple[str, ...], seed: int, budget: float | None) -> str:

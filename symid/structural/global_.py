@@ -32,7 +32,7 @@ from __future__ import annotations
 import random
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import sympy as sp
@@ -41,7 +41,8 @@ from sympy.polys.groebnertools import groebner
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
-from symid.errors import SolverError
+from symid.errors import ModelError, SolverError
+from symid.structural.local import rank_at
 from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
     KIND_TF,
@@ -52,8 +53,8 @@ from symid.structural.summary import (
     model_matrices,
 )
 
-__all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "ExactStepLimit", "GlobalResult", "global_analysis",
-           "star_and_summary"]
+__all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "ExactStepLimit", "GlobalResult", "NonGenericPoint",
+           "draw_point", "generic_global", "global_analysis", "star_and_summary"]
 
 REAL_TOL = 1e-7
 """Relative tolerance on a parameter value when comparing numerical solutions to θ*."""
@@ -130,29 +131,95 @@ class GlobalResult:
     groebner_size: int
     times: dict = field(default_factory=dict)
     notes: tuple = ()
+    theta_confirm: dict = field(default_factory=dict)
+    confirmed: bool = False
+    draws: int = 1
 
 
-def _pick_theta_star(model, mats, kind, output, params, rng: random.Random):
+STAR_NUMERATORS = (1, 100_000)
+"""θ* coordinates are p/q with p and q uniform in these ranges (wide: see :func:`draw_point`)."""
+STAR_DENOMINATORS = (1, 1_000)
+MAX_DRAWS = 8
+"""Draws of θ* (each of up to 50 candidates) before the global step gives up finding a generic point."""
+
+
+class NonGenericPoint(SolverError):
+    """θ* lies on a special set (rank drop, coinciding solutions): draw another (:func:`generic_global`)."""
+
+
+def draw_point(rng: random.Random, n: int, *, negative: Sequence[bool] | None = None) -> list[sp.Rational]:
+    """A random rational point: p/q with p ∈ [1, 10⁵], q ∈ [1, 10³] (about 6·10⁷ distinct values per coordinate).
+
+    By the Schwartz–Zippel lemma a polynomial of degree D that does not vanish
+    identically vanishes at such a point with probability at most D / 10⁵; the
+    special sets that matter here (a rank drop of the Jacobian, coinciding solutions)
+    are moreover checked at the point itself. ``negative``: per coordinate, draw the
+    sign at random (parameters not declared positive).
+
+    Examples
+    --------
+    >>> import random
+    >>> from symid.structural.global_ import draw_point
+    >>> draw_point(random.Random(0), 2)
+    [50495/777, 27563/21]
+    """
+    out = []
+    for i in range(n):
+        v = sp.Rational(rng.randint(*STAR_NUMERATORS), rng.randint(*STAR_DENOMINATORS))
+        if negative is not None and negative[i] and rng.random() < 0.5:
+            v = -v
+        out.append(v)
+    return out
+
+
+def _pick_theta_star(model, mats, kind, output, params, rng: random.Random, *, known=None, rank: int | None = None):
+    """A random θ* where M(θ*) is invertible and, when ``rank`` is given, the Jacobian has that (generic) rank.
+
+    A realisation minimal at θ* is preferred (the transfer-function summary is then
+    exhaustive); ``(point, minimal)``.
+    """
+    fallback, singular = None, 0
     for _ in range(50):
-        vals = rng.sample(range(2, 21), len(params)) if len(params) <= 19 else \
-            [rng.randint(2, 40) for _ in params]
-        pt = [sp.Integer(v) for v in vals]
+        pt = draw_point(rng, len(params))
         if kind == "second-order":
             M = mats["M"].xreplace(dict(zip(params, pt, strict=True)))
             if M.det() == 0:
+                singular += 1
                 continue
+        if rank is not None and rank_at(model, pt, known, rng=rng) < rank:
+            continue
         if is_minimal_at(mats, kind, output, params, pt):
             return pt, True
-    return pt, False
+        if fallback is None:
+            fallback = pt
+    if singular == 50:
+        raise ModelError("det M(θ) is identically zero (singular at 50 random points); the second-order model is "
+                         "degenerate")
+    if fallback is None:
+        raise ExactStepLimit("no point θ* with the generic Jacobian rank found in 50 random draws")
+    return fallback, False
 
 
-def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: int = 0):
+def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: int = 0, draw: int = 0,
+                     rank: int | None = None):
     """The random point θ* of the global step and the exhaustive summary built for it.
+
+    Parameters
+    ----------
+    model, known
+        As for :func:`global_analysis`.
+    seed : int
+        The seed of the analysis.
+    draw : int
+        Which independent point of the seed's sequence (0 is θ*; the confirmation point
+        and the redraws after a non-generic θ* use others), 0 ≤ draw < 1000.
+    rank : int, optional
+        The generic rank of the Jacobian: θ* is redrawn until the Jacobian has it at θ*.
 
     Returns
     -------
     (params, star, minimal, summary, rng)
-        Free parameters, θ* (sympy Integers), whether the realisation is minimal there,
+        Free parameters, θ* (sympy Rationals), whether the realisation is minimal there,
         the :class:`~symid.structural.summary.ExhaustiveSummary` and the seeded
         generator, advanced past θ* (for later random choices).
     """
@@ -160,8 +227,8 @@ def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: 
     output = getattr(model, "output", None)
     mats = model_matrices(model, known)
     params = free_parameters(model, known)
-    rng = random.Random(10_007 + seed)
-    star, minimal = _pick_theta_star(model, mats, kind, output, params, rng)
+    rng = random.Random(10_007 + 1000 * seed + draw)
+    star, minimal = _pick_theta_star(model, mats, kind, output, params, rng, known=known, rank=rank)
     summ = exhaustive_summary(model, known, check_point=star)
     return params, star, minimal, summ, rng
 
@@ -408,6 +475,8 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
             Grad = groebner(list(G) + extra, R)
             rbasis = _standard_monomials([g.LM for g in Grad], nv, MAX_QUOTIENT)
             n_c = len(rbasis)
+            if n_c < len(basis):  # a multiple solution: θ* is where solutions merge (never at a generic point)
+                raise NonGenericPoint(f"{len(basis)} solutions counted with multiplicity but {n_c} distinct")
             rmm = _mult_matrices(Grad, R, rbasis, range(nv))
             sols_all, n_r = _solve_numeric(rmm, theta_idx, rng, x)
             for s in sols_all:
@@ -460,3 +529,77 @@ def _solve_numeric(mm: dict[int, DomainMatrix], theta_idx, rng: random.Random, x
         out.append({"real": is_real, "values": [float(np.real(vals[v])) if is_real else complex(vals[v])
                                                 for v in range(nv)]})
     return out, n_real
+
+
+def _claims_global(res: GlobalResult) -> bool:
+    return (res.zero_dimensional and res.n_complex == 1) or any(res.global_complex.values())
+
+
+def generic_global(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
+                   seed: int = 0, rank: int | None = None, extra_candidates: Sequence[sp.Expr] = (),
+                   expressions: bool = True) -> GlobalResult:
+    """:func:`global_analysis` at a θ* checked to be generic, and its global claims confirmed at a second point.
+
+    1. θ* is drawn (:func:`draw_point`) until the Jacobian has the generic rank
+       ``rank`` at θ* itself (a rank drop is where solutions merge), and the global
+       step is redone at a new θ* when summary(θ) = summary(θ*) has a multiple
+       solution (the quotient algebra is larger than the number of distinct solutions);
+    2. when the result claims anything global (a single complex solution, or a
+       parameter with a single value over every complex solution), the step is
+       repeated at an independent generic point θ**, and a parameter is global only
+       when it is at both points (the larger solution count is kept).
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.global_ import generic_global
+    >>> a, b = si.parameters("a b")
+    >>> res = generic_global(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]]), rank=2)
+    >>> res.n_complex, res.confirmed, sorted(res.global_complex.items())
+    (1, True, [('a', True), ('b', True)])
+    """
+    notes: list[str] = []
+    res = None
+    for draw in range(MAX_DRAWS):
+        prepared = star_and_summary(model, known, seed=seed, draw=draw, rank=rank)
+        try:
+            res = global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
+                                  expressions=expressions, prepared=prepared)
+            break
+        except NonGenericPoint as exc:
+            star = ", ".join(str(v) for v in prepared[1])
+            notes.append(f"θ* = ({star}) was not generic ({exc}); drawn again")
+    if res is None:
+        raise ExactStepLimit(f"no generic point θ* in {MAX_DRAWS} random draws")
+    draws = draw + 1
+    if not _claims_global(res):
+        return replace(res, notes=(*res.notes, *notes), draws=draws)
+    other = None
+    for draw2 in range(500, 500 + MAX_DRAWS):
+        prepared = star_and_summary(model, known, seed=seed, draw=draw2, rank=rank)
+        try:
+            other = global_analysis(model, known, positive=positive, seed=seed, expressions=False, prepared=prepared)
+            break
+        except NonGenericPoint as exc:
+            star = ", ".join(str(v) for v in prepared[1])
+            notes.append(f"θ** = ({star}) was not generic ({exc}); drawn again")
+    if other is None:
+        raise ExactStepLimit(f"no generic confirmation point θ** in {MAX_DRAWS} random draws")
+    glob_c = {k: v and other.global_complex.get(k, False) for k, v in res.global_complex.items()}
+    agree = glob_c == res.global_complex and other.zero_dimensional == res.zero_dimensional and \
+        other.n_complex == res.n_complex
+    if not agree:
+        notes.append(f"the independent point θ** gave a different result ({other.n_complex} complex solutions there, "
+                     f"{res.n_complex} at θ*): the larger count and only the parameters global at both points are "
+                     "kept")
+        if other.n_complex is not None and res.n_complex is not None and other.n_complex > res.n_complex:
+            res = replace(other, candidates=res.candidates, membership=res.membership,
+                          summary_expressions=res.summary_expressions)
+        elif not other.zero_dimensional and res.zero_dimensional:
+            res = replace(other, candidates=res.candidates, membership=res.membership,
+                          summary_expressions=res.summary_expressions)
+        glob_r = {k: v and glob_c[k] for k, v in res.global_real.items()}
+        glob_a = {k: v and glob_c[k] for k, v in res.global_admissible.items()}
+        res = replace(res, global_complex=glob_c, global_real=glob_r, global_admissible=glob_a)
+    theta2 = {k: str(v) for k, v in other.theta_star.items()}
+    return replace(res, notes=(*res.notes, *notes), theta_confirm=theta2, confirmed=agree, draws=draws)

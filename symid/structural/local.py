@@ -40,7 +40,7 @@ from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 from symid.errors import ModelError
 from symid.structural.summary import free_parameters, model_kind, rational
 
-__all__ = ["LocalResult", "PoleError", "jacobian_at", "local_analysis", "random_point"]
+__all__ = ["LocalResult", "PoleError", "jacobian_at", "local_analysis", "random_point", "rank_at"]
 
 
 class PoleError(ModelError):
@@ -281,3 +281,30 @@ def local_analysis(model, known: Mapping[str, object] | None = None, *, seed: in
     best = ranks.index(rank)
     ident = tuple(all(vec[k] == 0 for vec in nulls[best]) for k in range(len(free)))
     return LocalResult(tuple(free), tuple(points), tuple(ranks), rank, tuple(nulls), ident)
+
+
+def rank_at(model, point: Sequence, known: Mapping[str, object] | None = None, *, rng: random.Random | None = None
+            ) -> int:
+    """Exact rank of the summary's Jacobian at ``point`` (random frequencies, redrawn when one is a pole).
+
+    Used to check that the point θ* of the global step is not special: a rank below the
+    generic rank there means θ* lies where solutions of summary(θ) = summary(θ*) merge.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.local import rank_at
+    >>> a, b = si.parameters("a b")
+    >>> rank_at(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]]), [1, 2])
+    2
+    """
+    parts = _affine_parts(model, known)
+    shift = _SHIFT.get(parts.output, 0)
+    rng = random.Random(0) if rng is None else rng
+    for _ in range(20):
+        freqs = _frequencies(rng, 2 * parts.n_order + 1 + shift)
+        try:
+            return jacobian_at(model, point, known, frequencies=freqs, _parts=parts).rank()
+        except PoleError:
+            continue
+    raise ModelError("the transfer function has a pole at every random test frequency; is M(θ) singular?")

@@ -6,13 +6,17 @@ from dataclasses import asdict, dataclass, field
 from fractions import Fraction
 from typing import Any
 
-__all__ = ["IdentifiabilityReport", "NecessaryCondition"]
+__all__ = ["VERDICTS", "IdentifiabilityReport", "NecessaryCondition"]
 
 _VERDICT_TEXT = {
     "global": "GLOBALLY IDENTIFIABLE",
-    "local": "LOCALLY IDENTIFIABLE (finitely many solutions)",
+    "local": "LOCALLY, NOT GLOBALLY IDENTIFIABLE (finitely many solutions)",
+    "local, global undetermined": "LOCALLY IDENTIFIABLE (global verdict undetermined)",
     "none": "NOT IDENTIFIABLE",
 }
+
+VERDICTS = ("global", "local", "local, global undetermined", "none")
+"""The values of ``verdict`` and ``verdicts[name]``."""
 
 
 @dataclass(frozen=True)
@@ -58,11 +62,20 @@ class IdentifiabilityReport:
     known : dict of str to float
         Parameters fixed by ``known=``.
     verdict : str
-        Model verdict: ``"global"``, ``"local"`` or ``"none"``.
+        Model verdict, one of :data:`VERDICTS`: ``"global"`` (one solution of
+        summary(θ) = summary(θ*) over ℂ, at a generic θ* and confirmed at a second
+        point), ``"local"`` (locally identifiable and *proven* not globally: two
+        admissible solutions at θ*, from the Gröbner step or certified witnesses),
+        ``"local, global undetermined"`` (locally identifiable; the global question is
+        open: the Gröbner step did not finish, or only positivity or realness at θ*
+        separates θ* from the other complex solutions) or ``"none"`` (not locally
+        identifiable).
     verdicts : dict of str to str
-        Per free parameter: ``"global"``, ``"local"`` or ``"none"``. When the global
-        step did not finish, locally identifiable parameters read ``"local"`` and
-        ``global_determined`` is False.
+        Per free parameter, the same four values: ``"global"`` when the parameter
+        takes a single value over every complex solution (at θ* and θ**), ``"local"``
+        when it takes two values over admissible solutions at θ* (Gröbner step or a
+        certified witness), ``"local, global undetermined"`` when locally identifiable
+        and neither is shown, ``"none"`` when not locally identifiable.
     locally_identifiable : dict of str to bool
         Per free parameter, from the Jacobian's null space.
     global_determined : bool
@@ -73,10 +86,13 @@ class IdentifiabilityReport:
         Gröbner step finished; or ``"undetermined (...)"`` with the reason (timeout,
         error).
     n_solutions : int or None
-        Admissible solutions of summary(θ) = summary(θ*) (real, positive where declared);
-        None when infinitely many or undetermined.
-    n_solutions_real, n_solutions_complex : int or None
-        Distinct real / complex solutions.
+        Admissible solutions of summary(θ) = summary(θ*) (real, positive where declared)
+        *at this θ**: not a structural number (it can differ at another θ*); None when
+        infinitely many or undetermined.
+    n_solutions_real : int or None
+        Distinct real solutions at this θ* (also depends on θ*).
+    n_solutions_complex : int or None
+        Distinct complex solutions: the generic (structural) count.
     jacobian_ranks : tuple of int
         Exact Jacobian rank at each random rational point (out of ``len(parameters)``).
     summary_kind : str or None
@@ -107,14 +123,22 @@ class IdentifiabilityReport:
         Per witness, whether the Krawczyk interval test proved an exact admissible
         solution next to it (see :mod:`symid.structural.witness`).
     n_solutions_at_least : int or None
-        When certified witnesses settled the verdicts without the exact count:
-        1 + the number of certified witnesses, a proven lower bound of the number of
-        admissible solutions.
+        When the Gröbner step did not finish and witnesses were certified: 1 + the
+        number of certified witnesses, a proven lower bound of the number of admissible
+        solutions at θ*. The witness search runs a fixed number of starts, so this
+        number does not depend on the machine's speed.
     verdicts_proven : bool
-        Whether the model verdict and every per-parameter verdict are proven: by the
-        Gröbner step, or by certified witnesses that move every parameter.
+        Whether no verdict is ``"local, global undetermined"``.
     timing : dict of str to float
-        Wall time (s) of ``local``, ``global`` and ``total``.
+        Wall time (s) of ``local``, ``global`` and ``total`` (the only part of the
+        report that depends on the machine).
+    theta_confirm : dict of str to str
+        The independent point θ** at which global claims were confirmed (empty when
+        nothing was claimed global or the Gröbner step did not finish).
+    solution_count : str
+        The solution count in words: exact (complex, generic; real and admissible at
+        θ*), a certified lower bound with the reason the exact count is missing, or why
+        it was not computed.
     """
 
     model: str
@@ -144,6 +168,8 @@ class IdentifiabilityReport:
     n_solutions_at_least: int | None = None
     verdicts_proven: bool = False
     timing: dict[str, float] = field(default_factory=dict)
+    theta_confirm: dict[str, str] = field(default_factory=dict)
+    solution_count: str = ""
 
     @property
     def identifiable(self) -> tuple[str, ...]:
@@ -172,15 +198,14 @@ class IdentifiabilityReport:
         L.append("=" * min(max(len(L[0]), 40), 100))
         verdict = _VERDICT_TEXT[self.verdict]
         if self.verdict == "local" and self.n_solutions is not None:
-            verdict = f"LOCALLY IDENTIFIABLE ({self.n_solutions} solutions)"
-        if not self.global_determined and self.verdict == "local":
-            verdict = "LOCALLY IDENTIFIABLE (global verdict undetermined)"
-            if self.n_solutions_at_least is not None:
-                verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE (proven; at least {self.n_solutions_at_least} "
-                           "solutions, exact count not computed)")
-            elif self.witnesses:
-                verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE (at least {1 + len(self.witnesses)} solutions found "
-                           "numerically; exact count undetermined)")
+            verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE ({self.n_solutions_complex} complex solutions; "
+                       f"{self.n_solutions} admissible at θ*)")
+        elif self.verdict == "local" and self.n_solutions_at_least is not None:
+            verdict = (f"LOCALLY, NOT GLOBALLY IDENTIFIABLE (proven; at least {self.n_solutions_at_least} "
+                       "solutions, exact count not computed)")
+        elif self.verdict == "local, global undetermined" and self.witnesses:
+            verdict = (f"LOCALLY IDENTIFIABLE (global verdict undetermined; {len(self.witnesses)} other "
+                       "solution(s) found numerically, not certified)")
         L.append(f"verdict            : {verdict}")
         if self.known:
             L.append("known              : " + ", ".join(f"{k} = {v:g}" for k, v in self.known.items()))
@@ -200,6 +225,8 @@ class IdentifiabilityReport:
                        f"{self.n_solutions_complex} complex")
             L.append(f"global (Gröbner)   : summary(θ) = summary(θ*): {sol}")
             L.append(f"summary            : {self.n_summary} {self.summary_kind}")
+            if self.theta_confirm:
+                L.append("confirmed          : at an independent point θ**")
         else:
             L.append(f"global (Gröbner)   : {self.global_status}")
         L.append("")
@@ -210,13 +237,13 @@ class IdentifiabilityReport:
         for p in self.parameters:
             v = self.verdicts[p]
             if v == "local" and not self.global_determined:
-                if p not in not_global:
-                    v = "local (global undetermined)"
-                elif self.verdicts_proven:
-                    v = "local (not global: differs at a certified witness)"
-                else:
-                    v = "local (not global: differs at a numerical witness)"
+                v = "local (not global: differs at a certified witness)"
+            elif v == "local, global undetermined" and p in not_global:
+                v = "local, global undetermined (differs at a numerical witness, not certified)"
             L.append(f"  {p:<{width}}  {v}")
+        if self.solution_count:
+            L.append("")
+            L.append(f"solutions: {self.solution_count}")
         if self.combinations:
             L.append("")
             L.append("identifiable combinations:")

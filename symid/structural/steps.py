@@ -32,13 +32,10 @@ import sympy as sp
 
 from symid.errors import ModelError, SolverError
 from symid.structural.deadline import Running, run_with_deadline, start, wait_any
-from symid.structural.global_ import GlobalResult, global_analysis, star_and_summary
+from symid.structural.global_ import GlobalResult, generic_global, star_and_summary
 from symid.structural.witness import WitnessResult, find_witnesses
 
 __all__ = ["GlobalOutcome", "limit_reason", "raise_on_error", "run_global"]
-
-WITNESS_SEARCH = 0.5
-"""Seconds after which the witness search begins no new batch of starts (when it has found one)."""
 
 HEAD_START = 0.05
 """Seconds the Gröbner step runs alone before the witness search starts (a fork costs ~7 ms here; most zoo
@@ -48,17 +45,16 @@ _MODEL_ERRORS = ("ModelError", "NonAffineError", "PoleError", "DataError")
 _LIMITS = ("ExactStepLimit", "MemoryError")
 
 
-def _global_step(model, known, positive, seed, extra_candidates, expressions):
-    """θ*, the summary and the Gröbner step, in one child process."""
-    prepared = star_and_summary(model, known, seed=seed)
-    return global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
-                           expressions=expressions, prepared=prepared)
+def _global_step(model, known, positive, seed, extra_candidates, expressions, rank):
+    """A generic θ*, the summary and the Gröbner step (confirmed at θ**), in one child process."""
+    return generic_global(model, known, positive=positive, seed=seed, rank=rank, extra_candidates=extra_candidates,
+                          expressions=expressions)
 
 
-def _witness_step(model, known, positive, seed, max_time):
-    """θ*, the summary and the numerical witness search, in one child process."""
-    prepared = star_and_summary(model, known, seed=seed)
-    return find_witnesses(model, known, positive=positive, seed=seed, max_time=max_time, prepared=prepared)
+def _witness_step(model, known, positive, seed, rank):
+    """θ* (the Gröbner step's first draw), the summary and the numerical witness search, in one child process."""
+    prepared = star_and_summary(model, known, seed=seed, rank=rank)
+    return find_witnesses(model, known, positive=positive, seed=seed, prepared=prepared)
 
 
 def limit_reason(step: str, status: str, value: object) -> str | None:
@@ -145,13 +141,13 @@ def _read_witnesses(out: GlobalOutcome, wit: WitnessResult, names: Sequence[str]
                "the Krawczyk test needs as many summary equations as unknowns; this system has more")
         out.notes.append(f"the witnesses are not certified ({why}): they are numerical evidence, not a proof")
     elif not wit.witnesses:
-        out.notes.append(f"no second solution found numerically ({wit.n_starts} starts in {wit.seconds:.1f} s); "
-                         "this proves nothing about the global verdict")
+        out.notes.append(f"no second solution found numerically ({wit.n_starts} starts); this proves nothing "
+                         "about the global verdict")
 
 
 def run_global(model, known: Mapping[str, sp.Rational], *, names: Sequence[str], positive: Sequence[bool],
                seed: int, extra_candidates: Sequence[sp.Expr], full_rank: bool, exact_count: bool,
-               left: Callable[[], float | None]) -> GlobalOutcome:
+               left: Callable[[], float | None], rank: int | None = None) -> GlobalOutcome:
     """Run the Gröbner step (and, for a full-rank Jacobian, the witness search beside it) within ``left()`` s.
 
     ``left()`` gives the seconds left of the budget (``None``: no limit, and the
@@ -160,12 +156,12 @@ def run_global(model, known: Mapping[str, sp.Rational], *, names: Sequence[str],
     t1 = time.perf_counter()
     out = GlobalOutcome()
     g_kwargs = {"model": model, "known": known, "positive": list(positive), "seed": seed,
-                "extra_candidates": list(extra_candidates), "expressions": not full_rank}
+                "extra_candidates": list(extra_candidates), "expressions": not full_rank, "rank": rank}
     if left() is None:  # no deadline: the exact answer, in this process
         status, value = run_with_deadline(_global_step, g_kwargs, None)
     else:
         status, value = _side_by_side(model, known, names, positive, seed, g_kwargs, full_rank, exact_count,
-                                      left, out)
+                                      left, out, rank)
     out.limit = limit_reason("Gröbner step", status, value)
     if out.limit is None:
         raise_on_error("global (Gröbner basis)", status, value)
@@ -178,7 +174,7 @@ def run_global(model, known: Mapping[str, sp.Rational], *, names: Sequence[str],
 
 
 def _side_by_side(model, known, names, positive, seed, g_kwargs, full_rank, exact_count, left,
-                  out: GlobalOutcome) -> tuple[str, object]:
+                  out: GlobalOutcome, rank) -> tuple[str, object]:
     gjob: Running | None = None
     wjob: Running | None = None
     status, value = "timeout", None
@@ -186,7 +182,7 @@ def _side_by_side(model, known, names, positive, seed, g_kwargs, full_rank, exac
         gjob = start(_global_step, g_kwargs)
         if full_rank and gjob.wait(min(HEAD_START, left()))[0] == "timeout":  # a fast basis needs no witnesses
             wjob = start(_witness_step, {"model": model, "known": known, "positive": list(positive), "seed": seed,
-                                         "max_time": WITNESS_SEARCH})
+                                         "rank": rank})
         while True:
             wait_any([j for j in (gjob, wjob) if j is not None], left())
             status, value = gjob.wait(0)

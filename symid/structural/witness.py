@@ -168,7 +168,7 @@ def _verify(exact, x: np.ndarray) -> list | None:
     nv = len(x)
     with mpmath.workdps(_DIGITS):
         X = [mpmath.mpf(float(v)) for v in x]
-        coefs = [[(mon, mpmath.mpf(c.numerator) / c.denominator) for mon, c in terms] for terms in exact]
+        coefs = [[(mon, mpmath.mpf(int(c.numerator)) / int(c.denominator)) for mon, c in terms] for terms in exact]
         last, floor = None, mpmath.mpf(10) ** (5 - _DIGITS)
         for _ in range(12):
             F = mpmath.matrix(len(exact), 1)
@@ -216,7 +216,7 @@ def _interval_terms(exact) -> list[list[tuple[tuple[tuple[int, int], ...], objec
     """Per polynomial: (sparse monomial ((variable, exponent), ...), enclosing interval of the coefficient)."""
     with _iv_precision():
         return [[(tuple((v, e) for v, e in enumerate(mon) if e),
-                  mpmath.iv.mpf(c.numerator) / mpmath.iv.mpf(c.denominator)) for mon, c in terms]
+                  mpmath.iv.mpf(int(c.numerator)) / mpmath.iv.mpf(int(c.denominator))) for mon, c in terms]
                 for terms in exact]
 
 
@@ -290,7 +290,7 @@ def _krawczyk(terms, den_terms, x, star, positive) -> tuple | None:
                 k += m * (box[j] - mid[j])
             if not (k.a > box[i].a and k.b < box[i].b):
                 return None
-        star_iv = [iv.mpf(v.numerator) / iv.mpf(v.denominator) for v in star]
+        star_iv = [iv.mpf(int(v.numerator)) / iv.mpf(int(v.denominator)) for v in star]
         if not any(star_iv[i].b < box[i].a or star_iv[i].a > box[i].b for i in range(nv)):
             return None  # the box may contain θ*
         if any(positive[i] and not box[i].a > 0 for i in range(nv)):
@@ -306,7 +306,7 @@ def _disjoint(a, b) -> bool:
 
 
 def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
-                   seed: int = 0, max_time: float = 2.0, batch: int = 48,
+                   seed: int = 0, batches: int = 8, batch: int = 48,
                    prepared: tuple | None = None) -> WitnessResult:
     """Search for admissible solutions θ ≠ θ* of summary(θ) = summary(θ*), and verify them.
 
@@ -319,8 +319,10 @@ def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive
         Per free parameter, whether only positive values are admissible.
     seed : int
         Seed of θ* (the same as :func:`~symid.structural.global_.global_analysis`) and of the starts.
-    max_time : float
-        Seconds after which no new batch of starts is begun (one batch always runs).
+    batches : int
+        Number of batches of starts (the search stops earlier once eight witnesses are
+        found). A fixed number of starts, not a time limit: the same model and seed give
+        the same witnesses on any machine.
     batch : int
         Starts per batch.
     prepared : tuple, optional
@@ -337,8 +339,9 @@ def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive
     >>> from symid.structural.witness import find_witnesses
     >>> th = si.parameters("th")
     >>> model = si.StateSpaceModel(A=[[-1]], B=[[th]], C=[[th]])  # θ and −θ give the same H
-    >>> res = find_witnesses(model, max_time=0.5)
-    >>> [round(w["th"] / float(res.theta_star["th"]), 9) for w in res.witnesses]
+    >>> res = find_witnesses(model, batches=1)
+    >>> from fractions import Fraction
+    >>> [round(w["th"] / float(Fraction(res.theta_star["th"])), 9) for w in res.witnesses]
     [-1.0]
     """
     t0 = time.perf_counter()
@@ -368,7 +371,9 @@ def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive
     rng = np.random.default_rng(random.Random(seed).randrange(2**32))
     found: list[np.ndarray] = []
     n_starts = 0
-    while (n_starts == 0 or time.perf_counter() - t0 < max_time) and len(found) < _MAX_WITNESSES:
+    for _ in range(batches):
+        if len(found) >= _MAX_WITNESSES:
+            break
         mag = xs * np.exp(rng.normal(0.0, 1.5, (batch, nv)))
         sign = np.where(pos, 1.0, rng.choice([-1.0, 1.0], (batch, nv)))
         X, res = _newton(compiled, mag * sign, 40)
@@ -382,8 +387,6 @@ def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive
                 continue
             if any(np.all(np.abs(x - f) <= 1e-6 * np.maximum(1.0, np.abs(f))) for f in found):
                 continue
-            if found and time.perf_counter() - t0 > max_time:
-                break
             sol_mp = _verify(exact, x)
             if sol_mp is None:
                 continue
