@@ -78,3 +78,29 @@ def test_global_verdicts_are_confirmed_at_a_second_point():
     assert set(rep.theta_confirm) == set(rep.parameters) and rep.theta_confirm != rep.theta_star
     assert any("confirmed at a second independent random point" in n for n in rep.notes)
     assert "exact: 1 complex solution" in rep.solution_count
+
+
+def test_a_report_settled_by_witnesses_is_the_same_at_every_run():
+    # random5 (thesis (6-29)): the Gröbner basis does not finish, certified witnesses settle the
+    # verdicts. The witness search runs a fixed number of starts (no time limit), so the
+    # witnesses and the certified lower bound on the count do not depend on the machine's speed
+    model = si.load_model("random5").model
+    one, two = (si.identifiability(model, seed=3).to_dict() for _ in range(2))
+    one.pop("timing"), two.pop("timing")
+    assert one == two
+    assert one["verdict"] == "local" and one["n_solutions_at_least"] == 1 + sum(one["witnesses_certified"]) >= 2
+    assert "certified lower bound" in one["solution_count"]
+
+
+def test_bad_input_gives_a_named_error_or_a_correct_report():
+    with pytest.raises(si.ModelError, match="the model has no parameter: there is nothing to identify"):
+        si.identifiability(si.SecondOrderModel(M=[[1]], V=[[1]], K=[[2]], B=[[1]], C=[[1]]))
+    a, b, hidden = si.parameters("a b hidden", positive=True)
+    with pytest.raises(si.ModelError, match=r"every parameter \(a, b\) is given in known="):
+        si.identifiability(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]]), known={"a": 1, "b": 2})
+    # a parameter that never reaches the output (an unobservable state): H(s) = 1/(s + a)
+    rep = si.identifiability(si.StateSpaceModel(A=[[-a, 0], [0, -hidden]], B=[[1], [1]], C=[[1, 0]]))
+    assert rep.verdicts == {"a": "global", "hidden": "none"} and rep.verdict == "none"
+    # no parameter reaches the output (C = 0): H ≡ 0, nothing is identifiable, no crash
+    rep = si.identifiability(si.StateSpaceModel(A=[[-a, 0], [0, -b]], B=[[1], [1]], C=[[0, 0]]))
+    assert rep.verdicts == {"a": "none", "b": "none"} and rep.jacobian_ranks == (0, 0)
