@@ -50,6 +50,17 @@ def _positive_seconds(text: str) -> float:
     return value
 
 
+def _positive_number(text: str) -> float:
+    """An argparse type: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0; got {text}")
+    return value
+
+
 def _known_values(items: Sequence[str] | None, command: str) -> dict[str, float]:
     known: dict[str, float] = {}
     for item in items or []:
@@ -96,16 +107,27 @@ def _output_dir(path: str | None, command: str):
 def _cmd_models(args: argparse.Namespace) -> int:
     from symid.zoo import list_models, load_model
 
-    for name in list_models():
-        entry = load_model(name)
-        print(f"{name:28s} {entry.title}  [{entry.source}]")
+    entries = [load_model(name) for name in list_models()]
+    if args.json:
+        import json
+
+        print(json.dumps([{"name": e.name, "title": e.title, "source": e.source} for e in entries], indent=2))
+        return 0
+    for entry in entries:
+        print(f"{entry.name:28s} {entry.title}  [{entry.source}]")
     return 0
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
     from symid.zoo import load_model
 
-    print(load_model(args.model).summary())
+    spec = load_model(args.model)
+    if args.json:
+        import json
+
+        print(json.dumps(spec.to_dict(), indent=2, default=_json_default))
+    else:
+        print(spec.summary())
     return 0
 
 
@@ -175,12 +197,124 @@ def _truth(entry, args) -> dict | None:
 
 
 def _method_options(args: argparse.Namespace) -> dict:
+    """The estimator options given by flags (--backend, --max-iter, --tol, --time-limit, --option)."""
     opts = {}
-    if getattr(args, "backend", None):
-        opts["backend"] = args.backend
-    if getattr(args, "max_iter", None) is not None:
-        opts["max_iter"] = args.max_iter
+    for name in _FLAG_OPTIONS.values():
+        value = getattr(args, name, None)
+        if value is not None:
+            opts[name] = value
+    for name, value in _pairs(getattr(args, "option", None), "--option", args.command).items():
+        if name in opts or name in ("scale", "x0", "known", "bounds"):
+            raise _UsageError(f"symid {args.command}: error: --option {name}=...: use the flag "
+                              f"--{name.replace('_', '-')} instead")
+        opts[name] = _option_value(value)
     return opts
+
+
+_FLAG_OPTIONS = {"--backend": "backend", "--max-iter": "max_iter", "--tol": "tol", "--time-limit": "time_limit"}
+
+
+def _option_value(text: str):
+    """A value of --option NAME=VALUE: a number, true/false/none, JSON for lists and dicts, else the text."""
+    import json
+
+    low = text.lower()
+    if low in ("true", "false"):
+        return low == "true"
+    if low == "none":
+        return None
+    for parse in (int, float):
+        try:
+            return parse(text)
+        except ValueError:
+            pass
+    if text[:1] in "[{":
+        try:
+            return json.loads(text)  # data, never code
+        except json.JSONDecodeError:
+            raise _UsageError(f"--option: {text!r} is not valid JSON") from None
+    return text
+
+
+def _numbers(items: Sequence[str] | None, flag: str, command: str) -> dict[str, float] | None:
+    if not items:
+        return None
+    out = {}
+    for name, value in _pairs(items, flag, command).items():
+        try:
+            out[name] = float(value)
+        except ValueError:
+            raise _UsageError(f"symid {command}: error: {flag} {name}={value}: not a number") from None
+    return out
+
+
+def _scale_arg(items: Sequence[str] | None, command: str):
+    if not items:
+        return None
+    if len(items) == 1 and "=" not in items[0]:
+        try:
+            return float(items[0])
+        except ValueError:
+            raise _UsageError(f"symid {command}: error: --scale takes one number or NAME=VALUE items") from None
+    return _numbers(items, "--scale", command)
+
+
+def _bounds_arg(items: Sequence[str] | None, command: str) -> dict | None:
+    if not items:
+        return None
+    out = {}
+    for name, value in _pairs(items, "--bounds", command).items():
+        lo, sep, hi = value.partition(":")
+        try:
+            if not sep:
+                raise ValueError(value)
+            out[name] = (float(lo) if lo.strip() else None, float(hi) if hi.strip() else None)
+        except ValueError:
+            raise _UsageError(f"symid {command}: error: --bounds expects NAME=LOW:HIGH (either side may be empty), "
+                              f"got {name}={value}") from None
+    return out
+
+
+def _spec(entry, args: argparse.Namespace, command: str):
+    """The model file's declarations with the command line's --known, --x0, --scale, --bounds applied."""
+    return entry.updated(known=_numbers(getattr(args, "known", None), "--known", command),
+                         start=_numbers(getattr(args, "x0", None), "--x0", command),
+                         scale=_scale_arg(getattr(args, "scale", None), command),
+                         bounds=_bounds_arg(getattr(args, "bounds", None), command))
+
+
+def _say(args: argparse.Namespace, text: str) -> None:
+    """Human output: on standard output, or on standard error with --json (standard output is the JSON)."""
+    print(text, file=sys.stderr if getattr(args, "json", False) else sys.stdout)
+
+
+def _run_identify(identify, model, data, args, x0, opts: dict, from_file: set[str]):
+    """identify() with the flags' options; an option the method does not take is named by its flag.
+
+    Options that came from the model file (``from_file``, e.g. its scale) are dropped, with a note, when the
+    method does not use them: the file describes the model, not one method.
+    """
+    from symid.errors import OptionError
+
+    while True:
+        try:
+            return identify(model, data, method=args.method, x0=x0, starts=args.starts, seed=args.seed,
+                            polish=args.polish, progress=True if args.starts > 1 else None, **opts), opts
+        except OptionError as exc:
+            text = str(exc)
+            dropped = sorted(n for n in from_file & set(opts) if f"'{n}'" in text or f" {n} " in text
+                             or text.startswith(f"options {n}"))
+            if dropped:
+                for n in dropped:
+                    opts.pop(n)
+                from_file -= set(dropped)
+                _say(args, f"note: method {args.method!r} does not use the model file's {', '.join(dropped)}")
+                continue
+            flags = [f for f, n in {**_FLAG_OPTIONS, "--scale": "scale"}.items() if n in opts and f"'{n}'" in text]
+            if flags:
+                raise _UsageError(f"symid identify: error: {', '.join(flags)}: not taken by method {args.method!r} "
+                                  f"on this data ({text})") from None
+            raise
 
 
 def _cmd_identify(args: argparse.Namespace) -> int:
@@ -188,34 +322,69 @@ def _cmd_identify(args: argparse.Namespace) -> int:
 
     out = _output_dir(args.out, "identify")
     entry, data, source = _entry_and_data(args, "identify")
-    print(f"model: {entry.name}   data: {source}")
-    if entry.known:
-        print("known: " + ", ".join(f"{k} = {v:.6g}" for k, v in entry.known.items()))
-    opts = _method_options(args) if args.method == "scr" else {}
-    truth = _truth(entry, args)
-    model = entry.free_model()
+    spec = _spec(entry, args, "identify")
+    _say(args, f"model: {spec.name}   data: {source}")
+    if spec.known:
+        _say(args, "known: " + ", ".join(f"{k} = {v:.6g}" for k, v in spec.known.items()))
+    truth = _truth(spec, args)
+    model = spec.free_model()
+    x0 = spec.start if spec.start is not None else spec.bounds_centre()
+    if spec.start is None and x0 is not None:
+        _say(args, "first start: the centre of the bounds")
+    opts = _method_options(args)
+    from_file = set()
+    if spec.scale:
+        opts["scale"] = [spec.scale[n] for n in model.parameter_names]
+        if not args.scale:
+            from_file.add("scale")
     try:
-        res = identify(model, data, method=args.method, x0=entry.start, starts=args.starts, seed=args.seed,
-                       polish=args.polish, progress=True if args.starts > 1 else None, **opts)
+        res, opts = _run_identify(identify, model, data, args, x0, opts, from_file)
     except Interrupted as exc:  # keep the finished starts
         res = exc.partial
-        print(res.summary(truth=truth))
+        _say(args, res.summary(truth=truth))
         if out is not None:
-            _write_identify(out, entry, model, data, res, truth)
+            _write_identify(out, spec, model, data, res, truth, args)
         raise
-    print(res.summary(truth=truth))
-    if out is not None:
-        _write_identify(out, entry, model, data, res, truth)
     final = res.polished if res.polished is not None else res
-    return 0 if final.success else 1
+    outside = spec.outside_bounds(final.theta)
+    fitted = bool(final.success or any(s.success for s in res.starts))
+    code = 0 if fitted else NO_FIT
+    _say(args, res.summary(truth=truth))
+    for name, (value, lo, hi) in outside.items():
+        _say(args, f"warning: {name} = {value:.6g} lies outside its bounds [{lo:g}, {hi:g}]")
+    if not fitted:
+        _say(args, f"no start fitted the data (exit status {NO_FIT}); the best estimate is shown")
+    written = _write_identify(out, spec, model, data, res, truth, args) if out is not None else []
+    if args.json:
+        import json
+
+        doc = {"model": spec.name, "data": source, "known": spec.known, "result": res.to_dict(),
+               "fitted": fitted, "outside_bounds": {k: v[0] for k, v in outside.items()},
+               "exit_status": code, "written": [str(p) for p in written]}
+        print(json.dumps(doc, indent=2, default=_json_default))
+    return code
 
 
-def _write_identify(out, entry, model, data, res, truth) -> None:
+NO_FIT = 4
+"""Exit status of ``symid identify`` when it ran and wrote its result but no start fitted the data."""
+
+
+def _json_default(value):
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def _write_identify(out, entry, model, data, res, truth, args) -> list:
     """result.json, summary.txt and the plots, each written atomically."""
     from symid.plots import bode_plot, start_convergence_plot
     from symid.runlog import write_atomic, write_json_atomic
 
-    write_json_atomic(out / "result.json", res.to_dict(), indent=2)
+    write_json_atomic(out / "result.json", {**res.to_dict(), "known": dict(entry.known)}, indent=2)
     with write_atomic(out / "summary.txt") as fh:
         fh.write(res.summary(truth=truth) + "\n")
     written = [out / "result.json", out / "summary.txt"]
@@ -229,7 +398,8 @@ def _write_identify(out, entry, model, data, res, truth) -> None:
         written.append(start_convergence_plot(
             best, out / "convergence.png", truth=None if truth is None else model.theta_vector(truth),
             title=f"{entry.name}: SCR convergence of the reported start"))
-    print("wrote " + ", ".join(str(p) for p in written))
+    _say(args, "wrote " + ", ".join(str(p) for p in written))
+    return written
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
@@ -237,25 +407,29 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
     out = _output_dir(args.out, "compare")
     entry, data, source = _entry_and_data(args, "compare")
+    spec = _spec(entry, args, "compare")
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
     if not methods:
         raise _UsageError(f"symid compare: error: --methods {args.methods!r} names no method")
-    truth = _truth(entry, args)
-    print(f"model: {entry.name}   data: {source}")
+    truth = _truth(spec, args)
+    _say(args, f"model: {spec.name}   data: {source}")
     scr_opts = _method_options(args)
     try:
-        cmp = compare(entry.free_model(), data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
-                      x0=entry.start,
-                      progress=True,
+        cmp = compare(spec.free_model(), data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
+                      x0=spec.start, progress=True,
                       options={"scr": scr_opts} if scr_opts and {"scr", "scr+polish"} & set(methods) else None)
     except Interrupted as exc:  # keep the finished starts
-        print(exc.partial.table())
+        _say(args, exc.partial.table())
         if out is not None:
             _write_compare(out, exc.partial)
         raise
-    print(cmp.table())
+    _say(args, cmp.table())
     if out is not None:
         _write_compare(out, cmp)
+    if args.json:
+        import json
+
+        print(json.dumps(cmp.to_dict(), indent=2, default=_json_default))
     return 0
 
 
@@ -277,7 +451,12 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
     positive = {"declared": None, "all": True, "ignore": False}[args.positive]
     report = identifiability(spec.model, known=known, positive=positive,
                              timeout=args.timeout, exact_count=args.exact_count, seed=args.seed)
-    print(report.summary())
+    if args.json:
+        import json
+
+        print(json.dumps(report.to_dict(), indent=2, default=_json_default))
+    else:
+        print(report.summary())
     return 0
 
 
@@ -310,17 +489,23 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="symid",
         description="Continuous-time grey-box system identification: symbolic models, "
-                    "identifiability, and estimation by sequential convex relaxation (SCR).")
+                    "identifiability, and estimation by sequential convex relaxation (SCR).",
+        epilog="Exit status: 0 done (identify: a start fitted the data); 2 bad input (arguments, model, data "
+               "or files); 3 internal error (a bug); 4 identify wrote its result but no start fitted the data; "
+               "130 interrupted. MODEL is a zoo name or a model file (a .py file: it is run as code, load only "
+               "files you trust).")
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
     p = sub.add_parser("models", help="list the model zoo", description="List the models of the zoo.")
+    p.add_argument("--json", action="store_true", help="print the list as JSON")
     p.set_defaults(func=_cmd_models)
 
     p = sub.add_parser("show", help="show a model: parameters, matrices, truth, data recipe",
                        description="Show a zoo model (or a model file): parameters, matrices, truth, data recipe.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
+    p.add_argument("--json", action="store_true", help="print the model's declarations as JSON")
     p.set_defaults(func=_cmd_show)
 
     p = sub.add_parser("identify", help="estimate a model's parameters from data",
@@ -331,16 +516,37 @@ def build_parser() -> argparse.ArgumentParser:
     _add_data_arguments(p, "simulate the zoo recipe")
     p.add_argument("--method", choices=all_methods(), default="scr",
                    help="estimator (default: scr); als and gb (alternating least squares, gradient-based BFGS, "
-                        "thesis appendix C) take black-box or I/O data")
+                        "thesis appendix C) take black-box or I/O data, oe (output error) time series")
     p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=1, metavar="N",
                    help="number of starts (default: 1)")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
-    p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
-    p.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
-                   help="SCR iterations per start (≥ 1)")
+    g = p.add_argument_group("what you know about the parameters (extends or replaces the model file's)")
+    g.add_argument("--x0", nargs="+", metavar="NAME=VALUE",
+                   help="the first start: a value for every free parameter (default: the model file's start, "
+                        "else the centre of the bounds when every parameter has finite ones, else the method's)")
+    g.add_argument("--known", nargs="+", metavar="NAME=VALUE",
+                   help="parameters whose values are known: substituted into the model before estimation")
+    g.add_argument("--scale", nargs="+", metavar="NAME=VALUE",
+                   help="typical magnitude of every free parameter (or one number for all), for the methods "
+                        "that take scale= (the unknowns become θ / scale)")
+    g.add_argument("--bounds", nargs="+", metavar="NAME=LOW:HIGH",
+                   help="plausible ranges (either end may be empty): the start must lie inside; an estimate "
+                        "outside is reported; symid's estimators do not constrain θ to them")
+    g = p.add_argument_group("method options (an option the method does not take is an error naming the flag)")
+    g.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
+    g.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
+                   help="iteration limit per start (≥ 1)")
+    g.add_argument("--tol", type=_positive_number, metavar="TOL", help="the method's stopping tolerance")
+    g.add_argument("--time-limit", type=_positive_seconds, dest="time_limit", metavar="S",
+                   help="wall-time budget of one start in seconds (methods that take time_limit)")
+    g.add_argument("--option", nargs="+", metavar="NAME=VALUE",
+                   help="any other option of the method (see the options table), e.g. aux_init=model or "
+                        "substitution=both; VALUE is a number, true/false/none, JSON, or text")
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
     p.add_argument("--out", metavar="DIR",
                    help="write result.json, summary.txt, bode.png and (SCR) convergence.png here")
+    p.add_argument("--json", action="store_true",
+                   help="print the result as JSON on standard output (the human report goes to standard error)")
     p.set_defaults(func=_cmd_identify)
 
     p = sub.add_parser("compare", help="compare estimators on the same data and starts",
@@ -358,7 +564,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
     p.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
                    help="SCR iterations per start (≥ 1)")
+    p.add_argument("--x0", nargs="+", metavar="NAME=VALUE", help="the first start of every method")
+    p.add_argument("--known", nargs="+", metavar="NAME=VALUE",
+                   help="parameters whose values are known: substituted into the model before estimation")
     p.add_argument("--out", metavar="DIR", help="write comparison.json and comparison.md here")
+    p.add_argument("--json", action="store_true", help="print the comparison as JSON on standard output")
     p.set_defaults(func=_cmd_compare)
 
     p = sub.add_parser("demo", help="run the demonstration on the belt drive",
@@ -385,6 +595,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "(default), of all parameters, or ignore positivity")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S",
                    help="seed of the random rational points (default: 0)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=_cmd_identifiability)
     return parser
 
@@ -401,10 +612,12 @@ def _version() -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``symid`` console script.
 
-    Exit status: 0 done; 1 ``identify`` ran but its reported start did not converge;
-    2 bad input (arguments, model, data or files), said in one line on standard
-    error; 3 an internal error (a bug: the traceback is shown with ``SYMID_TRACEBACK=1``);
-    130 interrupted by Ctrl-C (what had finished is printed and, with ``--out``, written).
+    Exit status: 0 done (for ``identify``: a result was written and a start fitted the
+    data); 2 bad input (arguments, model, data or files), said on standard error;
+    3 an internal error (a bug: the traceback is shown with ``SYMID_TRACEBACK=1``);
+    4 ``identify`` ran and wrote its result, but no start fitted the data (its
+    ``success`` is false: the best estimate is reported all the same); 130 interrupted
+    by Ctrl-C (what had finished is printed and, with ``--out``, written).
     """
     parser = build_parser()
     args = parser.parse_args(argv)

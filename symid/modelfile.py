@@ -144,6 +144,62 @@ class ModelFile:
         """
         return substitute_known(self.model, {**self.known, **dict(known or {})})
 
+    def updated(self, *, known: Mapping[str, float] | None = None, start: Mapping[str, float] | None = None,
+                scale: float | Mapping[str, float] | None = None,
+                bounds: Mapping[str, tuple[float | None, float | None]] | None = None,
+                where: str = "the command line") -> ModelFile:
+        """The same declarations with some replaced or extended (the command line's ``--known``, ``--x0`` ...).
+
+        ``known`` and ``bounds`` extend the file's (given names win); ``start`` and ``scale``
+        replace them. A parameter newly known leaves the file's start, scale and bounds.
+
+        Parameters
+        ----------
+        known, start, scale, bounds
+            As the attributes of the same names; ``None`` keeps the file's.
+        where : str
+            Where the values come from, for messages.
+
+        Returns
+        -------
+        ModelFile
+            Of the same class (a zoo entry stays one), every value checked as when read.
+        """
+        import dataclasses
+
+        known_ = {**self.known, **_known_values(known or {}, self.model, f"{where}: known")}
+        free = [n for n in self.model.parameter_names if n not in known_]
+        if start is not None:
+            start_ = _start_values(start, self.model, free, known_, f"{where}: x0")
+        elif self.start is not None and all(n in self.start for n in free):
+            start_ = {n: self.start[n] for n in free}
+        else:
+            start_ = None
+        if scale is not None:
+            scale_ = _scale_values(scale, free, known_, where)
+        else:
+            scale_ = {n: v for n, v in self.scale.items() if n in free} if all(n in self.scale for n in free) else {}
+        bounds_ = {n: b for n, b in self.bounds.items() if n in free}
+        bounds_.update(_bounds_values(bounds or {}, free, known_, where))
+        if start_ is not None:
+            bad = {k: v for k, v in start_.items() if k in bounds_ and not bounds_[k][0] <= v <= bounds_[k][1]}
+            if bad:
+                k, v = next(iter(bad.items()))
+                raise ModelError(f"{where}: the start {k} = {v:g} lies outside its bounds {bounds_[k]}; move the "
+                                 "start inside or widen the bounds")
+        return dataclasses.replace(self, known=known_, start=start_, scale=scale_, bounds=bounds_)
+
+    def bounds_centre(self) -> dict[str, float] | None:
+        """The centre of the bounds when every free parameter has finite ones (geometric for 0 < low), else None."""
+        free = [n for n in self.model.parameter_names if n not in self.known]
+        if not free or any(n not in self.bounds or not all(map(math.isfinite, self.bounds[n])) for n in free):
+            return None
+        centre = {}
+        for n in free:
+            lo, hi = self.bounds[n]
+            centre[n] = math.sqrt(lo * hi) if lo > 0 else 0.5 * (lo + hi)
+        return centre
+
     def h_unit(self, output: int = 0, input: int = 0) -> str | None:
         """The physical unit of H[output, input] (``"m/N"``), or ``None`` when the units are not given."""
         if not self.input_units or not self.output_units:

@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from symid.cli import build_parser, main
@@ -57,7 +58,7 @@ def test_identify_writes_results(tmp_path, capsys):
                  "--out", str(tmp_path / "out")])
     out = capsys.readouterr().out
     assert "method: ipopt" in out
-    assert code in (0, 1)
+    assert code in (0, 4)
     result = json.loads((tmp_path / "out" / "result.json").read_text())
     assert result["method"] == "ipopt" and len(result["starts"]) == 1
     assert (tmp_path / "out" / "bode.png").stat().st_size > 1000
@@ -222,7 +223,7 @@ def test_version_is_printed(capsys):
 
 def test_max_iter_is_honoured(tmp_path, capsys):
     # `--max-iter 1` must reach SCR (it was dropped by a truthiness test when 0, and is now checked ≥ 1)
-    assert main(["identify", "mass_damper_2dof", "--max-iter", "1", "--out", str(tmp_path)]) in (0, 1)
+    assert main(["identify", "mass_damper_2dof", "--max-iter", "1", "--out", str(tmp_path)]) in (0, 4)
     result = json.loads((tmp_path / "result.json").read_text())
     assert result["iterations"] == 1 and result["options"]["max_iter"] == 1
 
@@ -258,3 +259,81 @@ def test_interrupted_identify_writes_the_finished_starts(tmp_path, monkeypatch, 
     assert "symid: interrupted (the finished starts are shown above)" in captured.err
     result = json.loads((tmp_path / "result.json").read_text())
     assert len(result["starts"]) == 2 and result["options"]["interrupted"] is True
+
+
+def test_no_fit_is_exit_status_4_with_the_result_written(tmp_path, capsys):
+    """One IPOPT iteration from θ = 0 cannot fit the belt drive: the result is still printed and written."""
+    code = main(["identify", "belt_drive", "--method", "ipopt", "--max-iter", "1", "--out", str(tmp_path)])
+    captured = capsys.readouterr()
+    assert code == 4
+    assert "no start fitted the data (exit status 4)" in captured.out
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["success"] is False and result["options"]["max_iter"] == 1
+
+
+def test_identify_json_for_scripts(capsys):
+    code = main(["identify", "mass_damper_2dof", "--method", "ipopt", "--x0", "m1=1", "m2=1", "c1=0.2", "c2=0.2",
+                 "k1=1.5", "k2=1.5", "--tol", "1e-10", "--json"])
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out)  # standard output is the JSON document alone
+    assert code == doc["exit_status"] == 0 and doc["fitted"] is True
+    assert doc["result"]["starts"][0]["start"] == [1.0, 1.0, 0.2, 0.2, 1.5, 1.5]
+    assert doc["result"]["options"]["tol"] == 1e-10
+    assert "method: ipopt" in captured.err  # the human report moved to standard error
+
+
+def test_known_scale_bounds_and_options_reach_the_estimator(tmp_path, capsys):
+    code = main(["identify", "mass_damper_2dof", "--method", "ipopt", "--known", "m1=1", "m2=1",
+                 "--scale", "c1=0.1", "c2=0.3", "k1=2", "k2=1", "--bounds", "k1=0.5:5", "k2=:10",
+                 "--time-limit", "60", "--option", "hessian=limited-memory", "--out", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["parameter_names"] == ["c1", "c2", "k1", "k2"] and result["known"] == {"m1": 1.0, "m2": 1.0}
+    scale = result["options"]["scale"]  # JSON keeps an array option as its text
+    assert (json.loads(scale) if isinstance(scale, str) else scale) == [0.1, 0.3, 2.0, 1.0]
+    assert result["options"]["time_limit"] == 60.0
+    assert result["options"]["hessian"] == "limited-memory"
+    # every free parameter has finite bounds? k2's low end is open, so the method's own first start is used
+    assert "centre of the bounds" not in out
+
+
+def test_bounds_give_the_first_start_and_flag_estimates_outside(capsys):
+    code = main(["identify", "mass_damper_2dof", "--method", "ipopt", "--bounds", "m1=0.5:2", "m2=0.5:2",
+                 "c1=0.01:1", "c2=0.01:1", "k1=3:10", "k2=0.1:10", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    start = doc["result"]["starts"][0]["start"]
+    np.testing.assert_allclose(start, [1.0, 1.0, 0.1, 0.1, np.sqrt(30), 1.0], rtol=1e-12)  # geometric centres
+    assert code == 0 and doc["outside_bounds"] == {"k1": pytest.approx(2.0, rel=1e-6)}  # the truth k1 = 2 < 3
+
+
+OPTION_ERRORS = {
+    "time limit on als": (["identify", "enose", "--method", "als", "--time-limit", "5"],
+                          "--time-limit: not taken by method 'als'"),
+    "backend on ipopt": (["identify", "belt_drive", "--method", "ipopt", "--backend", "admm"],
+                         "--backend: not taken by method 'ipopt'"),
+    "x0 incomplete": (["identify", "belt_drive", "--x0", "theta1=1"], "x0: start lacks theta2, theta3, theta4"),
+    "x0 outside bounds": (["identify", "belt_drive", "--x0", "theta1=1", "theta2=1", "theta3=1", "theta4=1",
+                           "--bounds", "theta1=-2:0"], "lies outside its bounds"),
+    "known not a parameter": (["identify", "belt_drive", "--known", "mass=1"], "'mass', not a parameter"),
+    "bounds syntax": (["identify", "belt_drive", "--bounds", "theta1=1"], "--bounds expects NAME=LOW:HIGH"),
+    "tol negative": (["identify", "belt_drive", "--tol", "-1"], "--tol: must be a finite number > 0"),
+    "option for a flag": (["identify", "belt_drive", "--option", "scale=2"], "use the flag --scale instead"),
+    "unknown option": (["identify", "belt_drive", "--option", "gamma0=model"], "has no option 'gamma0'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(OPTION_ERRORS))
+def test_options_a_method_does_not_take_are_named(case, capsys):
+    argv, expected = OPTION_ERRORS[case]
+    assert _exit_code(argv) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "Traceback" not in err
+
+
+def test_other_commands_speak_json(capsys):
+    for argv in (["models", "--json"], ["show", "belt_drive", "--json"],
+                 ["identifiability", "belt_drive", "--json"],
+                 ["compare", "belt_drive", "--methods", "scr", "--starts", "2", "--json"]):
+        assert main(argv) == 0
+        json.loads(capsys.readouterr().out)  # a valid document, nothing else on standard output
