@@ -122,7 +122,23 @@ def psd_table(doc: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def n4sid_oversampling_table(doc: dict) -> str:
+    """benchmarks/n4sid_oversampling.py: worst relative error of f and ζ per route and oversampling ratio."""
+    def cell(c: dict) -> str:
+        if c["f_error_worst"] is None:
+            return f"failed {c['failed']}/{len(doc['seeds'])}"
+        return f"{c['f_error_worst']:.0e} / {c['zeta_error_worst']:.0e}"
+
+    lines = ["| fs / highest mode | samples | default horizon | longer horizon (i) | decimated (q), horizon 10 | "
+             "decimated, horizon 20 |", "|---|---|---|---|---|---|"]
+    for r in doc["rows"]:
+        lines.append(f"| {r['ratio']} | {r['N']} | {cell(r['default'])} | {cell(r['horizon'])} ({r['horizon_i']}) | "
+                     f"{cell(r['decimated'])} ({r['q']}) | {cell(r['decimated + i=20'])} |")
+    return "\n".join(lines) + "\n"
+
+
 TABLES: dict[str, Callable[[dict], str]] = {
+    "benchmarks/results/n4sid_oversampling.json": n4sid_oversampling_table,
     "benchmarks/results/psd.json": psd_table,
     "benchmarks/results/similarity_study.json": similarity_table,
     "benchmarks/results/identifiability.json": identifiability_table,

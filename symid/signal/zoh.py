@@ -23,7 +23,16 @@ does not exist; the scipy primitive does the work.
 A real continuous-time model exists only when the principal logarithm of Ad is real:
 no eigenvalue of Ad may lie on the closed negative real axis (an eigenvalue ≤ 0 means
 the sampling aliases a mode to the Nyquist frequency or the model is not a sampled
-continuous-time system). That case raises :class:`~symid.errors.DataError`.
+continuous-time system). That case raises :class:`~symid.errors.DataError`, unless
+such modes are dropped first: ``band=(w_low, w_high)`` keeps only the modes whose
+continuous-time natural frequency |s| = |ln z| / dt lies in the band. A mode on the
+negative real axis has |s| ≥ π/dt (the Nyquist frequency), so any ``w_high`` below π/dt
+drops it, and a band of interest drops the fast (or slow) modes a black box fitted
+to noise. The modes are separated exactly: an ordered real Schur form puts the kept
+eigenvalues first, and a Sylvester equation decouples them from the others
+(Golub & Van Loan, *Matrix Computations*, 4th ed., §7.6), so the kept modes keep
+their poles and residues; the dropped modes' contribution (their static gain
+included) is removed, not moved into D.
 """
 
 from __future__ import annotations
@@ -77,7 +86,43 @@ def _balanced_logm(big: np.ndarray) -> np.ndarray:
     return (L * scaling[:, None]) / scaling[None, :]
 
 
-def d2c(A: Any, B: Any, C: Any, D: Any = None, dt: Any = None) -> BlackBox:
+def _band(band: Any, dt: float) -> tuple[float, float]:
+    try:
+        lo, hi = (float(b) for b in band)
+    except (TypeError, ValueError):
+        raise DataError(f"band must be a pair (w_low, w_high) of angular frequencies in rad/s; got {band!r}") from None
+    if not (0 <= lo < hi) or np.isnan(hi):
+        raise DataError(f"band must be (w_low, w_high) in rad/s with 0 <= w_low < w_high; got {band!r}")
+    return lo, hi
+
+
+def _keep_modes(Ad: np.ndarray, Bd: np.ndarray, Cd: np.ndarray, dt: float, band: tuple[float, float]
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The subsystem of the modes with |ln z|/dt in ``band`` (ordered real Schur form + Sylvester decoupling)."""
+    lo, hi = band
+
+    def natural(z: complex) -> float:
+        return float("inf") if z == 0 else abs(np.log(complex(z))) / dt
+
+    def keep(x: float, y: float = 0.0) -> bool:
+        return lo <= natural(complex(x, y)) <= hi
+
+    ev = np.linalg.eigvals(Ad)
+    kept = [keep(z.real, z.imag) for z in ev]
+    if all(kept):
+        return Ad, Bd, Cd
+    if not any(kept):
+        freqs = ", ".join(f"{natural(z):.4g}" for z in ev)
+        raise DataError(f"no mode of the discrete model has its natural frequency in band {band!r} rad/s "
+                        f"(modes at {freqs} rad/s)")
+    T, Z, k = scipy.linalg.schur(Ad, output="real", sort=keep)
+    T11, T12, T22 = T[:k, :k], T[:k, k:], T[k:, k:]
+    X = scipy.linalg.solve_sylvester(T11, -T22, -T12)  # T11 X − X T22 = −T12 decouples the blocks
+    ZB, CZ = Z.T @ Bd, Cd @ Z
+    return T11, ZB[:k] - X @ ZB[k:], CZ[:, :k]
+
+
+def d2c(A: Any, B: Any, C: Any, D: Any = None, dt: Any = None, *, band: Any = None) -> BlackBox:
     """Continuous-time model whose zero-order-hold sampling at ``dt`` is the given discrete model.
 
     Parameters
@@ -92,18 +137,25 @@ def d2c(A: Any, B: Any, C: Any, D: Any = None, dt: Any = None) -> BlackBox:
         Feedthrough (unchanged); zero when omitted.
     dt : float
         Sample time in seconds.
+    band : (float, float), optional
+        Keep only the modes whose natural frequency |ln z| / dt (rad/s) lies in
+        [w_low, w_high] (module notes); with ``w_high`` < π/dt this drops a mode at the
+        Nyquist frequency, which has no real continuous-time equivalent. Default: every
+        mode.
 
     Returns
     -------
     BlackBox
-        The continuous-time (A, B, C, D) with ``expm([[A, B], [0, 0]] dt) = [[Ad, Bd], [0, I]]``.
+        The continuous-time (A, B, C, D) with ``expm([[A, B], [0, 0]] dt) = [[Ad, Bd], [0, I]]``
+        (for the kept modes, with ``band``).
 
     Raises
     ------
     DataError
         When ``dt`` is missing or not a positive number, on inconsistent shapes or
-        non-finite entries, or when no real logarithm exists: an eigenvalue of Ad on
-        the closed negative real axis (zero included).
+        non-finite entries, a malformed band or one that keeps no mode, or when no real
+        logarithm exists: an eigenvalue of Ad on the closed negative real axis (zero
+        included); the message then gives the ``band`` that drops it.
 
     Examples
     --------
@@ -126,13 +178,20 @@ def d2c(A: Any, B: Any, C: Any, D: Any = None, dt: Any = None) -> BlackBox:
     Cd = _matrix(C, "C", row=True)
     if Cd.shape[1] != n:
         raise DataError(f"C must have {n} columns to match A; got shape {checks.shape_text(Cd.shape)}")
+    if band is not None:
+        Ad, Bd, Cd = _keep_modes(Ad, Bd, Cd, dt_, _band(band, dt_))
+        n = Ad.shape[0]
     ev = np.linalg.eigvals(Ad)
     scale = max(1.0, float(np.abs(ev).max(initial=0.0)))
     bad = ev[(ev.real <= _AXIS_TOL * scale) & (np.abs(ev.imag) <= _AXIS_TOL * scale)]
     if bad.size:
+        fix = (f"drop that mode with band=(0, w_high), w_high below the Nyquist frequency π/dt = "
+               f"{np.pi / dt_:.6g} rad/s (keeps the modes in the band of interest)" if band is None else
+               "narrow the band")
         raise DataError(f"no real continuous-time model: the discrete A has eigenvalue {bad[0].real:.6g} on the "
                         "closed negative real axis, whose logarithm is not real (a mode at the Nyquist frequency, "
-                        "or a model that is not a sampled continuous-time system); sample faster or check the model")
+                        f"or a model that is not a sampled continuous-time system); {fix}, sample faster or check "
+                        "the model")
     m = Bd.shape[1]
     big = np.zeros((n + m, n + m))
     big[:n, :n] = Ad
