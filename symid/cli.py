@@ -392,7 +392,10 @@ def _write_identify(out, entry, model, data, res, truth, args) -> list:
         curves = {f"{res.method} estimate": (model, res.theta_vector)}
         if res.polished is not None:
             curves["after polish"] = (model, res.polished.theta_vector)
-        written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate"))
+        if truth is not None:
+            curves["truth"] = (model, model.theta_vector(truth))
+        written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate",
+                                 h_unit=entry.h_unit(), reference="truth"))
     best = res.best_start
     if best.history and best.history[0].families:  # SCR: thesis Figure 3-2 for the reported start
         written.append(start_convergence_plot(

@@ -27,8 +27,34 @@ def _has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+def _escape(text: str) -> str:
+    """A label shown as written: ``$`` would start matplotlib's math mode."""
+    return text.replace("$", r"\$")
+
+
+def _log_axis(ax: Any) -> None:
+    """Plain numbers (0.4, 2, 50) on a log frequency axis instead of 4×10⁻¹; minor labels at 2 and 5 over
+    narrow spans."""
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    lo, hi = ax.get_xlim()
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
+    if hi / lo < 100:
+        ax.xaxis.set_minor_locator(LogLocator(subs=(2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0)))
+        lead = (2, 5) if hi / lo > 10 else (2, 3, 4, 5, 6, 7, 8, 9)
+        ax.xaxis.set_minor_formatter(FuncFormatter(
+            lambda x, _: f"{x:g}" if round(x / 10 ** np.floor(np.log10(x))) in lead else ""))
+
+
+# Curves drawn on top of one another stay visible: the first is a wide, pale band, each later one
+# thinner and dashed differently, so a curve hidden under another still shows at its edges and gaps.
+_CURVE_STYLES = [dict(lw=5.0, alpha=0.35, ls="-"), dict(lw=2.2, ls="-"), dict(lw=1.6, ls=(0, (5, 3))),
+                 dict(lw=1.4, ls=(0, (1, 2))), dict(lw=1.4, ls=(0, (6, 2, 1, 2)))]
+
+
 def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | Path, *,
-              output: int = 0, input: int = 0, n_grid: int = 400, title: str | None = None) -> Path:
+              output: int = 0, input: int = 0, n_grid: int = 400, title: str | None = None,
+              h_unit: str | None = None, reference: str | None = None) -> Path:
     """Bode magnitude and phase of measured data against model estimates, saved as PNG.
 
     Parameters
@@ -36,12 +62,20 @@ def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | P
     data : FrequencyData
         The measured points (drawn as markers).
     estimates : mapping of label to (model, theta)
-        Curves drawn on a fine grid spanning the data band (one decade wider each side
-        is not used: the grid spans the data band widened by 30% in log scale).
+        Curves drawn on a fine grid spanning the data band widened by 30 % in log scale,
+        each in its own colour and dash pattern, so curves that coincide all stay visible.
     path : str or pathlib.Path
         Where to write the PNG.
     output, input : int
         The channel drawn.
+    n_grid : int
+        Points of the model curves.
+    title : str, optional
+    h_unit : str, optional
+        The physical unit of H (output unit per input unit, e.g. ``"m/N"``): the magnitude
+        axis reads "|H| (dB re 1 m/N)". Without it the axis says the unit is not given.
+    reference : str, optional
+        The label of a curve to draw as a wide pale band under the others (e.g. the truth).
 
     Returns
     -------
@@ -53,28 +87,36 @@ def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | P
     lo, hi = np.log10(max(w.min(), 1e-12)), np.log10(w.max())
     pad = 0.3 * max(hi - lo, 0.2)
     grid = np.logspace(lo - pad, hi + pad, n_grid)
-    fig, (ax_m, ax_p) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
-    styles = ["-", "--", ":", "-."]
-    for k, (label, (model, theta)) in enumerate(estimates.items()):
+    fig, (ax_m, ax_p) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6.2))
+    k = 0
+    for label, (model, theta) in sorted(estimates.items(), key=lambda item: item[0] != reference):
         Hm = model.frequency_response(theta, grid)[:, output, input]
-        ax_m.semilogx(grid, 20 * np.log10(np.abs(Hm)), styles[k % 4], lw=1.6, label=label)
-        ax_p.semilogx(grid, np.degrees(np.unwrap(np.angle(Hm))), styles[k % 4], lw=1.6, label=label)
-    ax_m.semilogx(w, 20 * np.log10(np.abs(H)), "ko", ms=5, mfc="none", label="data")
-    ax_p.semilogx(w, np.degrees(np.unwrap(np.angle(H))), "ko", ms=5, mfc="none", label="data")
-    ax_m.set_ylabel("magnitude (dB)")
-    ax_p.set_ylabel("phase (deg)")
-    ax_p.set_xlabel("ω (rad/s)")
-    ax_m.grid(True, which="both", alpha=0.3)
-    ax_p.grid(True, which="both", alpha=0.3)
-    ax_m.legend(loc="best", fontsize=8)
-    ax_m.set_title(title or f"Bode plot, output {output}, input {input}")
+        if label == reference:
+            style = _CURVE_STYLES[0]
+        else:
+            k += 1
+            style = _CURVE_STYLES[1 + (k - 1) % (len(_CURVE_STYLES) - 1)]
+        line, = ax_m.semilogx(grid, 20 * np.log10(np.abs(Hm)), label=_escape(label), **style)
+        ax_p.semilogx(grid, np.degrees(np.unwrap(np.angle(Hm))), color=line.get_color(), **style)
+    ax_m.semilogx(w, 20 * np.log10(np.abs(H)), "ko", ms=5, mfc="none", label="data", zorder=5)
+    ax_p.semilogx(w, np.degrees(np.unwrap(np.angle(H))), "ko", ms=5, mfc="none", zorder=5)
+    unit = f"dB re 1 {_escape(h_unit)}" if h_unit else "dB; unit of H not given"
+    ax_m.set_ylabel(f"magnitude |H| ({unit})")
+    ax_p.set_ylabel("phase ∠H (degrees)")
+    ax_p.set_xlabel("angular frequency ω (rad/s)")
+    for ax in (ax_m, ax_p):
+        ax.grid(True, which="both", alpha=0.3)
+    _log_axis(ax_p)
+    ax_m.legend(loc="best", fontsize=8, framealpha=0.9)
+    suffix = "" if np.asarray(data.H).shape[1:] == (1, 1) else f" (output {output}, input {input})"
+    ax_m.set_title(_escape(title or "Bode plot") + suffix, fontsize=11)
     fig.tight_layout()
     return _save(fig, path, dpi=110)
 
 
 def convergence_plot(groups: Mapping[str, Sequence[float]], path: str | Path, *, title: str | None = None,
-                     ylabel: str = "constraint residual ‖A P B − C‖_F", total: bool = True,
-                     error: Sequence[float] | None = None, error_label: str = "‖θ − θ*‖₂") -> Path:
+                     ylabel: str = "residual per family, ‖A P B − C‖_F", total: bool = True,
+                     error: Sequence[float] | None = None, error_label: str = "‖θ_k − θ*‖₂") -> Path:
     """Residual per constraint group against SCR iteration (log scale), as thesis Figure 3-2.
 
     Parameters
@@ -85,14 +127,15 @@ def convergence_plot(groups: Mapping[str, Sequence[float]], path: str | Path, *,
     path : str or pathlib.Path
         Where to write the PNG.
     title, ylabel : str, optional
-        Figure title and y-axis label.
+        Figure title and y-axis label of the residuals.
     total : bool
-        Also draw the sum over the groups (thick black), as the thesis's "total" curve.
+        Also draw the sum over the groups, as the thesis's "total" curve: a wide pale
+        band under the groups, so a group that carries nearly all of it stays visible.
     error : sequence of float, optional
         Parameter error per iteration (e.g. ‖θ_k − θ*‖₂ when the truth is known), drawn
-        dashed on the same axis.
+        in a panel of its own below, with its own axis label.
     error_label : str
-        Legend entry of ``error``.
+        Axis label and legend entry of ``error``.
 
     Returns
     -------
@@ -107,23 +150,33 @@ def convergence_plot(groups: Mapping[str, Sequence[float]], path: str | Path, *,
     True
     """
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8, 4.8))
+    if error is None:
+        fig, ax = plt.subplots(figsize=(8, 4.8))
+        ax_e = None
+    else:
+        fig, (ax, ax_e) = plt.subplots(2, 1, sharex=True, figsize=(8, 6.6), height_ratios=(2, 1))
     curves = {label: np.asarray(v, dtype=float) for label, v in groups.items()}
     if total and len(curves) > 1:
         ax.semilogy(np.arange(1, len(next(iter(curves.values()))) + 1), _positive(sum(curves.values())),
-                    color="black", lw=2.6, alpha=0.55, label="total")
-    for label, v in curves.items():
+                    color="0.5", lw=6, alpha=0.35, label="total (sum of the families)")
+    styles = _CURVE_STYLES[1:]
+    for k, (label, v) in enumerate(curves.items()):
         note = "  (≡ 0: exact)" if not np.any(v > 0) else ""  # e.g. equations that presolve made linear
-        ax.semilogy(np.arange(1, v.size + 1), _positive(v), lw=1.5, label=label + note)
-    if error is not None:
-        e = np.asarray(error, dtype=float)
-        ax.semilogy(np.arange(1, e.size + 1), _positive(e), "k--", lw=1.3, label=error_label)
-    ax.set_xlabel("SCR iteration k")
+        ax.semilogy(np.arange(1, v.size + 1), _positive(v), label=_escape(label) + note, **styles[k % len(styles)])
     ax.set_ylabel(ylabel)
     ax.grid(True, which="major", alpha=0.4)
     ax.grid(True, which="minor", alpha=0.12)
-    ax.legend(loc="best", fontsize=9)
-    ax.set_title(title or "SCR convergence per constraint group", fontsize=11)
+    ax.legend(loc="best", fontsize=8.5, framealpha=0.9)
+    ax.set_title(_escape(title or "SCR convergence per constraint family"), fontsize=11)
+    bottom = ax
+    if ax_e is not None:
+        e = np.asarray(error, dtype=float)
+        ax_e.semilogy(np.arange(1, e.size + 1), _positive(e), "k-", lw=1.5, label=_escape(error_label))
+        ax_e.set_ylabel(f"parameter error\n{_escape(error_label)}")
+        ax_e.grid(True, which="major", alpha=0.4)
+        ax_e.grid(True, which="minor", alpha=0.12)
+        bottom = ax_e
+    bottom.set_xlabel("SCR iteration k")
     fig.tight_layout()
     return _save(fig, path, dpi=120)
 
