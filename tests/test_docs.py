@@ -203,3 +203,41 @@ def test_readme_tables_are_generated_from_the_benchmark_json():
     spec.loader.exec_module(module)
     assert "<!-- table: " in README
     assert module.render(README) == README, "run: python benchmarks/readme_tables.py"
+
+
+# -- the documentation site (docs/) ----------------------------------------------------------
+
+DOCS = ROOT / "docs"
+GUIDE_BLOCKS = [(page.name, block) for page in sorted(DOCS.glob("*.rst"))
+                for block in re.findall(r"\.\. code-block:: python\n\n((?:(?:   .*)?\n)+)",
+                                        page.read_text(encoding="utf-8"))]
+
+
+@pytest.mark.parametrize("k", range(len(GUIDE_BLOCKS)))
+def test_guide_block_runs_on_its_own(k, tmp_path, monkeypatch):
+    """Every python block of the documentation runs alone, in a fresh namespace and a scratch directory."""
+    import textwrap
+
+    page, block = GUIDE_BLOCKS[k]
+    monkeypatch.chdir(tmp_path)
+    exec(compile(textwrap.dedent(block), f"docs/{page} block", "exec"), {})  # the docs are ours
+
+
+def test_the_guide_covers_what_a_newcomer_needs():
+    guide = (DOCS / "guide.rst").read_text(encoding="utf-8")
+    for section in ("Declare a model", "Check identifiability", "Each data kind", "Choosing a method",
+                    "Reading results", "Real data"):
+        assert f"\n{section}\n---" in guide, section
+    assert len(GUIDE_BLOCKS) >= 7
+    assert "model file is code" in guide.replace("\n", " ").lower() or "is code: symid runs it" in guide
+
+
+def test_every_gallery_image_exists():
+    for page in DOCS.glob("*.rst"):
+        for image in re.findall(r"\.\. image:: (\S+)", page.read_text(encoding="utf-8")):
+            assert (DOCS / image).is_file(), f"{page.name}: {image} (run docs/make_gallery.py)"
+
+
+def test_ci_builds_the_docs_without_warnings():
+    ci = (ROOT / ".ci" / "run").read_text()
+    assert '.venv/bin/pip install ".[docs]"' in ci and "sphinx-build -W" in ci
