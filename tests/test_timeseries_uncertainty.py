@@ -65,8 +65,10 @@ def test_fisher_uncertainty_matches_linear_regression():
     """A linear model: F⁻¹ σ̂² is the textbook (XᵀX)⁻¹ s² with s² = RSS / (N − k)."""
     rng = np.random.default_rng(3)
     X = rng.standard_normal((30, 3))
-    r = rng.standard_normal(30)
-    u = fisher_uncertainty(np.zeros(3), ("a", "b", "c"), r, X, np.zeros(30, int))
+    y = X @ [1.0, -2.0, 0.5] + rng.standard_normal(30)
+    beta, *_ = np.linalg.lstsq(X, y, rcond=None)
+    r = y - X @ beta  # the least-squares residual (orthogonal to the columns of X)
+    u = fisher_uncertainty(beta, ("a", "b", "c"), r, -X, np.zeros(30, int))
     np.testing.assert_allclose(u.covariance, np.linalg.inv(X.T @ X) * (r @ r) / 27, rtol=1e-10)
 
 

@@ -23,7 +23,7 @@ __all__ = ["identify"]
 def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, starts: int = 1,
              seed: int | None = None, polish: bool = False, progress: bool | None = None,
              identifiability_check: bool = True, noise_floor: float | None = None,
-             **options: Any) -> IdentificationResult:
+             noise_std: Any = None, **options: Any) -> IdentificationResult:
     """Estimate the parameters of a symbolic model from data.
 
     Parameters
@@ -68,6 +68,11 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
         The relative misfit noise alone leaves at the true parameters (ε² for relative
         noise of level ε); used to judge ``success`` (:mod:`symid.fit.success`). Default:
         estimated from the residual where the data kind allows it.
+    noise_std : float or array_like, optional
+        Standard deviation of the measurement noise of every measured value, in data
+        units (a number, one per frequency or sample, or the data's full shape), for the
+        uncertainty in ``result.uncertainty``; default: estimated from the residuals
+        (:mod:`symid.fit.uncertainty`).
     **options
         The method's options (see each estimator's docstring and the options table in
         :mod:`symid.fit.base`); an unknown name or a bad value is an
@@ -103,6 +108,9 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
     if progress is not None:
         progress = check_bool("progress", progress)
     estimator = prepare(model, data, method, options, noise_floor=noise_floor)
+    if noise_std is not None and not isinstance(estimator, FisherInformation):
+        raise OptionError(f"noise_std is for the uncertainty of the estimate, which method {estimator.method!r} "
+                          "on this data kind does not give")
     polisher = estimator.polisher() if polish else None
     if polish and polisher is None:
         raise OptionError(f"method {estimator.method!r} has no polish step (polish=True applies to SCR)")
@@ -132,8 +140,8 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
                                               cost_kind=estimator.cost_kind, options=options_used)
     if isinstance(estimator, FisherInformation) and np.all(np.isfinite(result.theta_vector)):
         # declared by the estimator (symid.fit.uncertainty): covariance of θ̂ at the best estimate
-        result = dataclasses.replace(result, uncertainty=estimator.uncertainty(result.theta_vector,
-                                                                               model.parameter_names))
+        result = dataclasses.replace(result, uncertainty=estimator.uncertainty(
+            result.theta_vector, model.parameter_names, noise_std=noise_std))
     if polisher is not None:
         from symid.fit.polish import polish_outcome
 
@@ -144,5 +152,8 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
         polished = IdentificationResult.from_starts(f"{estimator.method}+polish", model.parameter_names, [out],
                                                     cost_kind=estimator.cost_kind,
                                                     options={"polish": polisher.method})
+        if isinstance(polisher, FisherInformation) and np.all(np.isfinite(polished.theta_vector)):
+            polished = dataclasses.replace(polished, uncertainty=polisher.uncertainty(
+                polished.theta_vector, model.parameter_names, noise_std=noise_std))
         result = dataclasses.replace(result, polished=polished)
     return result

@@ -1,16 +1,39 @@
 """Covariance, standard errors and confidence intervals of θ from the Fisher information at the estimate.
 
-For a least-squares fit with residuals r = y − ŷ(θ) of independent Gaussian noise of
-variance σⱼ² in output channel j, the Fisher information is
+Every data kind's misfit is a weighted least-squares criterion ‖r(θ)‖², r the data minus
+the model, each entry weighed as the method's misfit weighs it. For independent Gaussian
+noise with Var(rᵢ) = vᵢ, the Fisher information at the estimate is
 
-    F = Σⱼ Jⱼᵀ Jⱼ / σⱼ²,          Jⱼ = ∂ŷⱼ/∂θ at the estimate
+    F = Jᵀ V⁻¹ J,          J = ∂r/∂θ at θ̂,  V = diag(vᵢ)
 
-(the Gauss–Newton matrix), and cov(θ̂) ≈ F⁻¹ (Ljung, *System Identification*, 2nd ed.,
-§9.2, (9.17)–(9.18); Bates & Watts, *Nonlinear Regression Analysis*, 1988, §2.3). σⱼ² is
-estimated from the residuals, σ̂ⱼ² = ‖rⱼ‖² / (Nⱼ − k Nⱼ/N) with k unknowns shared out
-over the channels in proportion to their samples. Nuisance unknowns (estimated initial
-states) are in F and marginalised: the θ block of F⁻¹ is reported. The 95 % intervals are
-θ̂ ± t₀.₉₇₅(N − k) · SE.
+(the Gauss–Newton matrix; Ljung, *System Identification*, 2nd ed., §9.2, (9.17)–(9.18);
+Pintelon & Schoukens, *System Identification: A Frequency Domain Approach*, 2nd ed.,
+§9.11 for frequency-domain data). The covariance of the estimate that minimises ‖r‖² is
+
+    cov(θ̂) ≈ (JᵀJ)⁻¹ Jᵀ V J (JᵀJ)⁻¹,
+
+which is F⁻¹ when the misfit weighs every entry by its noise (V ∝ I); otherwise the
+"sandwich" form is the right one (White, *Econometrica* 48, 1980). The noise is
+
+- **estimated from the residuals** (default): Vᵢ = σ_c² sᵢ² with a known shape sᵢ per
+  entry and one level σ_c per channel c (an output), σ̂_c from the part of the
+  standardised residual that the estimation error cannot reach (:func:`_noise_levels`;
+  RSS / (N − k) for a misfit that weighs every entry by its noise). The shape is the data
+  kind's noise model: constant per output for time series (σ in data units),
+  **relative** for frequency responses and spectra (sᵢ ∝ the model's |H| or |Φyy|
+  there, σ a relative level, as ``si.simulate_frf(..., noise=ε)`` adds); intervals are
+  θ̂ ± t₀.₉₇₅(N − k)·SE;
+- **given** (``si.identify(..., noise_std=...)``): the standard deviation of every
+  measured value in data units (a complex value's E|e|² = std²), intervals
+  θ̂ ± 1.96·SE, and ``residual_ratio`` = rms of the residual in units of the given noise
+  (≈ 1 when the given noise is right).
+
+Nuisance unknowns (estimated initial states) are in J and marginalised: the θ block of
+the covariance is reported. The covariance is that of the least-squares estimate of the
+method's misfit, evaluated at θ̂: exact to first order for the methods that minimise that
+misfit (``ipopt``, ``oe``); for the others (``scr``, ``ls``, ``als``, ``gb``, an
+equation-error objective) it holds as far as their estimate agrees with that minimiser,
+and ``note`` says so (``polish=True`` reaches it).
 
 A Fisher information that is near-singular means the data hardly determine some
 combination of the parameters — practically non-identifiable even when structurally
@@ -26,14 +49,18 @@ from __future__ import annotations
 
 import abc
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
-__all__ = ["NEAR_SINGULAR", "FisherInformation", "Uncertainty", "fisher_uncertainty"]
+from symid.errors import DataError
+
+__all__ = ["NEAR_SINGULAR", "FisherInformation", "Uncertainty", "broadcast_noise", "fisher_uncertainty"]
 
 NEAR_SINGULAR = 1e-8
 """Smallest/largest eigenvalue of the correlation-scaled Fisher information below which it is near-singular."""
+
+_Z975 = 1.959963984540054  # the 0.975 quantile of the standard normal
 
 
 @dataclass(frozen=True)
@@ -44,15 +71,20 @@ class Uncertainty:
     ----------
     parameter_names : tuple of str
     covariance : numpy.ndarray
-        (l, l) covariance of θ̂ (``inf`` on the diagonal where F is singular).
+        (l, l) covariance of θ̂ (``inf`` where the Fisher information is singular).
     standard_errors : numpy.ndarray
         Square roots of its diagonal.
     intervals : numpy.ndarray
         (l, 2) lower and upper ends of the 95 % confidence intervals.
     noise_std : numpy.ndarray
-        Estimated noise standard deviation per output channel (data units).
-    dof : int
-        Degrees of freedom N − k of the residual.
+        Noise level per channel (output): estimated from the residuals, in ``noise_units``;
+        with given noise, the rms of the given standard deviations (data units).
+    noise_units : str
+        ``"data units"`` or ``"relative"`` (a fraction of the model's value at each point).
+    noise_source : str
+        ``"residuals"`` or ``"given"``.
+    dof : int or None
+        Degrees of freedom N − k of the residual (``None`` with given noise: normal quantile).
     condition : float
         Largest over smallest eigenvalue of the correlation-scaled Fisher information.
     near_singular : bool
@@ -60,6 +92,10 @@ class Uncertainty:
         non-identifiable from these data.
     weakest : dict of str to float
         The (unit) direction of θ the data determine least, by parameter name.
+    residual_ratio : float or None
+        With given noise: rms of the residual in units of the given noise (≈ 1 when it is right).
+    note : str
+        What the covariance describes when the method does not minimise this misfit.
     """
 
     parameter_names: tuple[str, ...]
@@ -67,16 +103,35 @@ class Uncertainty:
     standard_errors: np.ndarray
     intervals: np.ndarray
     noise_std: np.ndarray
-    dof: int
+    dof: int | None
     condition: float
     near_singular: bool
     weakest: dict[str, float]
+    noise_units: str = "data units"
+    noise_source: str = "residuals"
+    residual_ratio: float | None = None
+    note: str = ""
+
+    @property
+    def correlation(self) -> np.ndarray:
+        """Correlation matrix of θ̂ (NaN where a standard error is 0 or infinite)."""
+        se = self.standard_errors
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return self.covariance / np.outer(se, se)
 
     def summary(self) -> str:
         """One line per fact, for :meth:`IdentificationResult.summary`."""
-        noise = ", ".join(f"{s:.3g}" for s in self.noise_std)
-        text = (f"uncertainty: Fisher information (Gauss-Newton), noise std {noise} from the residuals, "
-                f"{self.dof} dof; condition {self.condition:.2e}")
+        if self.noise_source == "given":
+            noise = (f"noise given per value (rms {', '.join(f'{s:.3g}' for s in self.noise_std)}), residual/noise "
+                     f"rms {self.residual_ratio:.3g}")
+        elif self.noise_units == "relative":
+            noise = "relative noise " + ", ".join(f"{100 * s:.3g} %" for s in self.noise_std) + " from the residuals"
+        else:
+            noise = "noise std " + ", ".join(f"{s:.3g}" for s in self.noise_std) + " from the residuals"
+        dof = "normal quantile" if self.dof is None else f"{self.dof} dof"
+        text = f"uncertainty: Fisher information at the estimate, {noise}, {dof}; condition {self.condition:.2e}"
+        if self.note:
+            text += f"\n  note: {self.note}"
         if self.near_singular:
             top = sorted(self.weakest.items(), key=lambda kv: -abs(kv[1]))[:3]
             text += ("\n  NEAR-SINGULAR Fisher information: the data hardly determine the direction "
@@ -84,66 +139,195 @@ class Uncertainty:
         return text
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-Python form, suitable for JSON."""
-        return {"parameter_names": list(self.parameter_names), "covariance": self.covariance.tolist(),
-                "standard_errors": self.standard_errors.tolist(), "intervals": self.intervals.tolist(),
-                "noise_std": self.noise_std.tolist(), "dof": self.dof, "condition": self.condition,
-                "near_singular": self.near_singular, "weakest": dict(self.weakest)}
+        """Plain-Python form, suitable for JSON (non-finite entries as ``None``)."""
+        return {"parameter_names": list(self.parameter_names), "covariance": _plain(self.covariance),
+                "standard_errors": _plain(self.standard_errors), "intervals": _plain(self.intervals),
+                "noise_std": _plain(self.noise_std), "noise_units": self.noise_units,
+                "noise_source": self.noise_source, "dof": self.dof, "condition": _plain(self.condition),
+                "near_singular": self.near_singular, "weakest": dict(self.weakest),
+                "residual_ratio": self.residual_ratio, "note": self.note}
+
+
+def _plain(a: Any) -> Any:
+    """Lists of floats, ``None`` for non-finite entries (JSON has no infinity)."""
+    arr = np.asarray(a, dtype=float)
+    return np.where(np.isfinite(arr), arr, None).tolist()
 
 
 class FisherInformation(abc.ABC):
-    """What an estimator supplies for :func:`fisher_uncertainty`: residuals, their Jacobian and channels."""
+    """What an estimator supplies for :func:`fisher_uncertainty`: residuals, their Jacobian and noise shape.
+
+    ``noise_units`` says what the residual-estimated noise level measures (``"data units"``
+    or ``"relative"``).
+    """
+
+    noise_units: ClassVar[str] = "data units"
 
     @abc.abstractmethod
     def jacobian(self, theta: Any) -> tuple[np.ndarray, np.ndarray]:
-        """Residual vector r (N,) and its Jacobian (N, k), θ first then any nuisance unknowns."""
+        """Residual vector r (N,) of the misfit (``cost ∝ ‖r‖²``) and its Jacobian (N, k), θ first, then
+        any nuisance unknowns."""
 
     @abc.abstractmethod
     def residual_channels(self) -> np.ndarray:
-        """Output channel (0 … p−1) of every entry of r."""
+        """Channel (0 … c−1, an output) of every entry of r."""
 
-    def uncertainty(self, theta: Any, parameter_names: tuple[str, ...]) -> Uncertainty:
-        """The :class:`Uncertainty` of the estimate ``theta``."""
+    @abc.abstractmethod
+    def noise_shape(self, theta: Any) -> np.ndarray:
+        """sᵢ ≥ 0 per entry of r with Var(rᵢ) = σ_c² sᵢ² under the data kind's noise model (0: no noise there)."""
+
+    @abc.abstractmethod
+    def given_noise(self, noise_std: Any) -> tuple[np.ndarray, np.ndarray]:
+        """The standard deviation of every entry of r for a user's ``noise_std`` (data units, per measured
+        value), and the given standard deviations themselves (flattened) for the report."""
+
+    def uncertainty_note(self) -> str:
+        """What the covariance describes for this method ('' when the method minimises the misfit)."""
+        return ""
+
+    def estimate_sensitivity(self, theta: Any) -> np.ndarray | None:
+        """For a method that does not minimise ‖r‖²: G (l, N) with dθ̂ = G e to first order for noise e on
+        the entries of r; ``None`` (default) for a least-squares minimiser of ‖r‖²."""
+        return None
+
+    def uncertainty(self, theta: Any, parameter_names: tuple[str, ...], noise_std: Any = None) -> Uncertainty:
+        """The :class:`Uncertainty` of the estimate ``theta`` (noise from the residuals, or ``noise_std``)."""
+        theta = np.asarray(theta, dtype=float)
         r, J = self.jacobian(theta)
-        return fisher_uncertainty(np.asarray(theta, dtype=float), parameter_names, r, J, self.residual_channels())
+        channels = self.residual_channels()
+        G = self.estimate_sensitivity(theta)
+        if noise_std is None:
+            return fisher_uncertainty(theta, parameter_names, r, J, channels, shape=self.noise_shape(theta),
+                                      units=self.noise_units, sensitivity=G, note=self.uncertainty_note())
+        std, given = self.given_noise(noise_std)
+        return fisher_uncertainty(theta, parameter_names, r, J, channels, given_std=std, given_values=given,
+                                  sensitivity=G, note=self.uncertainty_note())
+
+
+def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
+    """``noise_std`` as a float array of ``shape``: a number, or an array that broadcasts (its leading axes
+    matching); every value finite and > 0, else a :class:`~symid.errors.DataError` naming ``what``.
+
+    Examples
+    --------
+    >>> from symid.fit.uncertainty import broadcast_noise
+    >>> broadcast_noise([0.1, 0.2], (2, 1, 1), "H").ravel().tolist()
+    [0.1, 0.2]
+    """
+    try:
+        arr = np.asarray(noise_std, dtype=float)
+    except (TypeError, ValueError):
+        raise DataError(f"noise_std must be a number or an array of numbers (data units); got {noise_std!r}") from None
+    if arr.ndim > len(shape):
+        raise DataError(f"noise_std has shape {arr.shape}; {what} has shape {shape}")
+    arr = arr.reshape(arr.shape + (1,) * (len(shape) - arr.ndim))
+    try:
+        out = np.broadcast_to(arr, shape).astype(float)
+    except ValueError:
+        raise DataError(f"noise_std of shape {np.shape(noise_std)} does not fit {what} of shape {shape}: give one "
+                        f"number, one per {'frequency' if 'H' in what or 'Phi' in what else 'sample'} "
+                        f"({shape[0]},), or the full shape") from None
+    if not np.all(np.isfinite(out)) or np.any(out <= 0):
+        raise DataError("noise_std must be finite and > 0 everywhere (a standard deviation in data units)")
+    return out
+
+
+def _noise_levels(r: np.ndarray, J: np.ndarray, channels: np.ndarray, s: np.ndarray, p: int) -> np.ndarray:
+    """Noise levels σ_c from the residual, free of the estimation error.
+
+    To first order r = e − J δ (δ = θ̂ − θ). Standardised by the noise, r̃ = V^-½ r and
+    J̃ = V^-½ J, the part of r̃ orthogonal to the columns of J̃ is (I − P̃) ẽ: it does not
+    depend on δ, and E Σ_{i∈c} ((I − P̃) ẽ)ᵢ² = Σ_{i∈c} (1 − P̃ᵢᵢ). Matching the two per
+    channel gives σ_c (V holds the σ_c, so three rounds from σ = 1; one suffices for one
+    channel). For a fit that weighs every entry by its noise this is the textbook
+    RSS / (N − k); for one that does not (an unweighted misfit of relative noise), the
+    plain residual would mix in δ, and with it the very error the intervals are for.
+    """
+    level = np.ones(p)
+    present = np.array([np.any(channels == c) for c in range(p)])
+    for _ in range(1 if p == 1 else 3):
+        sd = level[channels] * s
+        Jt, rt = J / sd[:, None], r / sd
+        d = np.linalg.norm(Jt, axis=0)
+        U, sv, _ = np.linalg.svd(Jt / np.where(d > 0, d, 1.0)[None, :], full_matrices=False)
+        U = U[:, sv > sv.max() * 1e-12] if sv.size and sv.max() > 0 else U[:, :0]
+        e = rt - U @ (U.T @ rt)
+        lev = np.sum(U**2, axis=1)
+        for c in range(p):
+            rows = channels == c
+            if present[c]:
+                level[c] *= np.sqrt(float(np.sum(e[rows] ** 2)) / max(float(np.sum(1 - lev[rows])), 1e-300))
+    return level
 
 
 def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: np.ndarray, J: np.ndarray,
-                       channels: np.ndarray) -> Uncertainty:
-    """Covariance from F = Σⱼ Jⱼᵀ Jⱼ / σ̂ⱼ² (module text); the first ``len(theta)`` columns of J are θ.
+                       channels: np.ndarray, *, shape: np.ndarray | None = None, units: str = "data units",
+                       given_std: np.ndarray | None = None, given_values: np.ndarray | None = None,
+                       sensitivity: np.ndarray | None = None, note: str = "") -> Uncertainty:
+    """Covariance (JᵀJ)⁻¹ JᵀVJ (JᵀJ)⁻¹ with V from the residuals or given (module text).
+
+    The first ``len(theta)`` columns of J are θ; entries with zero noise shape (or given
+    standard deviation) carry no noise and are left out. ``sensitivity`` (l, N), when
+    given, is the method's own first-order map from the noise on the entries of r to
+    θ̂ (dθ̂ = G e), for a method that does not minimise ‖r‖²; the covariance is then G V Gᵀ.
 
     Examples
     --------
     >>> import numpy as np
     >>> from symid.fit.uncertainty import fisher_uncertainty
     >>> t = np.linspace(0, 1, 50)
-    >>> J = -np.column_stack([np.ones(50), t])            # ŷ = a + b t
-    >>> r = 0.1 * np.sin(37 * t)                           # some residual
-    >>> u = fisher_uncertainty(np.array([1.0, 2.0]), ("a", "b"), r, J, np.zeros(50, int))
+    >>> J = -np.column_stack([np.ones(50), t])            # r = y − (a + b t)
+    >>> y = 1 + 2 * t + 0.1 * np.sin(37 * t)
+    >>> ab, *_ = np.linalg.lstsq(-J, y, rcond=None)
+    >>> r = y + J @ ab                                     # the least-squares residual
+    >>> u = fisher_uncertainty(ab, ("a", "b"), r, J, np.zeros(50, int))
     >>> bool(np.allclose(u.covariance, np.linalg.inv(J.T @ J) * (r @ r) / 48))
     True
     """
     from scipy.stats import t as student_t
 
+    theta = np.asarray(theta, dtype=float)
     l = theta.size
-    N, k = J.shape
-    dof = max(N - k, 1)
-    channels = np.asarray(channels, dtype=int)
-    p = int(channels.max()) + 1
-    var = np.empty(p)
-    F = np.zeros((k, k))
-    for j in range(p):
-        rows = channels == j
-        nj = int(rows.sum())
-        var[j] = float(r[rows] @ r[rows]) / max(nj - k * nj / N, 1e-300)
-        if var[j] > 0:
-            F += J[rows].T @ J[rows] / var[j]
-    d = np.sqrt(np.clip(np.diag(F), 0, None))
+    r = np.asarray(r, dtype=float).reshape(-1)
+    J = np.asarray(J, dtype=float)
+    channels = np.asarray(channels, dtype=int).reshape(-1)
     names = tuple(parameter_names)
-    if np.all(var == 0) or not np.all(np.isfinite(F)):
+    s = np.ones(r.size) if shape is None else np.asarray(shape, dtype=float).reshape(-1)
+    if given_std is not None:
+        s = np.asarray(given_std, dtype=float).reshape(-1)
+    keep = s > 0
+    r, J, channels, s = r[keep], J[keep], channels[keep], s[keep]
+    Gm = None if sensitivity is None else np.asarray(sensitivity, dtype=float)[:, keep]
+    N, k = J.shape
+    p = int(channels.max()) + 1 if channels.size else 1
+    level = np.zeros(p)
+    ratio = None
+    if given_std is None:
+        dof: int | None = max(N - k, 1)
+        level = _noise_levels(r, J, channels, s, p)
+        var = (level[channels] * s) ** 2
+        quantile = float(student_t.ppf(0.975, dof))
+    else:
+        dof = None
+        var = s**2
+        ratio = float(np.sqrt(np.mean((r / s) ** 2))) if N else float("nan")
+        g = np.asarray(given_values, dtype=float).reshape(-1) if given_values is not None else s
+        level = np.array([float(np.sqrt(np.mean(g**2)))])
+        quantile = _Z975
+
+    def singular(cond: float = float("inf")) -> Uncertainty:
         inf = np.full((l, l), np.inf)
         return Uncertainty(names, inf, np.full(l, np.inf), np.column_stack([theta - np.inf, theta + np.inf]),
-                           np.sqrt(var), dof, float("inf"), True, {})
+                           level, dof, cond, True, {}, units, "residuals" if given_std is None else "given",
+                           ratio, note)
+
+    if N == 0 or not np.any(var > 0) or not np.all(np.isfinite(J)) or not np.all(np.isfinite(var)):
+        return singular()
+    # Fisher information F = Jᵀ V⁻¹ J; entries with no noise estimate (var = 0) carry no information here
+    noisy = var > 0
+    Jn, vn = J[noisy], var[noisy]
+    F = Jn.T @ (Jn / vn[:, None])
+    d = np.sqrt(np.clip(np.diag(F), 0, None))
     safe = np.where(d > 0, d, 1.0)
     Fs = F / np.outer(safe, safe)
     ev, vec = np.linalg.eigh(Fs)
@@ -151,15 +335,24 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     near = not (ev[0] > NEAR_SINGULAR * ev[-1]) or bool(np.any(d == 0))
     w = vec[:, 0][:l] / safe[:l]
     w = w / (np.linalg.norm(w) or 1.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv_s = np.where(ev > ev[-1] * 1e-15, 1.0 / ev, np.inf)
-        cov_all = (vec * inv_s) @ vec.T / np.outer(safe, safe) if np.all(np.isfinite(inv_s)) else None
-    if cov_all is None:
-        cov = np.full((l, l), np.inf)
+    weakest = dict(zip(names, np.round(w, 6).tolist(), strict=True))
+    # sandwich (JᵀJ)⁻¹ JᵀVJ (JᵀJ)⁻¹, columns scaled like F (the same null space)
+    Js = Jn / safe[None, :]
+    G = Js.T @ Js
+    gev, gvec = np.linalg.eigh(G)
+    if not np.any(d == 0) and gev[0] > gev[-1] * 1e-15 and ev[0] > ev[-1] * 1e-15:
+        if Gm is not None and np.all(np.isfinite(Gm)):
+            cov = (Gm * var[None, :]) @ Gm.T
+        else:
+            Ginv = (gvec / gev) @ gvec.T
+            cov_all = Ginv @ (Js.T @ (Js * vn[:, None])) @ Ginv / np.outer(safe, safe)
+            cov = cov_all[:l, :l]
+        cov = 0.5 * (cov + cov.T)
     else:
-        cov = cov_all[:l, :l]
+        result = singular(cond)
+        return Uncertainty(names, result.covariance, result.standard_errors, result.intervals, level, dof, cond,
+                           True, weakest, units, result.noise_source, ratio, note)
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
-    q = float(student_t.ppf(0.975, dof))
-    ci = np.column_stack([theta - q * se, theta + q * se])
-    return Uncertainty(names, cov, se, ci, np.sqrt(var), dof, cond, near,
-                       dict(zip(names, np.round(w, 6).tolist(), strict=True)))
+    ci = np.column_stack([theta - quantile * se, theta + quantile * se])
+    return Uncertainty(names, cov, se, ci, level, dof, cond, near, weakest, units,
+                       "residuals" if given_std is None else "given", ratio, note)

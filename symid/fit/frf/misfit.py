@@ -9,6 +9,7 @@ import numpy as np
 
 from symid.errors import DataError, ModelError
 from symid.fit.base import Estimator
+from symid.fit.frf.fisher import FrfFisher
 
 __all__ = ["FrfEstimator", "check_frf", "relative_misfit", "relative_residuals"]
 
@@ -76,8 +77,9 @@ def relative_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:
     return np.where(mag > 0, (H - Hm) / np.where(mag > 0, mag, 1.0), 0.0)
 
 
-class FrfEstimator(Estimator):
-    """Base of the frequency-response methods: their data misfit (relative, squared)."""
+class FrfEstimator(Estimator, FrfFisher):
+    """Base of the frequency-response methods: their data misfit (relative, squared), and its Fisher
+    information for the uncertainty of θ̂ (:mod:`symid.fit.frf.fisher`)."""
 
     cost_kind: ClassVar[str] = "relative FRF misfit Σ‖Hᵢ − H(ωᵢ, θ)‖²_F / Σ‖Hᵢ‖²_F"
 

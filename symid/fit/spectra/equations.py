@@ -18,6 +18,7 @@ import numpy as np
 
 from symid.errors import DataError, ModelError
 from symid.fit.base import Estimator
+from symid.fit.spectra.fisher import SpectraFisher
 from symid.model.secondorder import SecondOrderModel
 
 __all__ = ["SpectraEstimator", "SpectralEquations", "check_spectral", "model_spectra", "spectral_equations",
@@ -195,8 +196,9 @@ def spectral_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:
     return np.where(nrm > 0, (Phi - Pm) / np.where(nrm > 0, nrm, 1.0), 0.0)
 
 
-class SpectraEstimator(Estimator):
-    """Base of the spectral methods: their data misfit (relative, squared, on Φyy)."""
+class SpectraEstimator(Estimator, SpectraFisher):
+    """Base of the spectral methods: their data misfit (relative, squared, on Φyy), and its Fisher
+    information for the uncertainty of θ̂ (:mod:`symid.fit.spectra.fisher`)."""
 
     cost_kind = "relative spectral misfit Σ‖Φyyᵢ − H Φuuᵢ Hᴴ‖²_F / Σ‖Φyyᵢ‖²_F"
 

@@ -25,12 +25,13 @@ import casadi as ca
 import numpy as np
 
 from symid.engine.ipopt import HESSIANS, IpoptSolver, positivity_bounds
+from symid.errors import DataError
 from symid.fit.base import Estimator
 from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale
 from symid.fit.result import StartOutcome
 from symid.fit.timeseries.records import as_records
 from symid.fit.timeseries.response import casadi_output, simulate_output, squarings, state_transitions
-from symid.fit.uncertainty import FisherInformation
+from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
 __all__ = ["OutputError"]
 
@@ -243,6 +244,26 @@ class OutputError(Estimator, FisherInformation):
         """Output channel of every entry of the residual vector of :meth:`jacobian`."""
         p = self.model.n_outputs
         return np.concatenate([np.repeat(np.arange(p), r.n_samples) for r in self.records])
+
+    def noise_shape(self, theta: Any) -> np.ndarray:
+        """√wⱼ per entry: the residual of output j is √wⱼ (y − ŷ), noise of one level per output (data units)."""
+        sw = np.sqrt(self._weights)
+        return np.concatenate([np.repeat(sw, r.n_samples) for r in self.records])
+
+    def given_noise(self, noise_std: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Per entry of r, √wⱼ × the given standard deviation; ``noise_std`` is a number, an array (N,) per
+        sample, (1, p) per output or (N, p), or a list of such, one per record."""
+        items = noise_std if isinstance(noise_std, (list, tuple)) and len(self.records) > 1 else None
+        if items is not None and len(items) != len(self.records):
+            raise DataError(f"noise_std is a list of {len(items)}; there are {len(self.records)} records")
+        sw = np.sqrt(self._weights)
+        std, given = [], []
+        for e, r in enumerate(self.records):
+            arr = broadcast_noise(noise_std if items is None else items[e], (r.n_samples, r.n_outputs),
+                                  f"the output y of record {e}" if len(self.records) > 1 else "the output y")
+            std.append((arr * sw[None, :]).T.reshape(-1))  # channel by channel, as the residual
+            given.append(arr.reshape(-1))
+        return np.concatenate(std), np.concatenate(given)
 
     def jacobian(self, theta: Any) -> tuple[np.ndarray, np.ndarray]:
         """Weighted residual vector r and its Jacobian with respect to (θ, estimated x0) in natural units.
