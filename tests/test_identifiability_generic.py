@@ -47,14 +47,14 @@ def test_merged_solution_case_is_local_with_two_solutions_at_every_seed():
 
 def test_a_point_where_solutions_merge_is_rejected():
     # θ* with a1* = a2* + a21*: the Jacobian loses rank there, and the Gröbner step refuses the
-    # point (2 solutions counted with multiplicity, 1 distinct) instead of reporting "global"
+    # point (2 solutions counted with multiplicity, a multiple root) instead of reporting "global"
     model = _two_compartments()
     assert model.parameter_names == ("a2", "a21", "a1")
     merged = [sp.Integer(4), sp.Integer(3), sp.Integer(7)]  # a1 = 7 = a2 + a21
     assert rank_at(model, [3, 4, 5]) == 3
     assert rank_at(model, merged) == 2
     params, _, minimal, summ, rng = star_and_summary(model)
-    with pytest.raises(NonGenericPoint, match="2 solutions counted with multiplicity but 1 distinct"):
+    with pytest.raises(NonGenericPoint, match="2 solutions counted with multiplicity, and no linear form separates"):
         global_analysis(model, prepared=(params, merged, minimal, summ, rng))
 
 

@@ -2,29 +2,35 @@
 
 Method
 ------
-1. Pick a random positive rational θ* (small integers keep the basis small) at which
-   the realisation is minimal, and build the polynomial system
-   ``n_i(θ)·d_i(θ*) − n_i(θ*)·d_i(θ) = 0`` for every summary entry ``n_i/d_i``, plus
-   ``t·q(θ) − 1 = 0`` (a saturation variable t) when the normalising polynomial q
-   (``det M`` for a second-order model) depends on θ, which removes spurious solutions
-   where the normalisation vanishes.
+1. Pick a random rational θ* (p/q, p ≤ 10⁵, q ≤ 10³, :func:`draw_point`) at which
+   M(θ*) is invertible, the Jacobian of the summary has its generic rank (at a point
+   where solutions merge it drops) and, preferably, the realisation is minimal; build
+   the polynomial system ``n_i(θ)·d_i(θ*) − n_i(θ*)·d_i(θ) = 0`` for every summary
+   entry ``n_i/d_i``, plus ``t·q(θ) − 1 = 0`` (a saturation variable t) when the
+   normalising polynomial q (``det M`` for a second-order model) depends on θ, which
+   removes spurious solutions where the normalisation vanishes.
 2. Reduced Gröbner basis in grevlex order (sympy). The ideal is zero-dimensional
    iff every variable has a pure power among the leading monomials; otherwise the
    solution set is positive-dimensional: the model is not identifiable.
-3. Zero-dimensional: the standard monomials give the quotient algebra and the
-   multiplication matrices (exact). Adding the square-free part of each variable's
-   minimal polynomial makes the ideal radical (Seidenberg's lemma), whose quotient
-   dimension is the number k of distinct complex solutions. The solutions themselves
-   are the joint eigenvectors of the multiplication matrices (numpy, float64); the
-   number of real ones is checked exactly (Sturm count of a separating linear form).
-   Real solutions with a non-positive value of a parameter declared positive are
-   discarded.
-4. Per parameter: θ_k is globally identifiable iff it takes the single value θ_k* on
-   every admissible solution; in a positive-dimensional case iff θ_k − θ_k* lies in
-   the radical of the ideal (normal form, then the Rabinowitsch trick).
+3. Zero-dimensional: the standard monomials give the quotient algebra (dimension D,
+   the number of solutions counted with multiplicity) and the multiplication
+   matrices (exact). The characteristic polynomial of a random linear form ℓ of the
+   variables must be square-free of degree D: then there are D distinct solutions,
+   each simple (the ideal is radical). Otherwise θ* has a multiple solution, which a
+   generic point never has (generic fibres are reduced), and
+   :class:`NonGenericPoint` asks for another θ*. The solutions are the eigenvectors
+   of the multiplication matrix of ℓ (numpy, float64); the number of real ones is
+   exact (Sturm count of ℓ's characteristic polynomial). Real solutions with a
+   non-positive value of a parameter declared positive are discarded.
+4. Per parameter: θ_k takes a single value on every complex solution iff its
+   multiplication matrix is θ_k* I (the ideal is radical); in a positive-dimensional
+   case iff θ_k − θ_k* lies in the radical of the ideal (normal form, then the
+   Rabinowitsch trick).
+5. :func:`generic_global` confirms what is claimed global at an independent point θ**,
+   modulo a random prime p ≈ 2³¹ (:func:`confirm_mod_p`: no coefficient growth).
 
-The verdicts are at one random θ*: they are the generic verdicts with probability one
-over ℂ; the counts of *real* and *positive* solutions can depend on the region of θ*.
+The complex count is the generic (structural) count; the counts of *real* and
+*positive* solutions depend on the region of θ*.
 """
 
 from __future__ import annotations
@@ -54,7 +60,7 @@ from symid.structural.summary import (
 )
 
 __all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "ExactStepLimit", "GlobalResult", "NonGenericPoint",
-           "draw_point", "generic_global", "global_analysis", "star_and_summary"]
+           "confirm_mod_p", "draw_point", "generic_global", "global_analysis", "star_and_summary"]
 
 REAL_TOL = 1e-7
 """Relative tolerance on a parameter value when comparing numerical solutions to θ*."""
@@ -295,15 +301,6 @@ def _charpoly_expr(M: DomainMatrix, x: sp.Symbol) -> sp.Poly:
     return sp.Poly([QQ.to_sympy(c) for c in coeffs], x, domain="QQ")
 
 
-def _nilpotent(N: DomainMatrix) -> bool:
-    D = N.shape[0]
-    P, k = N, 1
-    while k < D:
-        P = P * P
-        k *= 2
-    return P.is_zero_matrix
-
-
 def _in_radical(G, R: PolyRing, f: PolyElement) -> bool:
     if f.rem(G) == R.zero:
         return True
@@ -311,6 +308,118 @@ def _in_radical(G, R: PolyRing, f: PolyElement) -> bool:
     Ry = ring([*R.symbols, y], QQ, grevlex_memo)[0]
     Gy = [g.set_ring(Ry) for g in G] + [Ry.one - Ry.gens[-1] * f.set_ring(Ry)]
     return groebner(Gy, Ry) == [Ry.one]
+
+
+def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, list[PolyElement], int]:
+    """The polynomial system summary(θ) = summary(θ*) over ℚ (or GF(modulus)): ring, equations, auxiliary count."""
+    dom = QQ if modulus is None else sp.GF(modulus)
+
+    def lift(p: PolyElement, R: PolyRing) -> PolyElement:
+        if modulus is None:
+            return _lift(p, R)
+        n = R.ngens - len(params)
+        return R({(*k, *([0] * n)): dom(int(c.numerator)) / dom(int(c.denominator)) for k, c in p.terms()})
+
+    def const(c) -> object:
+        return c if modulus is None else dom(int(c.numerator)) / dom(int(c.denominator))
+
+    R0 = summ.ring
+    tsym = sp.Dummy("t")
+    eqs = []
+    L = summ.normaliser
+    if L is not None and not L.is_ground:
+        # common normaliser: N_i(θ) = λ N_i(θ*), L(θ) = λ L(θ*), t λ = 1 (fewer terms than cross-multiplying)
+        lam = sp.Dummy("lam")
+        R = ring([*params, lam, tsym], dom, grevlex_memo)[0]
+        lamR, tR = R.gens[-2], R.gens[-1]
+        for num, den in [*zip(summ.numerators, summ.denominators, strict=True), (L, L)]:
+            raw = num * L.exquo(den)
+            eqs.append(lift(raw, R) - lamR * const(raw(*pt)))
+        eqs.append(tR * lamR - R.one)
+        aux = 2
+    else:
+        nonconst_den = [d for d in summ.denominators if not d.is_ground]
+        sat = None
+        if nonconst_den:
+            sat = nonconst_den[0]
+            for d in nonconst_den[1:]:
+                sat = sat.lcm(d)
+            sat = sat.sqf_part()
+            R = ring([*params, tsym], dom, grevlex_memo)[0]
+        else:
+            R = ring(list(params), dom, grevlex_memo)[0]
+        aux = 1 if sat is not None else 0
+        for num, den in zip(summ.numerators, summ.denominators, strict=True):
+            e = num * den(*pt) - den * num(*pt)
+            if e != R0.zero:
+                eqs.append(lift(e, R))
+        if sat is not None:
+            eqs.append(R.gens[-1] * lift(sat, R) - R.one)
+    eqs = [e for e in eqs if e != R.zero] or [R.zero]
+    return R, eqs, aux
+
+
+def _mod_p_modulus(rng: random.Random) -> int:
+    """A random prime in [2³⁰, 2³¹)."""
+    while True:
+        p = rng.randrange(2**30, 2**31) | 1
+        if sp.isprime(p):
+            return p
+
+
+def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int = 0, draw: int = 500,
+                  rank: int | None = None) -> tuple[bool, int | None, dict, dict]:
+    """Solve summary(θ) = summary(θ**) modulo a random prime at an independent generic point θ**.
+
+    Used to confirm global claims (:func:`generic_global`): the same algebra as
+    :func:`global_analysis` over GF(p), p a random prime in [2³⁰, 2³¹), so the
+    coefficients never grow. For a prime that does not divide the finitely many
+    denominators and leading coefficients of the computation (all but a negligible
+    fraction), the quotient dimension and the per-parameter answers are those over ℚ.
+
+    Returns
+    -------
+    (zero_dimensional, quotient dimension or None, single-valued per parameter, θ** as strings)
+    """
+    params, star, _, summ, rng = star_and_summary(model, known, seed=seed, draw=draw, rank=rank)
+    names = [p.name for p in params]
+    theta2 = {n: str(v) for n, v in zip(names, star, strict=True)}
+    pt = [QQ.from_sympy(v) for v in star]
+    modulus = _mod_p_modulus(rng)
+    R, eqs, _ = _system(summ, params, pt, modulus)
+    dom = R.domain
+    ptp = [dom(int(v.numerator)) / dom(int(v.denominator)) for v in pt]
+    G = groebner(eqs, R)
+    nv = R.ngens
+    if not _is_zero_dimensional(G, nv):
+        single = {}
+        for i, name in enumerate(names):
+            f = R.gens[i] - ptp[i]
+            if f.rem(G) == R.zero:
+                single[name] = True
+                continue
+            y = sp.Dummy("y")
+            Ry = ring([*R.symbols, y], dom, grevlex_memo)[0]
+            Gy = [g.set_ring(Ry) for g in G] + [Ry.one - Ry.gens[-1] * f.set_ring(Ry)]
+            single[name] = groebner(Gy, Ry) == [Ry.one]
+        return False, None, single, theta2
+    basis = _standard_monomials([g.LM for g in G], nv, MAX_QUOTIENT)
+    if basis is None:
+        return True, None, dict.fromkeys(names, False), theta2
+    if len(basis) == 1:
+        return True, 1, dict.fromkeys(names, True), theta2
+    single = {}
+    for i, name in enumerate(names):  # θ_i single-valued iff (x_i − θ_i**)·m ≡ 0 for every standard monomial m
+        ok = True
+        for m in basis:
+            mono = list(m)
+            mono[i] += 1
+            nf = (R({tuple(mono): dom(1)}) - R({m: ptp[i]})).rem(G)
+            if nf != R.zero:
+                ok = False
+                break
+        single[name] = ok
+    return True, len(basis), single, theta2
 
 
 def global_analysis(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
@@ -374,41 +483,8 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
 
     # -- polynomial system --------------------------------------------------------
     t1 = time.perf_counter()
-    R0 = summ.ring
-    tsym = sp.Dummy("t")
     pt = [QQ.from_sympy(v) for v in star]
-    eqs = []
-    L = summ.normaliser
-    if L is not None and not L.is_ground:
-        # common normaliser: N_i(θ) = λ N_i(θ*), L(θ) = λ L(θ*), t λ = 1 (fewer terms than cross-multiplying)
-        lam = sp.Dummy("lam")
-        R = ring([*params, lam, tsym], QQ, grevlex_memo)[0]
-        lamR, tR = R.gens[-2], R.gens[-1]
-        for num, den in [*zip(summ.numerators, summ.denominators, strict=True), (L, L)]:
-            raw = num * L.exquo(den)
-            eqs.append(_lift(raw, R) - lamR * raw(*pt))
-        eqs.append(tR * lamR - R.one)
-        aux = 2
-    else:
-        nonconst_den = [d for d in summ.denominators if not d.is_ground]
-        sat = None
-        if nonconst_den:
-            sat = nonconst_den[0]
-            for d in nonconst_den[1:]:
-                sat = sat.lcm(d)
-            sat = sat.sqf_part()
-            R = ring([*params, tsym], QQ, grevlex_memo)[0]
-        else:
-            R = ring(list(params), QQ, grevlex_memo)[0]
-        aux = 1 if sat is not None else 0
-        for num, den in zip(summ.numerators, summ.denominators, strict=True):
-            e = num * den(*pt) - den * num(*pt)
-            if e != R0.zero:
-                eqs.append(_lift(e, R))
-        if sat is not None:
-            eqs.append(R.gens[-1] * _lift(sat, R) - R.one)
-    if not eqs:
-        eqs = [R.zero]
+    R, eqs, aux = _system(summ, params, pt)
     G = groebner(eqs, R)
     times["groebner"] = time.perf_counter() - t1
     nv = R.ngens
@@ -464,21 +540,13 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
         else:
             mm = _mult_matrices(G, R, basis, range(nv))
             x = sp.Dummy("x")
-            for i, name in enumerate(names):
-                glob_c[name] = _nilpotent(mm[i] - DomainMatrix.eye(len(basis), QQ) * pt[i])
-            # radical: add square-free minimal polynomials of every variable (Seidenberg)
-            extra = []
-            for v in range(nv):
-                cp = _charpoly_expr(mm[v], x).sqf_part()
-                extra.append(sum((R.gens[v] ** k * QQ.from_sympy(c)
-                                  for (k,), c in cp.terms()), R.zero))
-            Grad = groebner(list(G) + extra, R)
-            rbasis = _standard_monomials([g.LM for g in Grad], nv, MAX_QUOTIENT)
-            n_c = len(rbasis)
-            if n_c < len(basis):  # a multiple solution: θ* is where solutions merge (never at a generic point)
-                raise NonGenericPoint(f"{len(basis)} solutions counted with multiplicity but {n_c} distinct")
-            rmm = _mult_matrices(Grad, R, rbasis, range(nv))
-            sols_all, n_r = _solve_numeric(rmm, theta_idx, rng, x)
+            # a separating linear form with a square-free characteristic polynomial proves the ideal radical:
+            # len(basis) distinct solutions, each simple (else θ* is where solutions merge: NonGenericPoint)
+            sols_all, n_r = _solve_numeric(mm, theta_idx, rng, x)
+            n_c = len(basis)
+            eye = DomainMatrix.eye(n_c, QQ)
+            for i, name in enumerate(names):  # radical: M_i is diagonalisable, single-valued iff M_i = θ_i* I
+                glob_c[name] = (mm[i] - eye * pt[i]).is_zero_matrix
             for s in sols_all:
                 if s["real"]:
                     real_sols.append({names[i]: s["values"][i] for i in theta_idx})
@@ -502,33 +570,63 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
 
 
 def _solve_numeric(mm: dict[int, DomainMatrix], theta_idx, rng: random.Random, x: sp.Symbol):
-    """All solutions of a radical zero-dimensional ideal from its multiplication matrices."""
+    """All solutions of a zero-dimensional ideal from its multiplication matrices, and the number of real ones.
+
+    The characteristic polynomial of a random linear form ℓ (exact) must be square-free of
+    degree D, the quotient dimension: then ℓ takes D distinct values, so there are D
+    distinct solutions, each simple (the ideal is radical). Else :class:`NonGenericPoint`.
+    """
     nv = len(mm)
     D = mm[0].shape[0]
     F = {v: np.array([[float(c) for c in row] for row in mm[v].to_list()]) for v in range(nv)}
-    for _ in range(10):
-        r = [rng.randint(1, 97) for _ in range(nv)]
+    for _ in range(3):
+        r = [rng.randint(1, 10**6) for _ in range(nv)]
         Ml = sum((mm[v] * QQ(r[v]) for v in range(1, nv)), mm[0] * QQ(r[0]))
         cp = _charpoly_expr(Ml, x)
         if cp.degree() == D and sp.degree(sp.gcd(cp, cp.diff(x)), x) == 0:
             break
-    else:  # pragma: no cover - a separating form exists with probability one
-        raise ExactStepLimit("no separating linear form found for the solution set in 10 random draws")
-    n_real = int(cp.count_roots())
+    else:  # three random forms (coefficients up to 1e6) fail to separate only at a multiple solution
+        raise NonGenericPoint(f"{D} solutions counted with multiplicity, and no linear form separates them: "
+                              "a multiple solution")
     Fl = sum(r[v] * F[v] for v in range(nv))
     w, vecs = np.linalg.eig(Fl.T)
-    order = np.argsort(np.abs(w.imag), kind="stable")
+    real = _certified_real(cp, w)
     out = []
-    for rank_, k in enumerate(order):
+    for k in np.argsort(~real, kind="stable"):
         vec = vecs[:, k]
         vals = []
         for v in range(nv):
             num = np.vdot(vec, F[v].T @ vec)
             vals.append(num / np.vdot(vec, vec))
-        is_real = rank_ < n_real
-        out.append({"real": is_real, "values": [float(np.real(vals[v])) if is_real else complex(vals[v])
-                                                for v in range(nv)]})
-    return out, n_real
+        out.append({"real": bool(real[k]), "values": [float(np.real(vals[v])) if real[k] else complex(vals[v])
+                                                      for v in range(nv)]})
+    return out, int(real.sum())
+
+
+def _certified_real(cp: sp.Poly, w: np.ndarray) -> np.ndarray:
+    """Which eigenvalues ``w`` of ℓ's multiplication matrix are real, each proven by an exact sign change of ``cp``.
+
+    ``cp`` (square-free, its roots the values of ℓ at the solutions) changes sign on a
+    small rational interval around each numerically real eigenvalue, the intervals
+    pairwise disjoint: an odd number of real roots in each, so at least one real
+    solution per interval (ℓ separates the solutions, so a real value of ℓ is a real
+    solution). Faster than a Sturm sequence, whose coefficients grow with θ*'s. An
+    eigenvalue not so proven is counted as not real (the count is then a lower bound;
+    for a simple real root it is exact).
+    """
+    real = np.zeros(len(w), dtype=bool)
+    cand = [k for k in range(len(w)) if abs(w[k].imag) <= 1e-6 * max(1.0, abs(w[k]))]
+    cand.sort(key=lambda k: w[k].real)
+    xs = [w[k].real for k in cand]
+    for j, k in enumerate(cand):
+        gap = min([abs(xs[j] - xs[i]) for i in (j - 1, j + 1) if 0 <= i < len(xs)] or [1.0])
+        delta = min(1e-6 * max(1.0, abs(xs[j])), gap / 3)
+        if delta <= 0:
+            continue
+        lo, hi = sp.Rational(xs[j] - delta), sp.Rational(xs[j] + delta)
+        a, b = cp.eval(lo), cp.eval(hi)
+        real[k] = (a < 0 < b) or (b < 0 < a)
+    return real
 
 
 def _claims_global(res: GlobalResult) -> bool:
@@ -546,8 +644,9 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
        solution (the quotient algebra is larger than the number of distinct solutions);
     2. when the result claims anything global (a single complex solution, or a
        parameter with a single value over every complex solution), the step is
-       repeated at an independent generic point θ**, and a parameter is global only
-       when it is at both points (the larger solution count is kept).
+       repeated at an independent generic point θ** modulo a random prime
+       (:func:`confirm_mod_p`), and a parameter is global only when it is at both
+       points.
 
     Examples
     --------
@@ -574,32 +673,18 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     draws = draw + 1
     if not _claims_global(res):
         return replace(res, notes=(*res.notes, *notes), draws=draws)
-    other = None
-    for draw2 in range(500, 500 + MAX_DRAWS):
-        prepared = star_and_summary(model, known, seed=seed, draw=draw2, rank=rank)
-        try:
-            other = global_analysis(model, known, positive=positive, seed=seed, expressions=False, prepared=prepared)
-            break
-        except NonGenericPoint as exc:
-            star = ", ".join(str(v) for v in prepared[1])
-            notes.append(f"θ** = ({star}) was not generic ({exc}); drawn again")
-    if other is None:
-        raise ExactStepLimit(f"no generic confirmation point θ** in {MAX_DRAWS} random draws")
-    glob_c = {k: v and other.global_complex.get(k, False) for k, v in res.global_complex.items()}
-    agree = glob_c == res.global_complex and other.zero_dimensional == res.zero_dimensional and \
-        other.n_complex == res.n_complex
+    zero2, count2, single2, theta2 = confirm_mod_p(model, known, seed=seed, draw=500, rank=rank)
+    glob_c = {k: v and single2.get(k, False) for k, v in res.global_complex.items()}
+    agree = glob_c == res.global_complex and zero2 == res.zero_dimensional and count2 == res.n_complex
     if not agree:
-        notes.append(f"the independent point θ** gave a different result ({other.n_complex} complex solutions there, "
-                     f"{res.n_complex} at θ*): the larger count and only the parameters global at both points are "
-                     "kept")
-        if other.n_complex is not None and res.n_complex is not None and other.n_complex > res.n_complex:
-            res = replace(other, candidates=res.candidates, membership=res.membership,
-                          summary_expressions=res.summary_expressions)
-        elif not other.zero_dimensional and res.zero_dimensional:
-            res = replace(other, candidates=res.candidates, membership=res.membership,
-                          summary_expressions=res.summary_expressions)
+        notes.append(f"the independent point θ** gave a different result ({count2} solutions there counted with "
+                     f"multiplicity, modulo a prime; {res.n_complex} at θ*): only the parameters single-valued at "
+                     "both points are global")
         glob_r = {k: v and glob_c[k] for k, v in res.global_real.items()}
         glob_a = {k: v and glob_c[k] for k, v in res.global_admissible.items()}
-        res = replace(res, global_complex=glob_c, global_real=glob_r, global_admissible=glob_a)
-    theta2 = {k: str(v) for k, v in other.theta_star.items()}
+        n_c = res.n_complex
+        if count2 is None or (n_c is not None and count2 > n_c) or (zero2 != res.zero_dimensional):
+            n_c = None if (count2 is None or not zero2) else count2
+        res = replace(res, global_complex=glob_c, global_real=glob_r, global_admissible=glob_a, n_complex=n_c,
+                      zero_dimensional=res.zero_dimensional and zero2)
     return replace(res, notes=(*res.notes, *notes), theta_confirm=theta2, confirmed=agree, draws=draws)
