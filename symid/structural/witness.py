@@ -320,9 +320,10 @@ def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive
     seed : int
         Seed of θ* (the same as :func:`~symid.structural.global_.global_analysis`) and of the starts.
     batches : int
-        Number of batches of starts (the search stops earlier once eight witnesses are
-        found). A fixed number of starts, not a time limit: the same model and seed give
-        the same witnesses on any machine.
+        Number of batches of starts (the search stops earlier, after a batch, once eight
+        witnesses are found or certified witnesses move every parameter). A fixed number
+        of starts, not a time limit: the same model and seed give the same witnesses on
+        any machine.
     batch : int
         Starts per batch.
     prepared : tuple, optional
@@ -373,6 +374,12 @@ def find_witnesses(model, known: Mapping[str, object] | None = None, *, positive
     n_starts = 0
     for _ in range(batches):
         if len(found) >= _MAX_WITNESSES:
+            break
+        moved = np.zeros(nv, dtype=bool)
+        for f, ok in zip(found, certified, strict=True):
+            if ok:
+                moved |= np.abs(f - xs) > 1e-6 * np.maximum(1.0, np.abs(xs))
+        if moved.all():  # certified witnesses already move every parameter: the verdicts are settled
             break
         mag = xs * np.exp(rng.normal(0.0, 1.5, (batch, nv)))
         sign = np.where(pos, 1.0, rng.choice([-1.0, 1.0], (batch, nv)))
