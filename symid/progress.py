@@ -20,10 +20,12 @@ def progress_bar(items: Iterable[T], *, desc: str, enabled: bool | None = None, 
     ``enabled=None`` shows the bar when there is more than one item and standard
     error is a terminal; ``True`` always, ``False`` never.
     """
-    seq = list(items)
+    if total is None:  # a sized sequence; an iterator with ``total`` is consumed lazily (as_completed)
+        items = list(items)
+        total = len(items)
     if enabled is None:
-        enabled = len(seq) > 1 and sys.stderr.isatty()
+        enabled = total > 1 and sys.stderr.isatty()
     if not enabled:
-        yield from seq
+        yield from items
         return
-    yield from tqdm(seq, desc=desc, total=total or len(seq), file=sys.stderr, leave=False, dynamic_ncols=True)
+    yield from tqdm(items, desc=desc, total=total, file=sys.stderr, leave=False, dynamic_ncols=True)

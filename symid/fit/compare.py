@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import time
+import uuid
+from collections.abc import Mapping, Sequence
+from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -154,10 +157,11 @@ class Comparison:
         return self.table()
 
 
-def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *, starts: int = 10,
-            seed: int | None = 0, truth: Any = None, x0: Any = None, param_tol: float = 1e-3,
-            progress: bool | None = None, options: dict[str, dict[str, Any]] | None = None,
-            noise_floor: float | None = None, log: RunLog | None = None) -> Comparison:
+def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *,
+            starts: int | Sequence[Any] = 10, seed: int | None = 0, truth: Any = None, x0: Any = None,
+            param_tol: float = 1e-3, progress: bool | None = None, options: dict[str, dict[str, Any]] | None = None,
+            noise_floor: float | None = None, log: RunLog | None = None, executor: Executor | None = None
+            ) -> Comparison:
     """Run several methods from identical starts and tabulate success and time.
 
     Parameters
@@ -172,8 +176,10 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         estimate fits the data (:meth:`symid.fit.frf.scr.ScrFRF.run_polished`). It is
         built and run on its own, so its setup and time per start (method + every
         polish) share nothing with the plain row.
-    starts : int
-        Number of starts; every method gets the same list (:func:`symid.starts.make_starts`).
+    starts : int or sequence of parameter vectors
+        Number of starts (every method gets the same list, :func:`symid.fit.starts.make_starts`),
+        or the starts themselves: a sequence of dicts or vectors in ``parameter_names``
+        order (then ``seed`` and ``x0`` play no part).
     seed : int, optional
         Seed of the random starts.
     truth : dict or sequence, optional
@@ -194,6 +200,15 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         are read back instead of run, so an interrupted comparison resumes where it
         stopped. Use :meth:`~symid.runlog.RunLog.scoped` to keep several comparisons in
         one file. A log written with other starts is refused.
+    executor : concurrent.futures.Executor, optional
+        Run the starts of each method as tasks of this executor: a
+        ``concurrent.futures.ProcessPoolExecutor`` on one machine, or a Dask cluster's
+        ``distributed.Client(...).get_executor()`` when a study outgrows it. Each worker
+        process builds every method's problem once (the model, data and options are sent
+        to it) and reuses it for the starts it runs; results are identical to a serial
+        run (every start is independent). Default: the starts run one after another in
+        this process. Threads (``ThreadPoolExecutor``) gain nothing: the solvers hold
+        the GIL for most of their time.
 
     Returns
     -------
@@ -234,9 +249,12 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         raise ModelError(f"options given for methods not compared: {', '.join(sorted(unknown))}")
     param_tol = check_float("param_tol", param_tol, low=0, strict_low=True)
     truth_vec = None if truth is None else model.theta_vector(truth)
-    x0s = make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+    x0s = _start_list(model, starts, seed, x0)
     if log is not None and not isinstance(log, RunLog):
         raise ModelError(f"log must be a symid.runlog.RunLog; got {type(log).__name__}")
+    if executor is not None and not isinstance(executor, Executor):
+        raise ModelError(f"executor must be a concurrent.futures.Executor (a process pool, or a Dask client's "
+                         f"get_executor()); got {type(executor).__name__}")
     criterion = (f"relative parameter error <= {param_tol:g}" if truth_vec is not None
                  else "the start's own success (solver finished and the estimate fits the data)")
     stats: list[MethodStats] = []
@@ -271,7 +289,8 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         meta: dict[str, Any] = {}
         try:
             method_options = dict(options.get(method.removesuffix("+polish"), {}))
-            _run_method(model, data, method, method_options, x0s, progress, log, outcomes, meta, noise_floor)
+            _run_method(model, data, method, method_options, x0s, progress, log, outcomes, meta, noise_floor,
+                        executor)
         except KeyboardInterrupt:
             if outcomes:
                 stats.append(tabulate(method, meta, outcomes, interrupted=True))
@@ -284,16 +303,66 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     return partial()
 
 
+def _start_list(model: Any, starts: Any, seed: int | None, x0: Any) -> list[np.ndarray]:
+    """The starts of a comparison: drawn (``starts`` a count) or given (a sequence of starts)."""
+    if isinstance(starts, (int, np.integer)) and not isinstance(starts, bool):
+        return make_starts(model, int(starts), seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+    if isinstance(starts, (str, bytes, Mapping)) or not isinstance(starts, (Sequence, np.ndarray)) or len(starts) == 0:
+        raise OptionError(f"starts must be a number of starts or a non-empty sequence of starts (dicts or vectors "
+                          f"of {model.n_parameters} values); got {type(starts).__name__}")
+    if x0 is not None:
+        raise OptionError("give either x0 or an explicit list of starts, not both (put x0 in the list)")
+    out = []
+    for i, st in enumerate(starts):
+        try:
+            out.append(np.asarray(model.theta_vector(st), dtype=float))
+        except ValueError as exc:
+            raise OptionError(f"start {i}: {exc}") from None
+    return out
+
+
+# One worker process builds each (comparison, method) estimator once and reuses it for its starts; a few
+# recent ones are kept, the oldest dropped. Private to this module; never consulted by the parent process.
+_WORKER_ESTIMATORS: dict[str, tuple[Any, Any]] = {}
+_WORKER_KEEP = 4
+
+
+def _worker_start(token: str, model: Any, data: Any, method: str, options: dict[str, Any],
+                  noise_floor: float | None, x: np.ndarray) -> StartOutcome:
+    """Run one start in an executor's worker (its history comes back with it)."""
+    built = _WORKER_ESTIMATORS.get(token)
+    if built is None:
+        estimator, polisher = _build(model, data, method, options, noise_floor)
+        while len(_WORKER_ESTIMATORS) >= _WORKER_KEEP:
+            _WORKER_ESTIMATORS.pop(next(iter(_WORKER_ESTIMATORS)))
+        built = _WORKER_ESTIMATORS[token] = (estimator, polisher)
+    estimator, polisher = built
+    return estimator.run(x) if polisher is None else estimator.run_polished(x, polisher)
+
+
+def _build(model: Any, data: Any, method: str, options: dict[str, Any], noise_floor: float | None
+           ) -> tuple[Any, Any]:
+    """The estimator of ``method`` and, for ``"<method>+polish"``, its polisher."""
+    estimator = prepare(model, data, method.removesuffix("+polish"), options, noise_floor=noise_floor)
+    polisher = None
+    if method.endswith("+polish"):
+        polisher = estimator.polisher()
+        if polisher is None:
+            raise OptionError(f"{method!r}: method {estimator.method!r} has no polish step")
+        polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
+    return estimator, polisher
+
+
 def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s: list[np.ndarray],
                 progress: bool | None, log: RunLog | None, outcomes: list[StartOutcome], meta: dict[str, Any],
-                noise_floor: float | None) -> None:
-    """Run one method from every start, appending to ``outcomes`` as each ends.
+                noise_floor: float | None, executor: Executor | None = None) -> None:
+    """Run one method from every start, appending to ``outcomes`` (in start order).
 
     ``meta`` receives ``ran_as``, ``options``, ``setup_time`` and ``cost_kind`` as soon as
     they are known (so an interrupted row is still labelled). Starts found in ``log`` are
-    read back instead of run; each new one is logged as it ends.
+    read back instead of run; each new one is logged as it ends. With an ``executor``
+    the starts run as its tasks and are logged as they complete, in any order.
     """
-    base = method.removesuffix("+polish")
     cached = [None if log is None else log.get(f"{method}/start{i}") for i in range(len(x0s))]
     for i, (rec, x) in enumerate(zip(cached, x0s, strict=True)):
         if rec is not None and not np.allclose(rec["start"], x, rtol=1e-12, atol=0):
@@ -306,13 +375,7 @@ def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s
         outcomes.extend(StartOutcome.from_dict(rec) for rec in cached)
         return
     t0 = time.perf_counter()
-    estimator = prepare(model, data, base, options, noise_floor=noise_floor)  # every row builds its own
-    polisher = None
-    if method.endswith("+polish"):
-        polisher = estimator.polisher()
-        if polisher is None:
-            raise OptionError(f"{method!r}: method {estimator.method!r} has no polish step")
-        polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
+    estimator, polisher = _build(model, data, method, options, noise_floor)  # every row builds its own
     setup = time.perf_counter() - t0
     opts = dict(estimator.options)
     ran_as = estimator.method
@@ -325,6 +388,9 @@ def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s
         log.append(f"{method}/setup", {"ran_as": ran_as, "options": opts, "setup_time": setup,
                                        "cost_kind": estimator.cost_kind})
     meta.update(ran_as=ran_as, options=opts, setup_time=setup, cost_kind=estimator.cost_kind)
+    if executor is not None:
+        _run_on_executor(executor, model, data, method, options, noise_floor, x0s, cached, progress, log, outcomes)
+        return
     for i, x in enumerate(progress_bar(x0s, desc=method, enabled=progress)):
         if cached[i] is not None:
             outcomes.append(StartOutcome.from_dict(cached[i]))
@@ -333,3 +399,28 @@ def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s
         outcomes.append(out)
         if log is not None:
             log.append(f"{method}/start{i}", out.to_dict())
+
+
+def _run_on_executor(executor: Executor, model: Any, data: Any, method: str, options: dict[str, Any],
+                     noise_floor: float | None, x0s: list[np.ndarray], cached: list[Any], progress: bool | None,
+                     log: RunLog | None, outcomes: list[StartOutcome]) -> None:
+    """The starts not in the log as tasks of ``executor``; ``outcomes`` gets them in start order.
+
+    On Ctrl-C the tasks not started are cancelled, and ``outcomes`` holds the starts
+    finished so far (in start order) before the interrupt propagates.
+    """
+    token = uuid.uuid4().hex
+    done: dict[int, StartOutcome] = {i: StartOutcome.from_dict(rec) for i, rec in enumerate(cached) if rec is not None}
+    futures = {executor.submit(_worker_start, token, model, data, method, options, noise_floor, x): i
+               for i, x in enumerate(x0s) if i not in done}
+    try:
+        for fut in progress_bar(as_completed(futures), desc=method, enabled=progress, total=len(futures)):
+            i = futures[fut]
+            out = fut.result()
+            done[i] = out
+            if log is not None:
+                log.append(f"{method}/start{i}", out.to_dict())
+    finally:
+        for fut in futures:
+            fut.cancel()
+        outcomes.extend(done[i] for i in sorted(done))
