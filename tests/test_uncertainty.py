@@ -173,7 +173,10 @@ def test_scr_reports_which_covariance_it_gives():
     m1 = two_dof([[1, 0]])
     frf = si.simulate_frf(m1, T2, np.logspace(np.log10(0.5), np.log10(2), 30), noise=0.01, seed=1)
     res = si.identify(m1, frf, method="scr", x0=T2, identifiability_check=False, polish=True)
-    assert "does not minimise" in res.uncertainty.note
+    unc = res.uncertainty
+    assert "does not minimise" in unc.note and unc.shift is not None
+    # intervals around θ̂ only when θ̂ is within SHIFT_LIMIT standard errors of the least-squares estimate
+    assert np.all(np.isnan(unc.intervals)) == (unc.shift > 0.5)
     pol = res.polished.uncertainty
     assert pol is not None and pol.note == "" and np.all(np.isfinite(pol.standard_errors))
 

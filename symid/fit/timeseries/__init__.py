@@ -7,10 +7,10 @@ IOData, TimeSeries ``oe``      output error: the model simulated exactly on the 
 or a list of them              its initial state, against the measured samples
                                (:mod:`~symid.fit.timeseries.oe`, CasADi/IPOPT)
 one IOData         ``scr``,    the black box of N4SID + exact ``d2c`` (thesis Algorithms 6.1, 7.1;
-                   ``als``,    :mod:`symid.fit.similarity`): these fit the black box's frequency
-                   ``gb``,     response, not the samples; ``cost`` is the black-box misfit
-                   ``ipopt``,
-                   ``ls``
+                   ``als``,    :mod:`symid.fit.similarity`): these fit the black box, not the
+                   ``gb``,     samples; their ``cost``, ``success`` and uncertainty are judged on
+                   ``ipopt``,  the samples all the same (:mod:`~symid.fit.timeseries.blackbox`),
+                   ``ls``      the black-box misfit is in ``message``
 =================  ==========  =====================================================================
 
 ``oe`` takes non-uniform sample times, several experiments, free responses (u ≡ 0) and
@@ -44,5 +44,10 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
         raise DataError(f"method {method!r} goes through N4SID, which needs one uniformly sampled record (IOData); "
                         "for several records or non-uniform sample times use method='oe'")
     from symid.fit.similarity import prepare as similarity_prepare
+    from symid.fit.timeseries.blackbox import ThroughBlackBox
+    from symid.fit.timeseries.oe import OutputError
 
-    return similarity_prepare(model, data, method, options, noise_floor=noise_floor)
+    inner = similarity_prepare(model, data, method, options, noise_floor=noise_floor)
+    samples = OutputError(model, data)
+    samples.noise_floor = noise_floor
+    return ThroughBlackBox(inner, samples)

@@ -25,7 +25,7 @@ import casadi as ca
 import numpy as np
 
 from symid.engine.ipopt import HESSIANS, IpoptSolver, positivity_bounds
-from symid.errors import DataError
+from symid.errors import DataError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale
 from symid.fit.result import StartOutcome
@@ -43,16 +43,72 @@ def _sx_matrix(amap: Any, theta: Any) -> Any:
     return X
 
 
+def _sx_state_space(model: Any, theta: Any) -> tuple[Any, Any, Any, Any]:
+    """(A, B, C, D) as CasADi expressions: the affine maps of a state-space model, or the first-order form
+    of a second-order model (x = [q; q'], thesis (7-2)) through M⁻¹."""
+    maps = model.maps
+    if "M" not in maps:
+        return tuple(_sx_matrix(maps[k], theta) for k in "ABCD")
+    M, V, K, B, C = (_sx_matrix(maps[k], theta) for k in "MVKBC")
+    n, m, p = model.n_dof, model.n_inputs, model.n_outputs
+    MiK, MiV, MiB = ca.solve(M, K), ca.solve(M, V), ca.solve(M, B)
+    A = ca.vertcat(ca.horzcat(ca.SX(n, n), ca.SX.eye(n)), ca.horzcat(-MiK, -MiV))
+    Bss = ca.vertcat(ca.SX(n, m), MiB)
+    D = ca.SX(p, m)
+    if model.output == "position":
+        Css = ca.horzcat(C, ca.SX(p, n))
+    elif model.output == "velocity":
+        Css = ca.horzcat(ca.SX(p, n), C)
+    else:
+        Css = ca.horzcat(-ca.mtimes(C, MiK), -ca.mtimes(C, MiV))
+        D = ca.mtimes(C, MiB)
+    return A, Bss, Css, D
+
+
+def _initial_state_mode(model: Any, initial_state: Any) -> tuple[str, Any]:
+    """``("model" | "zero" | "estimate" | "known", known values)`` from the ``initial_state`` option."""
+    if initial_state is None:
+        kind = getattr(model, "initial_state_kind", "zero")
+        return {"zero": "zero", "estimate": "estimate"}.get(kind, "model"), None
+    if isinstance(initial_state, str):
+        if initial_state != "estimate":
+            raise OptionError(f"initial_state must be None (the model's), 'estimate' or numbers (n,) = "
+                              f"({model.n_states},) per record; got {initial_state!r}")
+        return "estimate", None
+    return "known", initial_state
+
+
+def _known_states(value: Any, n: int, n_records: int) -> list[np.ndarray]:
+    """Known initial states: one (n,) array for every record, or a list of one per record."""
+    items = value if isinstance(value, (list, tuple)) and n_records > 1 and len(value) == n_records \
+        and all(np.ndim(v) == 1 for v in value) else [value] * n_records
+    out = []
+    for v in items:
+        try:
+            x = np.asarray(v, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise OptionError(f"initial_state must be numbers; got {v!r}") from None
+        if x.size != n or not np.all(np.isfinite(x)):
+            raise OptionError(f"initial_state must hold {n} finite numbers (the model's state"
+                              f"{' [q; dq/dt]' if n % 2 == 0 else ''}) per record; got {np.shape(v)}")
+        out.append(x)
+    return out
+
+
 class OutputError(Estimator, FisherInformation):
     """Output-error estimation on sampled records with CasADi/IPOPT, built once, run per start.
 
     Parameters
     ----------
-    model : StateSpaceModel
-        With ``x0=`` for its initial state (zero when omitted; ``"estimate"`` adds one
-        unknown initial state per record).
+    model : StateSpaceModel or SecondOrderModel
+        A state-space model's ``x0=`` gives its initial state (zero when omitted;
+        ``"estimate"`` adds one unknown initial state per record); a second-order model
+        starts at rest (x = [q; q'] = 0) unless ``initial_state`` says otherwise.
     data : IOData, TimeSeries, or a list of them
         One record per experiment; sample times need not be uniform.
+    initial_state : None, "estimate" or array_like, optional
+        ``None`` (default): the model's. ``"estimate"``: one unknown initial state per
+        record. Numbers (n,), or a list of them per record: known initial states.
     scale : array_like, optional
         Typical magnitude of each parameter; IPOPT works on θ / scale. Default 1.
     positivity : bool, optional
@@ -85,9 +141,12 @@ class OutputError(Estimator, FisherInformation):
     method: ClassVar[str] = "oe"
     cost_kind: ClassVar[str] = "relative output misfit to the measured samples (1/p) Σⱼ ‖yⱼ − ŷⱼ‖² / ‖yⱼ‖²"
 
-    def __init__(self, model: Any, data: Any, *, scale: Any = None, positivity: bool = True,
-                 hessian: str = "exact", max_iter: int = 500, tol: float = 1e-12):
-        self.records = as_records(model, data)
+    def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
+                 positivity: bool = True, hessian: str = "exact", max_iter: int = 500, tol: float = 1e-12):
+        self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
+        self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
+        if self._x0_mode == "known":
+            self._x0_known = _known_states(self._x0_known, model.n_states, len(self.records))
         self.model, self.data = model, data
         l = model.n_parameters
         self.scale = np.ones(l) if scale is None else check_scale("scale", scale, l)
@@ -97,15 +156,16 @@ class OutputError(Estimator, FisherInformation):
         self._tol = check_float("tol", tol, low=0, strict_low=True)
         self.options = {"scale": self.scale.tolist(), "positivity": self._positivity, "hessian": self._hessian,
                         "max_iter": self._max_iter, "tol": self._tol, "records": len(self.records),
-                        "initial_state": model.initial_state_kind}
+                        "initial_state": self._x0_mode if self._x0_mode != "model" else model.initial_state_kind}
         p = model.n_outputs
         energy = sum(np.sum(r.y**2, axis=0) for r in self.records)
         self._weights = 1.0 / (p * energy)  # per output channel: cost = Σ w_j ‖r_j‖²
         self._rms = np.sqrt(energy / sum(r.n_samples for r in self.records))
-        self._estimate_x0 = model.initial_state_kind == "estimate"
+        self._estimate_x0 = self._x0_mode == "estimate"
         self._x0_scale = np.array([max(float(np.abs(r.y).max()), 1e-300) for r in self.records])
         self._h_max = max(float(np.diff(r.t).max()) for r in self.records)
-        self._solvers: dict[int, tuple[IpoptSolver, Any]] = {}
+        self._solvers: dict[tuple[int, int], IpoptSolver] = {}
+        self._residual_fns: dict[int, Any] = {}
 
     # -- the data kind's part ------------------------------------------------------------------
     def _matrices(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -118,6 +178,10 @@ class OutputError(Estimator, FisherInformation):
         solves one linear least-squares problem (weighted as the cost).
         """
         theta = self.model.theta_vector(theta)
+        if self._x0_mode == "known":
+            return [x.copy() for x in self._x0_known]
+        if self._x0_mode == "zero":
+            return [np.zeros(self.model.n_states) for _ in self.records]
         if not self._estimate_x0:
             x0 = self.model.initial_state(theta)
             return [x0.copy() for _ in self.records]
@@ -171,14 +235,15 @@ class OutputError(Estimator, FisherInformation):
         nz = l + (n * E if self._estimate_x0 else 0)
         z = ca.SX.sym("z", nz)
         theta = z[:l] * ca.DM(self.scale)
-        maps = self.model.maps
-        A, B, C, D = (_sx_matrix(maps[k], theta) for k in "ABCD")
-        x0_map = self.model.initial_state_map
+        A, B, C, D = _sx_state_space(self.model, theta)
+        x0_map = self.model.initial_state_map if self._x0_mode == "model" else None
         res = []
         sw = ca.DM(np.sqrt(self._weights)).T
         for e, r in enumerate(self.records):
             if self._estimate_x0:
                 x0 = z[l + n * e: l + n * (e + 1)] * float(self._x0_scale[e])
+            elif self._x0_mode == "known":
+                x0 = ca.SX(ca.DM(self._x0_known[e]))
             elif x0_map is None:
                 x0 = ca.SX.zeros(n, 1)
             else:
@@ -188,18 +253,28 @@ class OutputError(Estimator, FisherInformation):
             res.append(ca.vec(R))
         return z, ca.vertcat(*res), theta
 
-    def _solver(self, s_max: int) -> tuple[IpoptSolver, Any]:
-        if s_max not in self._solvers:
+    def _residual_function(self, s_max: int) -> Any:
+        """CasADi function z ↦ (r, ∂r/∂z) for ``s_max`` squarings (built once)."""
+        if s_max not in self._residual_fns:
             z, r, _ = self._symbolic(s_max)
-            f = ca.sumsqr(r)
+            self._residual_fns[s_max] = (z, r, ca.Function("symid_oe_residual", [z], [r, ca.jacobian(r, z)]))
+        return self._residual_fns[s_max]
+
+    def _solver(self, s_max: int, decade: int = 0) -> IpoptSolver:
+        """IPOPT on ‖r‖² / 10^decade: the objective near 1 at the start, so that the barrier of the bounds
+        (μ starts at 0.1) does not push a start near the optimum away from it; the tolerance is scaled alike
+        (the same stopping point in the relative misfit)."""
+        key = (s_max, decade)
+        if key not in self._solvers:
+            z, r, _ = self._residual_function(s_max)
+            f = ca.sumsqr(r) / 10.0**decade
             lbt, ubt = positivity_bounds(self.model.positive, self._positivity, self.scale)
             extra = z.numel() - lbt.size
             lbz = np.concatenate([lbt, np.full(extra, -np.inf)])
             ubz = np.concatenate([ubt, np.full(extra, np.inf)])
-            solver = IpoptSolver("symid_oe", z, f, lbz=lbz, ubz=ubz, max_iter=self._max_iter, tol=self._tol,
-                                 hessian=self._hessian)
-            self._solvers[s_max] = (solver, ca.Function("symid_oe_residual", [z], [r, ca.jacobian(r, z)]))
-        return self._solvers[s_max]
+            self._solvers[key] = IpoptSolver("symid_oe", z, f, lbz=lbz, ubz=ubz, max_iter=self._max_iter,
+                                             tol=min(self._tol / 10.0**decade, 1e-4), hessian=self._hessian)
+        return self._solvers[key]
 
     def _squarings(self, theta: np.ndarray) -> int:
         A, B, _, _ = self._matrices(theta)
@@ -226,9 +301,10 @@ class OutputError(Estimator, FisherInformation):
         theta, z = start, self._z_start(start)
         s = self._squarings(start)
         iters, status, finished = 0, "not run", False
+        f0 = self.misfit(start) if np.all(np.isfinite(start)) else float("inf")
+        decade = int(np.clip(np.floor(np.log10(f0)), -12, 0)) if np.isfinite(f0) and f0 > 0 else 0
         for _ in range(3):
-            solver, _ = self._solver(s)
-            run = solver.solve(z)
+            run = self._solver(s, decade).solve(z)
             iters += run.iterations
             status, finished = run.status, run.finished
             z = run.z
@@ -272,7 +348,7 @@ class OutputError(Estimator, FisherInformation):
         """
         theta = self.model.theta_vector(theta)
         s = self._squarings(theta)
-        _, fun = self._solver(s)
+        _, _, fun = self._residual_function(s)
         z = self._z_start(theta)
         r, J = fun(z)
         col_scale = np.concatenate([self.scale, np.repeat(self._x0_scale, self.model.n_states)

@@ -28,7 +28,7 @@ def is_time_series(data: Any) -> bool:
             and all(isinstance(d, (IOData, TimeSeries)) for d in data))
 
 
-def as_records(model: Any, data: Any) -> tuple[TimeSeries, ...]:
+def as_records(model: Any, data: Any, *, estimate_x0: bool | None = None) -> tuple[TimeSeries, ...]:
     """The records as :class:`TimeSeries`, checked against the model's sizes.
 
     Raises
@@ -36,15 +36,18 @@ def as_records(model: Any, data: Any) -> tuple[TimeSeries, ...]:
     DataError
         On data that are not time series, channel counts that do not match the model,
         an output channel that is zero in every record, or (``x0="estimate"``) a record
-        too short to determine its initial state.
+        too short to determine its initial state (``estimate_x0``, default: the model's ``x0``).
     ModelError
-        For a model that is not a :class:`~symid.StateSpaceModel`.
+        For a model that is not a :class:`~symid.StateSpaceModel` or :class:`~symid.SecondOrderModel`.
     """
+    from symid.model.secondorder import SecondOrderModel
     from symid.model.statespace import StateSpaceModel
 
-    if not isinstance(model, StateSpaceModel):
-        raise ModelError(f"time-domain fitting needs a StateSpaceModel (its x0 gives the initial state); got "
+    if not isinstance(model, (StateSpaceModel, SecondOrderModel)):
+        raise ModelError(f"time-domain fitting needs a StateSpaceModel or SecondOrderModel; got "
                          f"{type(model).__name__}")
+    if estimate_x0 is None:
+        estimate_x0 = getattr(model, "initial_state_kind", "zero") == "estimate"
     if not is_time_series(data):
         raise DataError("time-domain fitting takes IOData, TimeSeries or a non-empty list of them (one per "
                         f"experiment); got {type(data).__name__}")
@@ -57,7 +60,7 @@ def as_records(model: Any, data: Any) -> tuple[TimeSeries, ...]:
             raise DataError(f"{where} has {ts.n_inputs} input(s) and {ts.n_outputs} output(s); the model has "
                             f"{model.n_inputs} input(s) and {model.n_outputs} output(s) "
                             "(a free response still needs u, all zero)")
-        if model.initial_state_kind == "estimate" and ts.n_samples * ts.n_outputs <= model.n_states:
+        if estimate_x0 and ts.n_samples * ts.n_outputs <= model.n_states:
             raise DataError(f"{where} holds {ts.n_samples} sample(s) of {ts.n_outputs} output(s), too few to "
                             f"estimate its initial state of {model.n_states} values on top of θ: record longer, "
                             "or give x0 (known numbers or an expression in θ)")
