@@ -31,6 +31,7 @@ from symid.zoo import ZooEntry, list_models, load_model
 if TYPE_CHECKING:
     from symid.fit.compare import Comparison, MethodStats, compare
     from symid.fit.identify import identify
+    from symid.fit.validation import Validation, validate
     from symid.signal.frf import estimate_coherence, estimate_frf
     from symid.signal.simulate import simulate_frf, simulate_io, simulate_spectra
     from symid.signal.spectra import estimate_spectra
@@ -47,6 +48,8 @@ _LAZY = {
     "d2c": "symid.signal.zoh",
     "n4sid": "symid.signal.subspace",
     "identify": "symid.fit.identify",
+    "validate": "symid.fit.validation",
+    "Validation": "symid.fit.validation",
     "simulate_frf": "symid.signal.simulate",
     "simulate_io": "symid.signal.simulate",
     "simulate_spectra": "symid.signal.simulate",
@@ -100,6 +103,7 @@ __all__ = [
     "StateSpaceModel",
     "SymidError",
     "TimeSeries",
+    "Validation",
     "ZooEntry",
     "compare",
     "d2c",
@@ -116,4 +120,5 @@ __all__ = [
     "simulate_frf",
     "simulate_io",
     "simulate_spectra",
+    "validate",
 ]

@@ -1,0 +1,428 @@
+"""``si.validate``: does a model with these parameters reproduce measured time series?
+
+The model is simulated on each record's sample times from its initial state (exactly,
+zero-order-hold input; :class:`~symid.fit.timeseries.oe.OutputError`) and compared with
+the measured output, as MATLAB's ``compare`` and ``resid`` do (Ljung, *System
+Identification*, 2nd ed., §16.6):
+
+- **fit** per output, the normalised root-mean-square fit
+  ``100 (1 − ‖y − ŷ‖ / ‖y − mean(y)‖)`` % (100 % is perfect, 0 % no better than the
+  mean, negative worse), and the rms error in data units;
+- **residual whiteness**: the normalised autocorrelation ρₑ(τ), τ = 1 … M, of the
+  residual ε = y − ŷ (means removed), with the band ±z/√N that a white residual stays in
+  (z = 2.58 for 99 %), and the Ljung–Box statistic Q = N(N+2) Σ ρₑ(τ)²/(N − τ),
+  χ²(M) for a white residual;
+- **input–residual independence**: the normalised cross-correlation ρₑᵤ(τ) of ε(t) with
+  u(t − τ), τ = −M … M, with the band ±z √(Σₖ ρₑ(k) ρᵤ(k) / N) (Ljung (16.60); ±z/√N when
+  ε is white), and S = N Σ_{τ=0}^{M} ρₑᵤ(τ)² / P, χ²(M + 1) when ε is independent of
+  past inputs. Correlation at τ < 0 (ε ahead of u) is what feedback produces, and is
+  shown, not tested.
+
+Correlations use sample lags, pooled over the records; for non-uniform sample times
+they are lags in samples (said in ``notes``). A constant input (an offset) has no
+cross-correlation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from symid.errors import DataError
+
+__all__ = ["Validation", "validate"]
+
+_Z = {0.95: 1.959963984540054, 0.99: 2.5758293035489004}
+
+
+@dataclass(frozen=True)
+class Validation:
+    """The comparison of a model's simulated output with measured records (:func:`validate`).
+
+    Attributes
+    ----------
+    parameter_names : tuple of str
+    theta : numpy.ndarray
+        The parameters validated.
+    fit_percent : numpy.ndarray
+        (p,) normalised rms fit per output, % (MATLAB ``compare``).
+    rms_error : numpy.ndarray
+        (p,) rms of y − ŷ per output, data units.
+    t, u, y, y_sim : tuple of numpy.ndarray
+        Per record: times, inputs, measured and simulated outputs.
+    initial_states : tuple of numpy.ndarray
+        The initial state each record was simulated from.
+    lags : numpy.ndarray
+        0 … M (sample lags).
+    autocorrelation : numpy.ndarray
+        (p, M + 1) normalised autocorrelation of the residual (1 at lag 0).
+    auto_band : float
+        Half-width of the confidence band of a white residual, z/√N.
+    whiteness_q : numpy.ndarray
+        (p,) Ljung–Box statistic; ``whiteness_p`` its p-value under χ²(M).
+    cross_lags : numpy.ndarray
+        −M … M.
+    cross_correlation : numpy.ndarray
+        (p, m, 2M + 1) normalised cross-correlation of residual and input (NaN for a constant input).
+    cross_band : numpy.ndarray
+        (p, m) half-widths of its confidence band.
+    independence_s : numpy.ndarray
+        (p, m) statistic over τ = 0 … M; ``independence_p`` its p-value under χ²(M + 1).
+    confidence : float
+        Level of the bands and tests (0.99 default).
+    notes : tuple of str
+        What the reader should know (non-uniform sampling, constant inputs ...).
+    time_unit : str
+    """
+
+    parameter_names: tuple[str, ...]
+    theta: np.ndarray
+    fit_percent: np.ndarray
+    rms_error: np.ndarray
+    t: tuple[np.ndarray, ...] = field(repr=False)
+    u: tuple[np.ndarray, ...] = field(repr=False)
+    y: tuple[np.ndarray, ...] = field(repr=False)
+    y_sim: tuple[np.ndarray, ...] = field(repr=False)
+    initial_states: tuple[np.ndarray, ...] = field(repr=False)
+    lags: np.ndarray = field(repr=False)
+    autocorrelation: np.ndarray = field(repr=False)
+    auto_band: float = 0.0
+    whiteness_q: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    whiteness_p: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    cross_lags: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    cross_correlation: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    cross_band: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    independence_s: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    independence_p: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    confidence: float = 0.99
+    notes: tuple[str, ...] = ()
+    time_unit: str = "s"
+
+    @property
+    def white(self) -> np.ndarray:
+        """(p,) whether each output's residual passes the whiteness test at ``confidence``."""
+        return self.whiteness_p >= 1 - self.confidence
+
+    @property
+    def independent(self) -> np.ndarray:
+        """(p, m) whether each residual passes the independence test against each (non-constant) input."""
+        with np.errstate(invalid="ignore"):
+            return np.where(np.isfinite(self.independence_p), self.independence_p >= 1 - self.confidence, True)
+
+    def summary(self) -> str:
+        """A readable table: fit and tests per output (and input)."""
+        p = self.fit_percent.size
+        level = f"{100 * self.confidence:g} %"
+        n = sum(tt.size for tt in self.t)
+        lines = [f"validation on {len(self.t)} record(s), {n} samples; tests at {level}, lags 1…{self.lags[-1]}",
+                 f"{'output':>7s} {'fit %':>8s} {'rms error':>11s} {'whiteness Q':>12s} {'p-value':>8s} "
+                 f"{'lags out':>9s}"]
+        for j in range(p):
+            out = int(np.sum(np.abs(self.autocorrelation[j, 1:]) > self.auto_band))
+            lines.append(f"{j:>7d} {self.fit_percent[j]:>8.2f} {self.rms_error[j]:>11.4g} {self.whiteness_q[j]:>12.4g} "
+                         f"{self.whiteness_p[j]:>8.3g} {out:>9d}")
+        m = self.cross_correlation.shape[1] if self.cross_correlation.ndim == 3 else 0
+        if m:
+            lines.append(f"{'output':>7s} {'input':>6s} {'S (τ ≥ 0)':>12s} {'p-value':>8s} {'lags out':>9s}")
+            for j in range(p):
+                for i in range(m):
+                    if not np.isfinite(self.independence_s[j, i]):
+                        lines.append(f"{j:>7d} {i:>6d} {'constant input: not tested':>31s}")
+                        continue
+                    pos = self.cross_correlation[j, i, self.cross_lags >= 0]
+                    out = int(np.sum(np.abs(pos) > self.cross_band[j, i]))
+                    lines.append(f"{j:>7d} {i:>6d} {self.independence_s[j, i]:>12.4g} "
+                                 f"{self.independence_p[j, i]:>8.3g} {out:>9d}")
+        verdict = []
+        if not np.all(self.white):
+            verdict.append("residual NOT white (model or noise structure missing)")
+        if not np.all(self.independent):
+            verdict.append("residual correlated with past inputs (dynamics not captured)")
+        lines.append("verdict: " + ("; ".join(verdict) if verdict else "residual white and independent of the "
+                                    "inputs at this level"))
+        lines.extend(f"note: {t}" for t in self.notes)
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.summary()
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python form (without the sample arrays), suitable for JSON."""
+
+        def plain(a: Any) -> Any:
+            arr = np.asarray(a, dtype=float)
+            return np.where(np.isfinite(arr), arr, None).tolist()
+
+        return {"parameter_names": list(self.parameter_names), "theta": plain(self.theta),
+                "fit_percent": plain(self.fit_percent), "rms_error": plain(self.rms_error),
+                "lags": self.lags.tolist(), "autocorrelation": plain(self.autocorrelation),
+                "auto_band": self.auto_band, "whiteness_q": plain(self.whiteness_q),
+                "whiteness_p": plain(self.whiteness_p), "white": self.white.tolist(),
+                "cross_lags": self.cross_lags.tolist(), "cross_correlation": plain(self.cross_correlation),
+                "cross_band": plain(self.cross_band), "independence_s": plain(self.independence_s),
+                "independence_p": plain(self.independence_p), "independent": self.independent.tolist(),
+                "confidence": self.confidence, "notes": list(self.notes), "time_unit": self.time_unit,
+                "records": len(self.t), "samples": int(sum(tt.size for tt in self.t))}
+
+    # -- figures --------------------------------------------------------------------------------
+    def plot(self, path: str | Path, *, output_names: Any = None, output_units: Any = None,
+             input_names: Any = None, title: str | None = None) -> tuple[Path, Path]:
+        """Write two PNG figures: simulated against measured output, and the residual tests.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            Stem of the files: ``<stem>_output.png`` and ``<stem>_residual.png`` (a
+            ``.png`` suffix is dropped first).
+        output_names, output_units, input_names : sequence of str, optional
+            Axis labels; without units the axis says they are not given.
+        title : str, optional
+
+        Returns
+        -------
+        tuple of pathlib.Path
+            The two files written.
+        """
+        p = self.fit_percent.size
+        m = self.cross_correlation.shape[1] if self.cross_correlation.ndim == 3 else 0
+        onames = _names(output_names, p, "output")
+        ounits = _names(output_units, p, None)
+        inames = _names(input_names, m, "input")
+        stem = Path(path)
+        if stem.suffix.lower() == ".png":
+            stem = stem.with_suffix("")
+        first = stem.with_name(stem.name + "_output.png")
+        second = stem.with_name(stem.name + "_residual.png")
+        plt = _pyplot()
+        fig, axes = plt.subplots(p, 1, figsize=(10, 2.8 * p + 0.6), squeeze=False, sharex=True)
+        for j in range(p):
+            ax = axes[j, 0]
+            for e, (tt, yy, ys) in enumerate(zip(self.t, self.y, self.y_sim, strict=True)):
+                ax.plot(tt, yy[:, j], color="0.55", lw=2.6, alpha=0.8, label="measured" if e == 0 else None)
+                ax.plot(tt, ys[:, j], color="C3", lw=1.1, ls=(0, (5, 2)), label="simulated" if e == 0 else None)
+            ax.plot(np.concatenate(self.t), np.concatenate([yy[:, j] - ys[:, j] for yy, ys in
+                                                             zip(self.y, self.y_sim, strict=True)]),
+                    color="C0", lw=0.8, label="residual y − ŷ")
+            unit = ounits[j] if ounits[j] else "unit not given"
+            ax.set_ylabel(f"{onames[j]} ({unit})")
+            ax.set_title(f"{onames[j]}: fit {self.fit_percent[j]:.2f} %, rms error {self.rms_error[j]:.3g}"
+                         f"{' ' + ounits[j] if ounits[j] else ''}", fontsize=10)
+            ax.grid(alpha=0.3)
+            ax.legend(loc="best", fontsize=8)
+        axes[-1, 0].set_xlabel(f"time ({self.time_unit})")
+        if title:
+            fig.suptitle(title)
+        fig.tight_layout()
+        _save(fig, first)
+        rows = p
+        cols = 1 + m
+        fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols + 0.8, 2.9 * rows + 0.6), squeeze=False)
+        level = f"{100 * self.confidence:g} % band"
+        for j in range(p):
+            ax = axes[j, 0]
+            ax.axhspan(-self.auto_band, self.auto_band, color="C2", alpha=0.2, label=level)
+            ax.vlines(self.lags[1:], 0, self.autocorrelation[j, 1:], color="C0", lw=1.5, label="ρₑ(τ)")
+            ax.plot(self.lags[1:], self.autocorrelation[j, 1:], "o", color="C0", ms=3)
+            ax.axhline(0, color="k", lw=0.6)
+            ax.set_title(f"whiteness of the {onames[j]} residual (p = {self.whiteness_p[j]:.2g})", fontsize=9)
+            ax.set_xlabel("lag τ (samples)")
+            ax.set_ylabel("autocorrelation (–)")
+            ax.legend(loc="best", fontsize=8)
+            ax.grid(alpha=0.3)
+            for i in range(m):
+                ax = axes[j, 1 + i]
+                rho = self.cross_correlation[j, i]
+                if not np.all(np.isfinite(rho)):
+                    ax.text(0.5, 0.5, f"{inames[i]} is constant:\nno cross-correlation", ha="center",
+                            va="center", transform=ax.transAxes)
+                    ax.set_axis_off()
+                    continue
+                b = self.cross_band[j, i]
+                ax.axhspan(-b, b, color="C2", alpha=0.2, label=level)
+                ax.vlines(self.cross_lags, 0, rho, color="C1", lw=1.5, label="ρₑᵤ(τ)")
+                ax.plot(self.cross_lags, rho, "o", color="C1", ms=3)
+                ax.axhline(0, color="k", lw=0.6)
+                ax.axvline(0, color="0.4", lw=0.6, ls=":")
+                ax.set_title(f"{onames[j]} residual vs {inames[i]} (τ ≥ 0: p = {self.independence_p[j, i]:.2g})",
+                             fontsize=9)
+                ax.set_xlabel("lag τ (samples; > 0: input leads)")
+                ax.set_ylabel("cross-correlation (–)")
+                ax.legend(loc="best", fontsize=8)
+                ax.grid(alpha=0.3)
+        if title:
+            fig.suptitle(title)
+        fig.tight_layout()
+        _save(fig, second)
+        return first, second
+
+
+def _names(values: Any, n: int, default: str | None) -> list[str]:
+    if values is None:
+        return [f"{default} {k}" if default else "" for k in range(n)]
+    if isinstance(values, str):
+        values = [values]
+    out = [str(v) for v in values]
+    if len(out) != n:
+        raise DataError(f"expected {n} name(s) or unit(s); got {len(out)}: {out}")
+    return out
+
+
+def _pyplot() -> Any:
+    import os
+
+    import matplotlib
+
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        matplotlib.use("Agg")  # no screen: draw to files only
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig: Any, path: Path) -> None:
+    from symid.runlog import write_atomic
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        with write_atomic(path, "wb") as fh:
+            fig.savefig(fh, dpi=110, format="png")
+    finally:
+        _pyplot().close(fig)
+
+
+def _correlations(res: list[np.ndarray], us: list[np.ndarray], M: int) -> tuple[np.ndarray, np.ndarray,
+                                                                                   np.ndarray, np.ndarray]:
+    """Pooled normalised auto- (p, M+1) and cross-correlations (p, m, 2M+1), input autocorrelations (m, 2M+1)
+    and the residual autocorrelation at negative lags too (p, 2M+1)."""
+    p, m = res[0].shape[1], us[0].shape[1]
+    e_mean = np.sum([e.sum(axis=0) for e in res], axis=0) / sum(e.shape[0] for e in res)
+    u_mean = np.sum([u.sum(axis=0) for u in us], axis=0) / sum(u.shape[0] for u in us)
+    E = [e - e_mean for e in res]
+    U = [u - u_mean for u in us]
+    ee = np.zeros((p, M + 1))
+    uu = np.zeros((m, M + 1))
+    eu = np.zeros((p, m, 2 * M + 1))
+    for e, u in zip(E, U, strict=True):
+        N = e.shape[0]
+        for tau in range(min(M, N - 1) + 1):
+            ee[:, tau] += np.sum(e[tau:] * e[: N - tau], axis=0)
+            uu[:, tau] += np.sum(u[tau:] * u[: N - tau], axis=0)
+            eu[:, :, M + tau] += e[tau:].T @ u[: N - tau]          # ε(t) u(t − τ)
+            if tau:
+                eu[:, :, M - tau] += e[: N - tau].T @ u[tau:]      # ε(t) u(t + τ)
+    se = np.sqrt(ee[:, :1])
+    su = np.sqrt(uu[:, :1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rho_e = ee / se**2
+        rho_u = uu / su**2
+        rho_eu = eu / (se[:, 0][:, None, None] * su[:, 0][None, :, None])
+    return rho_e, rho_u, rho_eu, su[:, 0]
+
+
+def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, max_lag: int = 25,
+             confidence: float = 0.99) -> Validation:
+    """Simulate the model at θ on measured records and test what is left (module text).
+
+    Parameters
+    ----------
+    model : StateSpaceModel or SecondOrderModel
+    theta : dict or sequence of float
+        The parameters (e.g. ``result.theta``).
+    data : IOData, TimeSeries, or a list of them
+        Validation records (preferably not those θ was estimated from).
+    initial_state : None, "estimate" or array_like, optional
+        ``None``: the model's (zero, known, affine in θ, or least squares for a model with
+        ``x0="estimate"``); ``"estimate"``: the least-squares initial state of each record
+        (as MATLAB's ``compare`` does by default); numbers (n,): known.
+    max_lag : int
+        M, the largest correlation lag in samples (default 25, MATLAB's ``resid``).
+    confidence : {0.99, 0.95}
+        Level of the bands and tests.
+
+    Returns
+    -------
+    Validation
+
+    Raises
+    ------
+    DataError
+        On data that are not time series, records that do not match the model, a lag
+        that the records cannot hold, or a confidence level other than 0.95 or 0.99.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> k, g = si.parameters("k g", positive=True)
+    >>> model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    >>> u = np.random.default_rng(0).standard_normal(500)
+    >>> io = si.simulate_io(model, {"k": 0.5, "g": 2.0}, u, dt=0.1, noise=0.05, seed=1)
+    >>> v = si.validate(model, {"k": 0.5, "g": 2.0}, io)
+    >>> bool(90 < v.fit_percent[0] < 100), bool(v.white[0]), bool(v.independent[0, 0])
+    (True, True, True)
+    >>> bool(si.validate(model, {"k": 0.25, "g": 2.0}, io).white[0])   # a wrong model leaves structure
+    False
+    """
+    from scipy.stats import chi2
+
+    from symid.fit.timeseries.oe import OutputError
+
+    if isinstance(max_lag, bool) or not isinstance(max_lag, (int, np.integer)) or max_lag < 1:
+        raise DataError(f"max_lag must be an int >= 1 (sample lags); got {max_lag!r}")
+    if confidence not in _Z:
+        raise DataError(f"confidence must be 0.95 or 0.99; got {confidence!r}")
+    M = int(max_lag)
+    sim = OutputError(model, data, initial_state=initial_state)
+    th = model.theta_vector(theta)
+    try:
+        ys = sim.simulate(th)
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise DataError(f"the model cannot be simulated at θ = {model.theta_dict(th)}: {exc}") from None
+    x0s = sim.initial_states(th)
+    recs = sim.records
+    N = sum(r.n_samples for r in recs)
+    if M >= min(r.n_samples for r in recs):
+        raise DataError(f"max_lag = {M} needs records longer than {M} samples; the shortest has "
+                        f"{min(r.n_samples for r in recs)}")
+    y_all = np.vstack([r.y for r in recs])
+    e_all = np.vstack([r.y - s for r, s in zip(recs, ys, strict=True)])
+    if not np.all(np.isfinite(e_all)):
+        raise DataError(f"the simulated output at θ = {model.theta_dict(th)} overflows (an unstable model?)")
+    denom = np.linalg.norm(y_all - y_all.mean(axis=0), axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fit = 100.0 * (1.0 - np.linalg.norm(e_all, axis=0) / denom)
+    rms = np.sqrt(np.mean(e_all**2, axis=0))
+    rho_e, rho_u, rho_eu, su = _correlations([r.y - s for r, s in zip(recs, ys, strict=True)],
+                                             [r.u for r in recs], M)
+    z = _Z[confidence]
+    taus = np.arange(1, M + 1)
+    q = N * (N + 2) * np.sum(rho_e[:, 1:] ** 2 / (N - taus), axis=1)
+    q_p = chi2.sf(q, M)
+    # Ljung (16.60): P = Σ_k ρε(k) ρu(k), k = −M … M (both even), ±z √(P/N)
+    P = rho_e[:, None, 0] * rho_u[None, :, 0] + 2 * np.sum(rho_e[:, None, 1:] * rho_u[None, :, 1:], axis=2)
+    P = np.where(np.isfinite(P) & (P > 0), P, 1.0)
+    cross_band = z * np.sqrt(P / N)
+    s_stat = N * np.sum(rho_eu[:, :, M:] ** 2, axis=2) / P
+    s_p = chi2.sf(s_stat, M + 1)
+    notes = []
+    constant = np.flatnonzero(~(su > 0))
+    if constant.size:
+        notes.append(f"input(s) {', '.join(str(int(i)) for i in constant)} constant: no cross-correlation")
+        s_stat[:, constant] = np.nan
+        s_p[:, constant] = np.nan
+        rho_eu[:, constant, :] = np.nan
+    if not all(r.is_uniform if hasattr(r, "is_uniform") else np.allclose(np.diff(r.t), np.diff(r.t)[0], rtol=1e-6)
+               for r in recs):
+        notes.append("sample times are not uniform: correlation lags are in samples, not in time")
+    if len(recs) > 1:
+        notes.append(f"{len(recs)} records pooled (fit over all samples; correlations summed over records)")
+    return Validation(parameter_names=tuple(model.parameter_names), theta=th, fit_percent=fit, rms_error=rms,
+                      t=tuple(r.t for r in recs), u=tuple(r.u for r in recs), y=tuple(r.y for r in recs),
+                      y_sim=tuple(ys), initial_states=tuple(x0s), lags=np.arange(M + 1), autocorrelation=rho_e,
+                      auto_band=float(z / np.sqrt(N)), whiteness_q=q, whiteness_p=q_p,
+                      cross_lags=np.arange(-M, M + 1), cross_correlation=rho_eu, cross_band=cross_band,
+                      independence_s=s_stat, independence_p=s_p, confidence=float(confidence),
+                      notes=tuple(notes), time_unit=getattr(recs[0], "time_unit", "s"))
