@@ -7,11 +7,20 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from symid.errors import DataError, ModelError
+from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.frf.fisher import FrfFisher
 
-__all__ = ["FrfEstimator", "check_frf", "relative_misfit", "relative_residuals"]
+__all__ = ["FrfEstimator", "check_frf", "frf_weights", "relative_misfit", "relative_residuals"]
+
+VARIANCE_OPTION_DOC = """variance : "data", None or array_like, optional
+        Noise weighting of the FRF criterion, Σᵢ Σ_jk |Hᵢ,jk − H(ωᵢ, θ)_jk|² / σ²ᵢ,jk
+        (the maximum-likelihood criterion for independent complex Gaussian noise on H,
+        as frequency-domain toolboxes such as FDIDENT use): ``"data"`` (default) takes
+        σ² from the data's per-line variance (``FrequencyData.variance``, e.g. from
+        :func:`symid.estimate_frf`) and weighs every line alike when the data have none;
+        ``None`` weighs every line alike; an array gives σ², one per frequency (s,) or per
+        entry (s, p, m)."""
 
 
 def check_frf(model: Any, data: Any) -> None:
@@ -29,6 +38,66 @@ def check_frf(model: Any, data: Any) -> None:
                         f"parameters: at least {need} frequencies are needed")
 
 
+def frf_weights(data: Any, variance: Any = "data") -> np.ndarray | None:
+    """Weights 1/σ² of the noise-weighted FRF criterion, one per entry of H, scaled to mean 1.
+
+    Parameters
+    ----------
+    data : FrequencyData
+    variance : "data", None or array_like
+        ``"data"``: the data's per-line variance when it has one; ``None``: equal weights;
+        an array: σ² per frequency (s,) or per entry (s, p, m), finite and > 0.
+
+    Returns
+    -------
+    numpy.ndarray of shape (s, p, m), or None
+        ``None`` means equal weights (the relative misfit Σ‖Hᵢ − H(ωᵢ, θ)‖² / Σ‖Hᵢ‖²).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.frf.misfit import frf_weights
+    >>> frf = si.FrequencyData([1.0, 2.0], np.ones(2), variance=[1e-4, 4e-4])
+    >>> frf_weights(frf).ravel()
+    array([1.6, 0.4])
+    >>> frf_weights(frf, None) is None
+    True
+    """
+    H = np.asarray(data.H)
+    if isinstance(variance, str):
+        if variance != "data":
+            raise OptionError(f"variance must be 'data', None or an array of noise variances; got {variance!r}")
+        given = getattr(data, "variance", None)
+        if given is None:
+            return None
+        var = np.asarray(given, dtype=float)
+        source = "the data's variance"
+    elif variance is None:
+        return None
+    else:
+        try:
+            var = np.asarray(variance, dtype=float)
+        except (TypeError, ValueError):
+            raise OptionError(f"variance must be 'data', None or an array of real noise variances; got "
+                              f"{type(variance).__name__}") from None
+        if var.shape == (H.shape[0],):
+            var = np.broadcast_to(var[:, None, None], H.shape)
+        if var.shape != H.shape:
+            raise OptionError(f"variance must have one value per frequency ({H.shape[0]},) or per entry of H "
+                              f"{H.shape}; got shape {var.shape}")
+        source = "variance"
+    var = var.reshape(H.shape)
+    bad = ~np.isfinite(var) | (var <= 0)
+    if np.any(bad):
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise OptionError(f"{source} must be finite and > 0 to weigh the fit by it: entry {idx} (frequency "
+                          f"{float(np.asarray(data.w)[idx[0]]):g} rad/s) is {var[idx]!r}; give a small positive "
+                          f"variance for lines measured without noise, or variance=None for equal weights")
+    wts = 1.0 / var
+    return wts / float(np.mean(wts))
+
+
 def _model_response(model: Any, data: Any, theta: Any) -> np.ndarray | None:
     try:
         Hm = model.frequency_response(theta, data.w)
@@ -37,18 +106,20 @@ def _model_response(model: Any, data: Any, theta: Any) -> np.ndarray | None:
     return Hm if np.all(np.isfinite(Hm)) else None
 
 
-def _relative(H: np.ndarray, Hm: np.ndarray) -> float:
-    """Σ|H − Hm|² / Σ|H|², computed on H / max|H| so that neither sum under- or overflows."""
+def _relative(H: np.ndarray, Hm: np.ndarray, weights: np.ndarray | None = None) -> float:
+    """Σ w|H − Hm|² / Σ w|H|² (w = 1 without weights), on H / max|H| so that neither sum under- or overflows."""
     scale = float(np.max(np.abs(H)))
     if scale == 0.0 or not np.isfinite(scale):
         return 0.0 if not np.any(Hm) else float("inf")
-    den = float(np.sum(np.abs(H / scale) ** 2))
-    return float(np.sum(np.abs((H - Hm) / scale) ** 2) / den)
+    wts = 1.0 if weights is None else weights
+    den = float(np.sum(wts * np.abs(H / scale) ** 2))
+    return float(np.sum(wts * np.abs((H - Hm) / scale) ** 2) / den)
 
 
-def relative_misfit(model: Any, data: Any, theta: Any) -> float:
+def relative_misfit(model: Any, data: Any, theta: Any, weights: np.ndarray | None = None) -> float:
     """Relative squared misfit Σ‖Hᵢ − H(ωᵢ, θ)‖²_F / Σ‖Hᵢ‖²_F of a frequency response.
 
+    With ``weights`` (:func:`frf_weights`), Σ w|Hᵢ − H(ωᵢ, θ)|² / Σ w|Hᵢ|² entry by entry.
     Returns ``inf`` when the model cannot be evaluated at θ (singular M, a pole on
     the imaginary axis, non-finite values).
 
@@ -64,7 +135,7 @@ def relative_misfit(model: Any, data: Any, theta: Any) -> float:
     0.0
     """
     Hm = _model_response(model, data, theta)
-    return float("inf") if Hm is None else _relative(np.asarray(data.H), Hm)
+    return float("inf") if Hm is None else _relative(np.asarray(data.H), Hm, weights)
 
 
 def relative_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:
@@ -83,9 +154,12 @@ class FrfEstimator(Estimator, FrfFisher):
 
     cost_kind: ClassVar[str] = "relative FRF misfit Σ‖Hᵢ − H(ωᵢ, θ)‖²_F / Σ‖Hᵢ‖²_F"
 
+    line_weights: np.ndarray | None = None
+    """Per-entry weights 1/σ² of a noise-weighted fit (:func:`frf_weights`); ``None``: equal weights."""
+
     def misfit(self, theta: np.ndarray) -> float:
-        """:func:`relative_misfit` of the model at θ."""
-        return relative_misfit(self.model, self.data, theta)
+        """:func:`relative_misfit` of the model at θ (noise-weighted when ``line_weights`` is set)."""
+        return relative_misfit(self.model, self.data, theta, self.line_weights)
 
     def residuals(self, theta: np.ndarray) -> np.ndarray | None:
         """:func:`relative_residuals` at θ."""
