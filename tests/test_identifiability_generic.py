@@ -11,6 +11,8 @@ old integer θ* (drawn from 2…20) produced a false "global".
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -104,3 +106,15 @@ def test_bad_input_gives_a_named_error_or_a_correct_report():
     # no parameter reaches the output (C = 0): H ≡ 0, nothing is identifiable, no crash
     rep = si.identifiability(si.StateSpaceModel(A=[[-a, 0], [0, -b]], B=[[1], [1]], C=[[0, 0]]))
     assert rep.verdicts == {"a": "none", "b": "none"} and rep.jacobian_ranks == (0, 0)
+
+
+def test_combinations_do_not_wait_for_the_groebner_basis(monkeypatch):
+    # issue 17: with the Gröbner step stopped by the deadline, the identifiable combinations of a
+    # model that is not locally identifiable still come back (the summary entries are identifiable
+    # functions; they are chosen in a child process beside the Gröbner step)
+    monkeypatch.setattr("symid.structural.steps.generic_global", lambda *args, **kwargs: time.sleep(600))
+    rep = si.identifiability(si.load_model("compartment_catenary").model, timeout=3.0)  # thesis (1-2): θ2θ4, ...
+    assert not rep.global_determined and rep.verdict == "none"
+    exprs = {c["expression"] for c in rep.combinations}
+    assert {"theta2*theta4", "theta1 + theta2 + theta3 + theta4"} <= exprs
+    assert all(c["global"] in (True, None) for c in rep.combinations)

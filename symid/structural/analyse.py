@@ -10,8 +10,13 @@ import sympy as sp
 
 from symid.errors import IdentifiabilityWarning, ModelError
 from symid.structural.arguments import checked_arguments, checked_known, checked_seed
-from symid.structural.combinations import monomial_candidates, parameters_to_fix, select_combinations
-from symid.structural.deadline import run_with_deadline
+from symid.structural.combinations import (
+    monomial_candidates,
+    parameters_to_fix,
+    poly_gradients,
+    select_combinations,
+)
+from symid.structural.deadline import run_with_deadline, start
 from symid.structural.local import local_analysis
 from symid.structural.numeric import numeric_local_check
 from symid.structural.report import IdentifiabilityReport, NecessaryCondition
@@ -236,6 +241,25 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
 
     # One budget: the Gröbner step and, for a locally identifiable model, the witness
     # search side by side in two child processes (symid/structural/steps.py).
+    # a model that is not locally identifiable: its summary entries (identifiable functions, the
+    # last source of combinations) are computed beside the Gröbner step, on the core the witness
+    # search would use, so that the combinations never depend on the basis finishing
+    summary_job = None
+    if not full_rank and timeout is not None:
+        summary_job = start(_summary_combinations, {"model": model, "known": known_exact, "local": local,
+                                                    "monos": monos, "limit": 4 * len(free)})
+    try:
+        return _finish(model, args, local, monos, full_rank, free, names, pos, necessary, notes, t0, t_local, left,
+                       summary_job)
+    finally:
+        if summary_job is not None:
+            summary_job.stop()
+
+
+def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, notes, t0, t_local, left,
+            summary_job) -> IdentifiabilityReport:
+    """The global step, the verdicts, the combinations and the report (see :func:`identifiability`)."""
+    timeout, seed, known_exact = args.timeout, args.seed, args.known
     out = run_global(model, known_exact, names=names, positive=pos, seed=seed, extra_candidates=monos,
                      full_rank=full_rank, exact_count=args.exact_count, left=left, rank=local.rank)
     glob = out.result
@@ -337,14 +361,24 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
             candidates += [(e, "groebner", True) for e in gb]
             sm = sorted(glob.summary_expressions, key=_complexity)
             candidates += [(e, "summary", True) for e in sm]
-        else:  # the summary entries are identifiable functions: no Gröbner basis needed
-            status_s, exprs = run_with_deadline(_summary_expressions, {"model": model, "known": known_exact}, left())
+        else:  # the summary entries are identifiable functions: no Gröbner basis needed (chosen in the child)
+            s_kwargs = {"model": model, "known": known_exact, "local": local, "monos": monos, "limit": 4 * len(free)}
+            status_s, chosen_s = run_with_deadline(_summary_combinations, s_kwargs, left()) \
+                if summary_job is None else summary_job.wait(left())
+            stopped = limit_reason("combinations step", status_s, chosen_s)
             if status_s == "ok":
-                candidates += [(e, "summary", True) for e in sorted(exprs, key=_complexity)]
-            else:
+                candidates = []
+                combos = chosen_s
+            elif stopped is not None:
+                notes.append(f"no combinations from the summary entries: {stopped}")
+            elif status_s == "timeout":
                 notes.append("the summary entries were not computed within the budget: no combinations from them")
-        chosen = select_combinations(local, candidates)
-        combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global} for c in chosen]
+            else:
+                raise_on_error("combinations", status_s, chosen_s)
+        if candidates:
+            chosen = select_combinations(local, candidates)
+            combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global}
+                      for c in chosen]
         reparam = {f"phi{i + 1}": c["expression"] for i, c in enumerate(combos)}
         fix_syms = parameters_to_fix(local)
         fix = tuple(q.name for q in fix_syms)
@@ -375,9 +409,21 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         theta_confirm=dict(glob.theta_confirm) if determined else {}, solution_count=count)
 
 
-def _summary_expressions(model, known) -> list:
-    """The exhaustive summary's entries as sympy expressions (run in a child process)."""
-    return exhaustive_summary(model, known).expressions()
+def _summary_combinations(model, known, local, monos, limit: int) -> list[dict]:
+    """Combinations from the scaling monomials and the ``limit`` simplest summary entries (fewest terms).
+
+    Run in a child process beside the Gröbner step of a model that is not locally
+    identifiable: the summary entries are identifiable functions, so the combinations
+    do not depend on the Gröbner basis finishing.
+    """
+    summ = exhaustive_summary(model, known)
+    order = sorted(range(len(summ)), key=lambda i: (len(summ.numerators[i]) + len(summ.denominators[i]), i))
+    candidates = [(e, "scaling", None) for e in monos]
+    for i in order[:limit]:
+        num, den = summ.numerators[i], summ.denominators[i]
+        candidates.append((num.as_expr() / den.as_expr(), "summary", True, poly_gradients(num, den, local.points)))
+    return [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global}
+            for c in select_combinations(local, candidates)]
 
 
 def _check_fix(model, known_exact, fix: tuple[str, ...], seed: int, budget: float | None) -> str:

@@ -35,7 +35,7 @@ from sympy.polys.matrices import DomainMatrix
 
 from symid.structural.local import LocalResult
 
-__all__ = ["Combination", "monomial_candidates", "parameters_to_fix", "select_combinations"]
+__all__ = ["Combination", "monomial_candidates", "parameters_to_fix", "poly_gradients", "select_combinations"]
 
 
 @dataclass(frozen=True)
@@ -116,8 +116,10 @@ def select_combinations(local: LocalResult, candidates: Sequence[tuple[sp.Expr, 
     Parameters
     ----------
     local : LocalResult
-    candidates : sequence of (expression, source, is_global)
-        Tried in order.
+    candidates : sequence of (expression, source, is_global) or (expression, source, is_global, gradients)
+        Tried in order. ``gradients``: the exact gradient at each point of ``local``
+        (skips differentiating the expression, e.g. :func:`poly_gradients` for a summary
+        entry).
     """
     params = local.parameters
     nonid = {p for p, ok in zip(params, local.identifiable, strict=True) if not ok}
@@ -128,14 +130,15 @@ def select_combinations(local: LocalResult, candidates: Sequence[tuple[sp.Expr, 
     rank = len(basis)
     chosen: list[Combination] = []
     seen = set()
-    for expr, source, is_global in candidates:
+    for expr, source, is_global, *given in candidates:
         if rank >= local.rank:
             break
-        expr = sp.factor_terms(expr)
+        if not given:
+            expr = sp.factor_terms(expr)
         if expr in seen or not (expr.free_symbols & nonid):
             continue
         seen.add(expr)
-        grads = [_gradient(expr, params, pt) for pt in local.points]
+        grads = given[0] if given else [_gradient(expr, params, pt) for pt in local.points]
         if any(g is None for g in grads):
             continue
         if not all(local.in_rowspace(g, which=i) for i, g in enumerate(grads)):
@@ -146,6 +149,29 @@ def select_combinations(local: LocalResult, candidates: Sequence[tuple[sp.Expr, 
             rank = new_rank
             chosen.append(Combination(expr, source, is_global))
     return chosen
+
+
+def poly_gradients(num, den, points: Sequence[Sequence]) -> list[list]:
+    """Exact gradients of ``num/den`` (sympy ``PolyElement`` s over ℚ in θ) at each point (QQ coordinates).
+
+    Examples
+    --------
+    >>> from sympy import QQ
+    >>> from sympy.polys.rings import ring
+    >>> from symid.structural.combinations import poly_gradients
+    >>> R, a, b = ring("a b", QQ)
+    >>> g = poly_gradients(a * b, R.one + b, [[QQ(2), QQ(1)]])  # ∂(ab/(1+b)) = (b/(1+b), a/(1+b)²)
+    >>> [[str(v) for v in row] for row in g]
+    [['1/2', '1/2']]
+    """
+    out = []
+    gens = num.ring.gens
+    dnum = [num.diff(g) for g in gens]
+    dden = [den.diff(g) for g in gens]
+    for pt in points:
+        n, d = num(*pt), den(*pt)
+        out.append([(dn(*pt) * d - n * dd(*pt)) / (d * d) for dn, dd in zip(dnum, dden, strict=True)])
+    return out
 
 
 def parameters_to_fix(local: LocalResult) -> tuple[sp.Symbol, ...]:

@@ -263,14 +263,33 @@ def _det(mat: DomainMatrix) -> PolyElement:
     return minors.get(tuple(range(n)), mat.domain.zero)
 
 
+def _bilinear_adjugate(P: DomainMatrix, c: list, b: list, detP: PolyElement) -> PolyElement:
+    """c adj(P) b: from the cofactors when c and b have few nonzero entries, else det(P + b c) − det(P).
+
+    adj(P)[q, r] = (−1)^(q+r) det(P without row r and column q); a sensor and an actuator
+    at one coordinate each need one determinant of order n − 1 instead of one of order n.
+    """
+    n = P.shape[0]
+    pairs = [(q, r) for q in range(n) if c[q] for r in range(n) if b[r]]
+    dom = P.domain
+    if len(pairs) > 2:
+        bc = DomainMatrix([[b[r] * c[q] for q in range(n)] for r in range(n)], (n, n), dom)
+        return _det(P + bc) - detP
+    rows = P.to_list()
+    out = dom.zero
+    for q, r in pairs:
+        minor = [[rows[i][k] for k in range(n) if k != q] for i in range(n) if i != r]
+        cof = _det(DomainMatrix(minor, (n - 1, n - 1), dom)) if n > 1 else dom.one
+        out += c[q] * b[r] * (cof if (q + r) % 2 == 0 else -cof)
+    return out
+
+
 def _coeffs_in_s(p: PolyElement, s_index: int, degree: int) -> list[PolyElement]:
     """Coefficients of s⁰..s^degree of a polynomial of QQ[θ, s], as polynomials of the same ring."""
-    out = [p.ring.zero for _ in range(degree + 1)]
-    for monom, coeff in p.terms():
-        k = monom[s_index]
-        rest = (*monom[:s_index], 0, *monom[s_index + 1:])
-        out[k] += p.ring({rest: coeff})
-    return out
+    parts: list[dict] = [{} for _ in range(degree + 1)]
+    for monom, coeff in p.items():
+        parts[monom[s_index]][(*monom[:s_index], 0, *monom[s_index + 1:])] = coeff
+    return [p.ring(d) if d else p.ring.zero for d in parts]
 
 
 def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
@@ -329,7 +348,7 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
     keep_n, keep_d, keep_l, n_const = [], [], [], 0
     for num, den, lab in zip(nums, dens, labels, strict=True):
         num_r, den_r = _to_ring(num, R, names), _to_ring(den, R, names)
-        g = num_r.gcd(den_r)
+        g = _monomial_gcd(num_r, den_r) if len(den_r) == 1 else num_r.gcd(den_r)
         if g != R.one:
             num_r, den_r = num_r.exquo(g), den_r.exquo(g)
         if num_r.is_ground and den_r.is_ground:
@@ -345,16 +364,30 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
                              normaliser)
 
 
+def _monomial_gcd(num: PolyElement, mono: PolyElement) -> PolyElement:
+    """gcd of a polynomial and a monomial (times a constant): the monomial of the smallest common exponents."""
+    R = num.ring
+    if not num:
+        return mono.monic()
+    (exps,) = mono.monoms()
+    for m in num.monoms():
+        exps = tuple(min(a, b) for a, b in zip(exps, m, strict=True))
+        if not any(exps):
+            break
+    return R({exps: R.domain.one})
+
+
 def _to_ring(p: PolyElement, R: PolyRing, names: list[sp.Symbol]) -> PolyElement:
     if p.ring == R:
         return p
     idx = [p.ring.symbols.index(x) for x in names]
-    out = R.zero
-    for monom, coeff in p.terms():
-        if any(monom[i] for i in range(len(monom)) if i not in idx):
+    rest = [i for i in range(p.ring.ngens) if i not in idx]
+    terms = {}
+    for monom, coeff in p.items():  # distinct monomials stay distinct: the dropped exponents are all 0
+        if any(monom[i] for i in rest):
             raise ModelError("internal error: summary entry still depends on s")  # pragma: no cover
-        out += R({tuple(monom[i] for i in idx): coeff})
-    return out
+        terms[tuple(monom[i] for i in idx)] = coeff
+    return R(terms) if terms else R.zero
 
 
 def _tf_summary(mats, mkind, output, params):
@@ -393,9 +426,8 @@ def _tf_summary(mats, mkind, output, params):
         Bl, Cl = B.to_list(), C.to_list()
         for i in range(C.shape[0]):
             for j in range(B.shape[1]):
-                bc = DomainMatrix([[Bl[r][j] * Cl[i][c] for c in range(n)] for r in range(n)], (n, n), P.domain)
-                num = (_det(P + bc) - detP) * sv**shift
-                nums[i, j] = _coeffs_in_s(num, si, 2 * n + shift)
+                num = _bilinear_adjugate(P, [Cl[i][c] for c in range(n)], [Bl[r][j] for r in range(n)], detP)
+                nums[i, j] = _coeffs_in_s(num * sv**shift, si, 2 * n + shift)
         degree = 2 * n
     for k in range(degree):
         entries_n.append(dcoef[k])
