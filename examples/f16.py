@@ -51,7 +51,16 @@ The analysis
 
 Reference values (measured on these files outside symid): a hand-started fit of this
 model reaches a relative FRF misfit of about 0.01 and a validation fit of 71 %; an
-N4SID black box 67 %.
+N4SID black box 67 %. On the steady-state lines used here the same hand-started fit
+validates at 80.6 % (``tests/test_f16_example.py`` asserts at least 71 %).
+
+What ``success`` means here: the lines are measured to about 0.1 % of |H|, so noise
+alone would leave a relative misfit of 1.5e-6 (Σ variance / Σ |H|²); a misfit of 0.01
+is model error (eight linear modes for a structure with a mildly nonlinear
+wing-torsion mode at 7.3 Hz and more modes outside the band). symid's rule (a fit is a
+success only when what is left is noise) therefore reports ``success=False`` even for
+the best fit, and says why in the fit test printed under each route; the validation on
+the other record is what tells whether the model is useful.
 """
 
 from __future__ import annotations
@@ -282,6 +291,7 @@ def main(argv: list[str] | None = None) -> int:
         r["validation"] = fit
         print(f"{name:>11}: FRF misfit {res.cost:.4f}, success {res.success}, {r['seconds']:.0f} s for {starts} "
               f"start(s); validation fit {fit:.1f} %")
+        print(f"{'':>13}fit test: {res.fit}")
         if best is None or res.cost < best.cost:
             best_name, best = name, res
     print(f"best route: {best_name}; modes (Hz, damping ratio):")
