@@ -30,6 +30,8 @@ _BLOCK = re.compile(r"(<!-- table: (?P<src>[^ ]+) -->\n)(?P<body>.*?)(<!-- /tabl
 def _k(row: dict) -> str:
     if row["verdict"] == "none" and row.get("global_determined"):
         return "∞"  # not identifiable: a positive-dimensional solution set
+    if row.get("n_solutions_complex") is not None:
+        return str(row["n_solutions_complex"])  # complex solutions: the structural count
     if row.get("n_solutions") is None:
         at_least = row.get("n_solutions_at_least")
         return f"≥ {at_least}" if at_least else "not found"
@@ -44,13 +46,41 @@ def identifiability_table(doc: dict) -> str:
         verdict = {"none": "not identifiable"}.get(row["verdict"], row["verdict"])
         if verdict == "local" and row.get("verdicts_proven") and not row.get("global_determined"):
             verdict = "local, not global (proven by certified witnesses)"
-        elif not row.get("global_determined") and not row.get("verdicts_proven"):
+        elif not row.get("global_determined") and not row.get("verdicts_proven") and "undetermined" not in verdict:
             verdict += " (global undetermined)"
         wall = f"{row['wall_s']:.2f}" + (f" (timeout {doc['timeout_s']:g} s)"
                                           if row["report_s"] >= doc["timeout_s"] else "")
         lines.append(f"| {name} | {row['n_parameters']} | {wall} | {row['cpu_s']:.2f} | {verdict} | {_k(row)} |")
     lines.append(f"\nLoad average (1 min) {doc['load_average_before']:.2f} before, {doc['load_average_after']:.2f} "
                  f"after, on {doc['cores']} cores.")
+    return "\n".join(lines) + "\n"
+
+
+def _family_complete(row: dict) -> bool:
+    return "error" not in row and "local, global undetermined" not in (row["verdict"], *row["verdicts"].values())
+
+
+def identifiability_families_table(doc: dict) -> str:
+    """The model families of the identifiability benchmark: per family, how many full reports within 2 s."""
+    lines = ["| family | models | parameters | complete within 2 s | complete (any time) | median wall s | "
+             "median cpu s | verdicts (complete reports) |", "|---|---|---|---|---|---|---|---|"]
+    fams: dict[str, list] = {}
+    for row in doc["rows"]:
+        fams.setdefault(row["model"].split("-")[0], []).append(row)
+    for fam, rows in fams.items():
+        pars = [r["n_parameters"] for r in rows if "n_parameters" in r]
+        done = [r for r in rows if _family_complete(r)]
+        fast = [r for r in done if r["wall_s"] <= doc["target_s"]]
+        walls = sorted(r["wall_s"] for r in rows)
+        cpus = sorted(r["cpu_s"] for r in rows)
+        counts: dict[str, int] = {}
+        for r in done:
+            counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
+        verdicts = ", ".join(f"{v} {c}" for v, c in sorted(counts.items()))
+        lines.append(f"| {fam} | {len(rows)} | {min(pars)}–{max(pars)} | {len(fast)} | {len(done)} | "
+                     f"{walls[len(walls) // 2]:.2f} | {cpus[len(cpus) // 2]:.2f} | {verdicts} |")
+    lines.append(f"\nBudget {doc['timeout_s']:g} s per model; load average (1 min) {doc['load_average_before']:.2f} "
+                 f"before, {doc['load_average_after']:.2f} after, on {doc['cores']} cores.")
     return "\n".join(lines) + "\n"
 
 
@@ -142,6 +172,7 @@ TABLES: dict[str, Callable[[dict], str]] = {
     "benchmarks/results/psd.json": psd_table,
     "benchmarks/results/similarity_study.json": similarity_table,
     "benchmarks/results/identifiability.json": identifiability_table,
+    "benchmarks/results/identifiability_families.json": identifiability_families_table,
     "benchmarks/results/frf.json": frf_table,
 }
 

@@ -582,7 +582,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "identifiability", help="structural identifiability report of a model",
         description="Which parameters of a model can be recovered from noise-free input-output data: per "
-                    "parameter global / local / none (exact Jacobian rank and a Gröbner basis), the number of "
+                    "parameter global / local / local, global undetermined / none (exact Jacobian rank and a "
+                    "Gröbner basis at a generic random point, confirmed at a second one), the number of "
                     "solutions, identifiable combinations and a reparameterisation.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     p.add_argument("--timeout", type=_positive_seconds, default=30.0, metavar="S",
