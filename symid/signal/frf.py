@@ -27,7 +27,7 @@ H1. For H2 the same first-order value at the H2 estimate,
 The variance is that of the noise only: a window also smooths the response over its
 resolution (leakage), a bias that is largest at lightly damped resonances, where it
 shows as dips of the coherence (on the F-16 ground vibration test, Welch with
-8192-sample Hann segments drops the coherence to 0.55 at the 7.3 Hz mode, where the
+8192-sample Hann segments drops the coherence to 0.56 at the 7.3 Hz mode, where the
 periodic estimate of the same record keeps it above 0.999). Longer segments or periodic
 excitation remove it.
 
