@@ -68,7 +68,7 @@ def data_kind(data: Any) -> DataKind:
     >>> import symid as si
     >>> from symid.fit.registry import data_kind
     >>> data_kind(si.FrequencyData([1.0, 2.0], np.ones(2))).methods
-    ('scr', 'ipopt', 'ls')
+    ('scr', 'ipopt', 'ls', 'lm', 'auto')
     """
     if isinstance(data, (list, tuple)) and data:  # several experiments: every record a time series
         names = {type(d).__name__ for d in data}

@@ -7,6 +7,8 @@ scr      Algorithm 3.1 (state space) / (4-8) with M, V, K ⪰ 0 (second    :mod:
          order); the linear case below when it applies
 ipopt    nonlinear least squares on the relative FRF misfit              :mod:`~symid.fit.frf.ipopt`
 ls       the linear least squares (4-10)/(4-11) (C or B known, square)   :mod:`~symid.fit.frf.ls`
+lm       Levenberg–Marquardt on log-parameters, log-H then H criterion    :mod:`~symid.fit.frf.lm`
+auto     ``lm`` restarted around the start until the estimate fits       :mod:`~symid.fit.frf.lm`
 =======  ==============================================================  ==========================
 """
 
@@ -21,7 +23,7 @@ from symid.fit.options import check_bool, check_known_names
 
 __all__ = ["METHODS", "prepare"]
 
-METHODS = ("scr", "ipopt", "ls")
+METHODS = ("scr", "ipopt", "ls", "lm", "auto")
 
 
 def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
@@ -34,6 +36,7 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     options given without it are refused (they would be ignored).
     """
     from symid.fit.frf.ipopt import IpoptFRF
+    from symid.fit.frf.lm import AutoFRF, LmFRF
     from symid.fit.frf.ls import LinearFRF, ls_applicable
     from symid.fit.frf.scr import ScrFRF
     from symid.model.secondorder import SecondOrderModel
@@ -43,6 +46,10 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
         return LinearFRF.create(model, data, options, noise_floor=noise_floor)
     if method == "ipopt":
         return IpoptFRF.create(model, data, options, noise_floor=noise_floor)
+    if method == "lm":
+        return LmFRF.create(model, data, options, noise_floor=noise_floor)
+    if method == "auto":
+        return AutoFRF.create(model, data, options, noise_floor=noise_floor)
     if method != "scr":
         raise ModelError(f"unknown method {method!r} for frequency-response data; choose one of "
                          f"{', '.join(METHODS)}")

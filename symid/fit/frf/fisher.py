@@ -21,7 +21,7 @@ from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
 __all__ = ["FrfFisher"]
 
-_MINIMISERS = ("ipopt",)
+_MINIMISERS = ("ipopt", "lm", "auto")
 
 
 class FrfFisher(FisherInformation):

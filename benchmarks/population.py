@@ -1,0 +1,294 @@
+"""Every frequency-response method on a generated population of models nobody tuned for.
+
+Problems come from :mod:`population_models` (this folder): mass-spring-damper chains of
+n masses (position, velocity or acceleration output; collocated or not), chains with a
+second sensor, chains with an actuator gain in B and a sensor gain in C, first-order
+state-space networks with parameters in A, B and C, and catenary or mammillary
+compartment models with a volume in C; true values drawn log-uniformly over physical
+ranges (SI units), frequency grids that cover the modes. Every problem is checked with
+:func:`symid.identifiability` before it is used: one with a parameter that is not
+locally identifiable is drawn again, never counted against a method.
+
+Per problem, noise level (noise-free, 1 % relative) and kind of start:
+
+- informed starts: within a factor 3 of the truth (log-uniform);
+- uninformed starts: log-uniform over two decades around the typical value of each
+  parameter, which every method that takes one is given as ``scale=`` (what a user
+  knows before measuring: the order of magnitude of a mass, a stiffness, a rate).
+
+Every method runs from the same starts through :func:`symid.compare`, each start with a
+wall-time budget (``--time-limit``, the methods' ``time_limit=`` option). A start
+succeeds when
+
+- noise-free: ‖θ̂ − θ*‖/‖θ*‖ ≤ 1e-3, or, for a problem not proven globally identifiable,
+  θ̂ fits the data exactly (relative misfit ≤ 1e-10) with every parameter declared
+  positive positive: another admissible solution;
+- 1 % noise: ‖θ̂ − θ*‖/‖θ*‖ ≤ 2 × that of IPOPT started at the truth (the reference
+  estimate), or, for a problem not proven globally identifiable, θ̂ fits at least as
+  well as the reference (misfit ≤ 1.001 × its misfit) with positive parameters.
+
+Tabulated per class × method × noise × start kind: success rate, median seconds per
+start, time to solution (all starts' time / successes).
+
+Run (one BLAS thread per process)::
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/population.py \\
+        [--classes chain,gains] [--sizes 2,3,5,8] [--problems 2] [--starts 3] [--methods auto,ipopt,scr] \\
+        [--noise 0,0.01] [--kinds informed,uninformed] [--time-limit 60] [--workers 2 | --dask ADDRESS]
+
+Every finished start is appended to ``benchmarks/results/population.jsonl`` (``--log``) as
+it ends; running the command again resumes (finished starts are read back), ``--fresh``
+starts over. ``--summary-only`` rebuilds the summary from the log. The summary
+(``benchmarks/results/population.json``, the README table's source) is rewritten from the
+whole log after every problem, so it always describes exactly what the log holds.
+``--workers N`` runs the starts in a local process pool; ``--dask ADDRESS`` on a Dask
+cluster (``distributed.Client(ADDRESS).get_executor()``, the optional extra
+``symid[dask]``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import subprocess
+import sys
+import time
+import warnings
+from collections import defaultdict
+from concurrent.futures import Executor, ProcessPoolExecutor
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from population_models import CLASSES, Problem, make_problem  # benchmarks/ (the script's folder) is on the path
+
+import symid as si
+from symid.fit.compare import relative_parameter_error
+from symid.fit.frf.ls import ls_applicable
+from symid.fit.success import EXACT_FIT
+from symid.interrupt import Interrupted
+from symid.runlog import RunLog, write_json_atomic
+
+RESULTS = Path(__file__).resolve().parent / "results"
+METHODS = ("auto", "lm", "ipopt", "scr", "scr+polish", "ls")
+SCALED = ("auto", "lm", "ipopt", "scr")  # methods that take the user's typical values as scale=
+TIMED = ("auto", "lm", "ipopt", "scr")  # methods that take time_limit=
+MAX_SIZE = {"compartment": 6, "state_space": 8}  # larger sizes of these classes are skipped
+
+
+def _problem(log: RunLog, cls: str, n: int, index: int, timeout: float) -> Problem:
+    """The problem, checked once and rebuilt from its draw afterwards (the check is logged)."""
+    key = f"{cls}-n{n}-{index}/problem"
+    rec = log.get(key)
+    if rec is not None:
+        p = make_problem(cls, n, index, check=False, draw=rec["info"]["draw"])
+        p.info.update(rec["info"])
+        return p
+    t0 = time.perf_counter()
+    p = make_problem(cls, n, index, timeout=timeout)
+    log.append(key, {"cls": cls, "n": n, "index": index, "n_parameters": p.model.n_parameters,
+                     "parameter_names": list(p.model.parameter_names), "truth": p.truth, "typical": p.typical,
+                     "w": [float(p.w[0]), float(p.w[-1]), int(p.w.size)], "info": p.info,
+                     "check_time": time.perf_counter() - t0})
+    return p
+
+
+def _reference(log: RunLog, p: Problem, noise: float, data: Any) -> dict[str, Any]:
+    """IPOPT started at the truth: the estimate a method is measured against on noisy data."""
+    key = f"{p.name}/noise{noise:g}/reference"
+    rec = log.get(key)
+    if rec is None:
+        res = si.identify(p.model, data, method="ipopt", x0=p.truth, identifiability_check=False, scale=p.typical)
+        log.append(key, {"theta": res.theta_vector, "cost": res.cost,
+                         "error": relative_parameter_error(res.theta_vector, p.truth), "status": res.status})
+        rec = log.get(key)
+    return rec
+
+
+def start_success(theta: Any, cost: Any, truth: np.ndarray, positive: np.ndarray, globally: bool,
+                  reference: dict[str, Any] | None) -> bool:
+    """The benchmark's success rule for one start (module docstring)."""
+    if theta is None or cost is None:
+        return False
+    theta = np.asarray(theta, dtype=float)
+    if not np.all(np.isfinite(theta)):
+        return False
+    err = relative_parameter_error(theta, truth)
+    admissible = bool(np.all(theta[positive] > 0))
+    if reference is None:  # noise-free
+        return err <= 1e-3 or (not globally and admissible and float(cost) <= EXACT_FIT)
+    ref_err, ref_cost = float(reference["error"]), float(reference["cost"])
+    return err <= 2 * ref_err or (not globally and admissible and float(cost) <= 1.001 * ref_cost)
+
+
+def run_problem(log: RunLog, p: Problem, args: argparse.Namespace, executor: Executor | None) -> None:
+    methods = [m for m in args.methods if m != "ls" or ls_applicable(p.model) is not None]
+    for noise in args.noise:
+        data = p.data(noise=noise, seed=0)
+        if noise > 0:
+            _reference(log, p, noise, data)
+        for kind in args.kinds:
+            starts = list(p.starts(kind, args.starts, seed=0))
+            options = {m: {**({"scale": p.typical} if m in SCALED else {}),
+                           **({"time_limit": args.time_limit} if m in TIMED else {})}
+                       for m in {x.removesuffix("+polish") for x in methods}}
+            scope = log.scoped(f"{p.name}/noise{noise:g}/{kind}/")
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # identifiability was checked above
+                si.compare(p.model, data, methods=methods, starts=starts, options=options, log=scope,
+                           executor=executor, progress=args.progress, noise_floor=None)
+
+
+def summarise(log: RunLog) -> dict[str, Any]:
+    """Success rate, median time per start and time to solution per class × method × noise × start kind,
+    from every record in the log."""
+    problems: dict[str, dict[str, Any]] = {}
+    refs: dict[tuple[str, str], dict[str, Any]] = {}
+    for rec in log.records():
+        parts = rec["key"].split("/")
+        if parts[-1] == "problem":
+            problems[parts[0]] = rec
+        elif parts[-1] == "reference":
+            refs[(parts[0], parts[1])] = rec
+    cells: dict[tuple, dict[str, Any]] = defaultdict(lambda: {"starts": 0, "success": 0, "times": [], "setup": 0.0,
+                                                              "problems": set()})
+    for rec in log.records():
+        parts = rec["key"].split("/")
+        if len(parts) != 5 or parts[0] not in problems:
+            continue
+        name, noise_key, kind, method, what = parts
+        prob = problems[name]
+        cell = cells[(prob["cls"], method, noise_key, kind)]
+        if what == "setup":
+            cell["setup"] += float(rec.get("setup_time", 0.0))
+            continue
+        globally = bool(prob["info"].get("global", False))
+        model_positive = np.asarray([True] * prob["n_parameters"])  # every generated parameter is declared positive
+        ref = None if noise_key == "noise0" else refs.get((name, noise_key))
+        ok = start_success(rec.get("theta"), rec.get("cost"), np.asarray(prob["truth"]), model_positive, globally,
+                           ref)
+        cell["starts"] += 1
+        cell["success"] += int(ok)
+        cell["times"].append(float(rec["wall_time"]))
+        cell["problems"].add(name)
+    rows = []
+    for (cls, method, noise_key, kind), c in sorted(cells.items()):
+        total = c["setup"] + sum(c["times"])
+        rows.append({"class": cls, "method": method, "noise": float(noise_key.removeprefix("noise")),
+                     "starts_kind": kind,
+                     "problems": len(c["problems"]), "starts": c["starts"], "successes": c["success"],
+                     "success_rate": c["success"] / c["starts"] if c["starts"] else None,
+                     "median_time": float(np.median(c["times"])) if c["times"] else None,
+                     "time_to_solution": total / c["success"] if c["success"] else None})
+    sizes = defaultdict(set)
+    for prob in problems.values():
+        sizes[prob["cls"]].add(int(prob["n"]))
+    return {"rows": rows, "problems": len(problems), "sizes": {k: sorted(v) for k, v in sizes.items()}}
+
+
+def _git_commit() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True,
+                              cwd=Path(__file__).resolve().parent).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def print_table(summary: dict[str, Any]) -> None:
+    head = ("class", "method", "noise", "starts", "problems", "success", "median s/start", "time to solution s")
+    print(" | ".join(head))
+    for r in summary["rows"]:
+        rate = "—" if r["success_rate"] is None else f"{r['successes']}/{r['starts']} ({100 * r['success_rate']:.0f} %)"
+        med = "—" if r["median_time"] is None else f"{r['median_time']:.3g}"
+        tts = "inf" if r["time_to_solution"] is None else f"{r['time_to_solution']:.3g}"
+        print(" | ".join([r["class"], r["method"], f"{r['noise']:g}", r["starts_kind"], str(r["problems"]), rate, med,
+                          tts]))
+
+
+def _floats(text: str) -> list[float]:
+    return [float(v) for v in text.split(",") if v]
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--classes", default=",".join(CLASSES))
+    ap.add_argument("--sizes", default="2,3,5,8", help="masses / states / compartments (default %(default)s)")
+    ap.add_argument("--problems", type=int, default=2, help="problems per class and size (default %(default)s)")
+    ap.add_argument("--starts", type=int, default=3, help="starts of each kind (default %(default)s)")
+    ap.add_argument("--methods", default=",".join(METHODS))
+    ap.add_argument("--noise", default="0,0.01", help="relative noise levels (default %(default)s)")
+    ap.add_argument("--kinds", default="informed,uninformed")
+    ap.add_argument("--time-limit", type=float, default=60.0, help="seconds per start (default %(default)s)")
+    ap.add_argument("--check-timeout", type=float, default=30.0, help="identifiability check budget (s)")
+    ap.add_argument("--workers", type=int, default=1, help="local worker processes (default: serial)")
+    ap.add_argument("--dask", default=None, help="address of a Dask scheduler to run the starts on")
+    ap.add_argument("--log", default=str(RESULTS / "population.jsonl"))
+    ap.add_argument("--out", default=str(RESULTS / "population.json"))
+    ap.add_argument("--fresh", action="store_true", help="start over: discard the log")
+    ap.add_argument("--summary-only", action="store_true", help="rebuild the summary from the log; run nothing")
+    ap.add_argument("--progress", action="store_true", help="progress bars per method")
+    args = ap.parse_args(argv)
+    args.classes = [c for c in args.classes.split(",") if c]
+    bad = sorted(set(args.classes) - set(CLASSES))
+    if bad:
+        ap.error(f"unknown classes {bad}; choose among {', '.join(CLASSES)}")
+    args.methods = [m for m in args.methods.split(",") if m]
+    args.noise = _floats(args.noise)
+    args.kinds = [k for k in args.kinds.split(",") if k]
+    sizes = [int(v) for v in args.sizes.split(",") if v]
+    log = RunLog(args.log, fresh=args.fresh)
+    header = {"commit": _git_commit(), "machine": platform.machine(), "cpus": os.cpu_count(),
+              "python": platform.python_version()}
+
+    def write_summary() -> dict[str, Any]:
+        summary = {**header, **summarise(log), "criteria": {
+            "noise-free": "relative parameter error <= 1e-3, or (not proven globally identifiable) an exact fit "
+                          "(misfit <= 1e-10) with positive parameters",
+            "noisy": "relative parameter error <= 2 x that of IPOPT started at the truth, or (not proven globally "
+                     "identifiable) misfit <= 1.001 x the reference's with positive parameters"}}
+        write_json_atomic(args.out, summary)
+        return summary
+
+    if args.summary_only:
+        print_table(write_summary())
+        return 0
+    executor: Executor | None = None
+    client = None
+    if args.dask:
+        import distributed
+
+        client = distributed.Client(args.dask)
+        executor = client.get_executor()
+    elif args.workers > 1:
+        executor = ProcessPoolExecutor(max_workers=args.workers, mp_context=get_context("spawn"))
+    t0 = time.perf_counter()
+    try:
+        for cls in args.classes:
+            for n in sizes:
+                if n > MAX_SIZE.get(cls, 8):
+                    continue
+                for index in range(args.problems):
+                    p = _problem(log, cls, n, index, args.check_timeout)
+                    print(f"{p.name}: {p.model.n_parameters} parameters, {p.info.get('identifiability')}, "
+                          f"{time.perf_counter() - t0:.0f} s", flush=True)
+                    run_problem(log, p, args, executor)
+                    write_summary()
+    except (KeyboardInterrupt, Interrupted):
+        print(f"\ninterrupted: {len(log)} finished runs are kept in {args.log}; run the same command again to "
+              f"resume", file=sys.stderr)
+        write_summary()
+        return 130
+    finally:
+        if isinstance(executor, ProcessPoolExecutor):
+            executor.shutdown(cancel_futures=True)
+        if client is not None:
+            client.close()
+    print_table(write_summary())
+    print(f"wrote {args.out} (log: {args.log})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
