@@ -121,7 +121,7 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
         from symid.structural.analyse import warn_if_not_identifiable
 
         warn_if_not_identifiable(model, stacklevel=2)
-    if estimator.method == "ls":
+    if estimator.method in ("ls", "svf"):  # linear least squares: one start says it all
         x0s = x0s[:1]
     options_used = dict(estimator.options)
     outcomes: list[StartOutcome] = []

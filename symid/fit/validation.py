@@ -197,21 +197,23 @@ class Validation:
         first = stem.with_name(stem.name + "_output.png")
         second = stem.with_name(stem.name + "_residual.png")
         plt = _pyplot()
-        fig, axes = plt.subplots(p, 1, figsize=(10, 2.8 * p + 0.6), squeeze=False, sharex=True)
+        fig, axes = plt.subplots(2 * p, 1, figsize=(10, 4.2 * p + 0.6), squeeze=False, sharex=True,
+                                 gridspec_kw={"height_ratios": [2, 1] * p})
         for j in range(p):
-            ax = axes[j, 0]
+            ax, rax = axes[2 * j, 0], axes[2 * j + 1, 0]
+            unit = ounits[j] if ounits[j] else "unit not given"
             for e, (tt, yy, ys) in enumerate(zip(self.t, self.y, self.y_sim, strict=True)):
                 ax.plot(tt, yy[:, j], color="0.55", lw=2.6, alpha=0.8, label="measured" if e == 0 else None)
                 ax.plot(tt, ys[:, j], color="C3", lw=1.1, ls=(0, (5, 2)), label="simulated" if e == 0 else None)
-            ax.plot(np.concatenate(self.t), np.concatenate([yy[:, j] - ys[:, j] for yy, ys in
-                                                             zip(self.y, self.y_sim, strict=True)]),
-                    color="C0", lw=0.8, label="residual y − ŷ")
-            unit = ounits[j] if ounits[j] else "unit not given"
+                rax.plot(tt, yy[:, j] - ys[:, j], color="C0", lw=0.8, label="measured − simulated" if e == 0 else None)
             ax.set_ylabel(f"{onames[j]} ({unit})")
             ax.set_title(f"{onames[j]}: fit {self.fit_percent[j]:.2f} %, rms error {self.rms_error[j]:.3g}"
                          f"{' ' + ounits[j] if ounits[j] else ''}", fontsize=10)
-            ax.grid(alpha=0.3)
-            ax.legend(loc="best", fontsize=8)
+            rax.axhline(0, color="k", lw=0.6)
+            rax.set_ylabel(f"residual ({unit})")
+            for a in (ax, rax):
+                a.grid(alpha=0.3)
+                a.legend(loc="best", fontsize=8)
         axes[-1, 0].set_xlabel(f"time ({self.time_unit})")
         if title:
             fig.suptitle(title)
@@ -227,7 +229,7 @@ class Validation:
             ax.vlines(self.lags[1:], 0, self.autocorrelation[j, 1:], color="C0", lw=1.5, label="ρₑ(τ)")
             ax.plot(self.lags[1:], self.autocorrelation[j, 1:], "o", color="C0", ms=3)
             ax.axhline(0, color="k", lw=0.6)
-            ax.set_title(f"whiteness of the {onames[j]} residual (p = {self.whiteness_p[j]:.2g})", fontsize=9)
+            ax.set_title(f"whiteness of the {onames[j]} residual ({_p_text(self.whiteness_p[j])})", fontsize=9)
             ax.set_xlabel("lag τ (samples)")
             ax.set_ylabel("autocorrelation (–)")
             ax.legend(loc="best", fontsize=8)
@@ -236,7 +238,7 @@ class Validation:
                 ax = axes[j, 1 + i]
                 rho = self.cross_correlation[j, i]
                 if not np.all(np.isfinite(rho)):
-                    ax.text(0.5, 0.5, f"{inames[i]} is constant:\nno cross-correlation", ha="center",
+                    ax.text(0.5, 0.5, f"input '{inames[i]}' does not vary:\nno cross-correlation", ha="center",
                             va="center", transform=ax.transAxes)
                     ax.set_axis_off()
                     continue
@@ -246,7 +248,7 @@ class Validation:
                 ax.plot(self.cross_lags, rho, "o", color="C1", ms=3)
                 ax.axhline(0, color="k", lw=0.6)
                 ax.axvline(0, color="0.4", lw=0.6, ls=":")
-                ax.set_title(f"{onames[j]} residual vs {inames[i]} (τ ≥ 0: p = {self.independence_p[j, i]:.2g})",
+                ax.set_title(f"{onames[j]} residual vs {inames[i]} (τ ≥ 0: {_p_text(self.independence_p[j, i])})",
                              fontsize=9)
                 ax.set_xlabel("lag τ (samples; > 0: input leads)")
                 ax.set_ylabel("cross-correlation (–)")
@@ -257,6 +259,10 @@ class Validation:
         fig.tight_layout()
         _save(fig, second)
         return first, second
+
+
+def _p_text(p: float) -> str:
+    return "p < 1e-16" if p < 1e-16 else f"p = {p:.2g}"
 
 
 def _names(values: Any, n: int, default: str | None) -> list[str]:

@@ -11,6 +11,9 @@ one IOData         ``scr``,    the black box of N4SID + exact ``d2c`` (thesis Al
                    ``gb``,     samples; their ``cost``, ``success`` and uncertainty are judged on
                    ``ipopt``,  the samples all the same (:mod:`~symid.fit.timeseries.blackbox`),
                    ``ls``      the black-box misfit is in ``message``
+IOData, TimeSeries ``svf``     least squares on state-variable-filtered derivatives, for models whose
+or a list of them              states are all measured (:mod:`~symid.fit.timeseries.svf`); judged on
+                               the samples like the N4SID route
 =================  ==========  =====================================================================
 
 ``oe`` takes non-uniform sample times, several experiments, free responses (u ≡ 0) and
@@ -28,7 +31,7 @@ from symid.fit.base import Estimator
 __all__ = ["BLACK_BOX_METHODS", "METHODS", "prepare"]
 
 BLACK_BOX_METHODS = ("scr", "als", "gb", "ipopt", "ls")
-METHODS = ("oe", *BLACK_BOX_METHODS)
+METHODS = ("oe", "svf", *BLACK_BOX_METHODS)
 
 
 def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
@@ -40,6 +43,10 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
         from symid.fit.timeseries.oe import OutputError
 
         return OutputError.create(model, data, options, noise_floor=noise_floor)
+    if method == "svf":
+        from symid.fit.timeseries.svf import StateVariableFilter
+
+        return StateVariableFilter.create(model, data, options, noise_floor=noise_floor)
     if not isinstance(data, IOData):
         raise DataError(f"method {method!r} goes through N4SID, which needs one uniformly sampled record (IOData); "
                         "for several records or non-uniform sample times use method='oe'")

@@ -24,42 +24,16 @@ from symid.fit.result import StartOutcome
 from symid.fit.timeseries.oe import OutputError
 from symid.fit.uncertainty import FisherInformation
 
-__all__ = ["ThroughBlackBox"]
+__all__ = ["JudgedOnSamples", "ThroughBlackBox"]
 
 
-class ThroughBlackBox(Estimator, FisherInformation):
-    """A black-box-route estimator whose outcomes are judged on the measured samples.
-
-    Parameters
-    ----------
-    inner : Estimator
-        The similarity estimator built on the N4SID black box.
-    samples : OutputError
-        The output-error view of the same records (cost, residuals, Fisher information, polish).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import symid as si
-    >>> a, b = si.parameters("a b", positive=True)
-    >>> model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])
-    >>> u = np.random.default_rng(0).standard_normal(400)
-    >>> io = si.simulate_io(model, [0.5, 2.0], u, dt=0.1, noise=0.02, seed=1)
-    >>> res = si.identify(model, io, method="ipopt", x0=[1.0, 1.0], identifiability_check=False)
-    >>> res.cost_kind.startswith("relative output misfit to the measured samples"), "black-box misfit" in res.message
-    (True, True)
-    """
+class JudgedOnSamples(Estimator, FisherInformation):
+    """Base of the time-series methods that do not fit the samples themselves: their cost, success, polish
+    and uncertainty come from the output-error view of the records (``self.samples``)."""
 
     cost_kind = OutputError.cost_kind
-
-    def __init__(self, inner: Estimator, samples: OutputError):
-        self.inner, self.samples = inner, samples
-        self.model, self.data = inner.model, samples.data
-        self.method = inner.method  # type: ignore[misc]
-        self.noise_floor = inner.noise_floor
-        self.options = {**inner.options,
-                        "fits": "the N4SID black box (thesis Algorithms 6.1/7.1); cost, success and uncertainty on "
-                                "the measured samples"}
+    samples: OutputError
+    route: str = ""
 
     def misfit(self, theta: np.ndarray) -> float:
         """The relative output misfit to the measured samples."""
@@ -75,13 +49,6 @@ class ThroughBlackBox(Estimator, FisherInformation):
     def n_data(self) -> int:
         """Number of measured output values."""
         return self.samples.n_data()
-
-    def run(self, x0: np.ndarray) -> StartOutcome:
-        """The route's method from ``x0``, its estimate judged on the samples."""
-        out = self.inner.run(x0)
-        return self.outcome(out.start, out.theta, finished=out.finished, status=out.status,
-                            message=f"{out.message}; black-box misfit {out.cost:.3e}", iterations=out.iterations,
-                            wall_time=out.wall_time, history=out.history)
 
     def polisher(self) -> Estimator:
         """Output error on the samples (method ``oe``)."""
@@ -105,6 +72,48 @@ class ThroughBlackBox(Estimator, FisherInformation):
         return self.samples.given_noise(noise_std)
 
     def uncertainty_note(self) -> str:
-        """The route does not minimise the sample misfit."""
-        return (f"method {self.method!r} fits the N4SID black box, not the samples: this is the covariance of the "
+        """The method does not minimise the sample misfit."""
+        return (f"method {self.method!r} fits {self.route}, not the samples: this is the covariance of the "
                 "output-error estimate, evaluated at its θ̂ (polish=True refines on the samples)")
+
+
+class ThroughBlackBox(JudgedOnSamples):
+    """A black-box-route estimator whose outcomes are judged on the measured samples.
+
+    Parameters
+    ----------
+    inner : Estimator
+        The similarity estimator built on the N4SID black box.
+    samples : OutputError
+        The output-error view of the same records (cost, residuals, Fisher information, polish).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> a, b = si.parameters("a b", positive=True)
+    >>> model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])
+    >>> u = np.random.default_rng(0).standard_normal(400)
+    >>> io = si.simulate_io(model, [0.5, 2.0], u, dt=0.1, noise=0.02, seed=1)
+    >>> res = si.identify(model, io, method="ipopt", x0=[1.0, 1.0], identifiability_check=False)
+    >>> res.cost_kind.startswith("relative output misfit to the measured samples"), "black-box misfit" in res.message
+    (True, True)
+    """
+
+    route = "the N4SID black box"
+
+    def __init__(self, inner: Estimator, samples: OutputError):
+        self.inner, self.samples = inner, samples
+        self.model, self.data = inner.model, samples.data
+        self.method = inner.method  # type: ignore[misc]
+        self.noise_floor = inner.noise_floor
+        self.options = {**inner.options,
+                        "fits": "the N4SID black box (thesis Algorithms 6.1/7.1); cost, success and uncertainty on "
+                                "the measured samples"}
+
+    def run(self, x0: np.ndarray) -> StartOutcome:
+        """The route's method from ``x0``, its estimate judged on the samples."""
+        out = self.inner.run(x0)
+        return self.outcome(out.start, out.theta, finished=out.finished, status=out.status,
+                            message=f"{out.message}; black-box misfit {out.cost:.3e}", iterations=out.iterations,
+                            wall_time=out.wall_time, history=out.history)
