@@ -234,3 +234,23 @@ def test_svf_refuses_what_it_cannot_do():
     model, short = _mck_io(n=50)
     with pytest.raises(si.OptionError, match="samples are left"):
         si.identify(model, short, method="svf", bandwidth=0.5, identifiability_check=False)
+
+
+def test_bad_time_series_input_is_named():
+    """Issue 15, Bad input: what is wrong and what would fix it."""
+    k10, k12, k21, q = si.parameters("k10 k12 k21 q", positive=True)
+    est = si.StateSpaceModel(A=[[-k10 - k12, k21], [k12, -k21]], B=[[0], [0]], C=[[q, 0]], x0="estimate")
+    five = TimeSeries([0, 1, 2, 3, 4.0], np.zeros(5), [1.0, 0.8, 0.6, 0.5, 0.4])
+    with pytest.raises(si.DataError, match=r"5 output value\(s\) for 6 unknowns .*give the initial state"):
+        si.identify(est, five, method="oe", identifiability_check=False)
+    hours = TimeSeries([0, 1, 2.0], np.zeros(3), [1.0, 0.5, 0.2], time_unit="h")
+    with pytest.raises(si.DataError, match="different units"):
+        si.identify(pk_model(), [pk_record(pk_model()), hours], method="oe", identifiability_check=False)
+    forced = si.StateSpaceModel(A=[[-k10 - k12, k21], [k12, -k21]], B=[[1], [0]], C=[[q, 0]])
+    u = np.zeros(100)
+    u[:4] = 10.0  # a short infusion: not persistently exciting
+    io = si.simulate_io(forced, TRUTH, u, dt=0.5)
+    with pytest.raises(si.DataError, match="method='oe' fits the samples directly"):
+        si.identify(forced, io, method="scr", identifiability_check=False)
+    res = si.identify(forced, io, method="oe", x0=START, identifiability_check=False)
+    np.testing.assert_allclose(res.theta_vector, [TRUTH[k] for k in forced.parameter_names], rtol=1e-6)

@@ -54,7 +54,13 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     from symid.fit.timeseries.blackbox import ThroughBlackBox
     from symid.fit.timeseries.oe import OutputError
 
-    inner = similarity_prepare(model, data, method, options, noise_floor=noise_floor)
+    try:
+        inner = similarity_prepare(model, data, method, options, noise_floor=noise_floor)
+    except DataError as exc:
+        if "persistently exciting" not in str(exc):
+            raise
+        raise DataError(f"{exc}. Method {method!r} goes through N4SID, which needs such an input; method='oe' "
+                        "fits the samples directly and does not (a single dose or step will do)") from None
     samples = OutputError(model, data)
     samples.noise_floor = noise_floor
     return ThroughBlackBox(inner, samples)

@@ -162,6 +162,14 @@ class OutputError(Estimator, FisherInformation):
         self._weights = 1.0 / (p * energy)  # per output channel: cost = Σ w_j ‖r_j‖²
         self._rms = np.sqrt(energy / sum(r.n_samples for r in self.records))
         self._estimate_x0 = self._x0_mode == "estimate"
+        values = sum(r.n_samples * r.n_outputs for r in self.records)
+        if values < self.n_unknowns():
+            x0_part = (f" and {model.n_states} initial-state value(s) per record × {len(self.records)}"
+                       if self._estimate_x0 else "")
+            raise DataError(f"the record(s) hold {values} output value(s) for {self.n_unknowns()} unknowns "
+                            f"({l} parameter(s){x0_part}): too few to fix them; use longer or more records"
+                            + (", or give the initial state (x0= numbers or an expression in θ)"
+                               if self._estimate_x0 else ""))
         self._x0_scale = np.array([max(float(np.abs(r.y).max()), 1e-300) for r in self.records])
         self._h_max = max(float(np.diff(r.t).max()) for r in self.records)
         self._solvers: dict[tuple[int, int], IpoptSolver] = {}

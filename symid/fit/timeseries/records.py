@@ -65,6 +65,10 @@ def as_records(model: Any, data: Any, *, estimate_x0: bool | None = None) -> tup
                             f"estimate its initial state of {model.n_states} values on top of θ: record longer, "
                             "or give x0 (known numbers or an expression in θ)")
         out.append(ts)
+    units = sorted({getattr(ts, "time_unit", "s") for ts in out})
+    if len(units) > 1:
+        raise DataError(f"the records' times are in different units ({', '.join(units)}): one θ has one time unit; "
+                        "rewrite the records in one unit")
     energy = sum(np.sum(ts.y**2, axis=0) for ts in out)
     zero = np.flatnonzero(energy == 0)
     if zero.size:
