@@ -350,11 +350,13 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     fitted = bool(final.success or any(s.success for s in res.starts))
     code = 0 if fitted else NO_FIT
     _say(args, res.summary(truth=truth))
+    validation = _time_series_validation(model, data, final, args)
     for name, (value, lo, hi) in outside.items():
         _say(args, f"warning: {name} = {value:.6g} lies outside its bounds [{lo:g}, {hi:g}]")
     if not fitted:
         _say(args, f"no start fitted the data (exit status {NO_FIT}); the best estimate is shown")
-    written = _write_identify(out, spec, model, data, res, truth, args) if out is not None else []
+    written = (_write_identify(out, spec, model, data, res, truth, args, validation=validation)
+               if out is not None else [])
     if args.json:
         import json
 
@@ -379,8 +381,27 @@ def _json_default(value):
     raise TypeError(f"{type(value).__name__} is not JSON serialisable")
 
 
-def _write_identify(out, entry, model, data, res, truth, args) -> list:
-    """result.json, summary.txt and the plots, each written atomically."""
+def _time_series_validation(model, data, res, args):
+    """For time series: ``si.validate`` at the estimate (simulated against measured output, residual tests),
+    printed; ``None`` for other data, or with a note when the model cannot be simulated there."""
+    from symid.errors import DataError, ModelError
+    from symid.fit.registry import data_kind
+    from symid.fit.validation import validate
+
+    if data_kind(data).name != "time series":
+        return None
+    initial = res.options.get("initial_state") if res.options.get("initial_state") == "estimate" else None
+    try:
+        v = validate(model, res.theta, data, initial_state=initial)
+    except (DataError, ModelError) as exc:
+        _say(args, f"note: no validation: {exc}")
+        return None
+    _say(args, v.summary())
+    return v
+
+
+def _write_identify(out, entry, model, data, res, truth, args, validation=None) -> list:
+    """result.json, summary.txt and the plots (and, for time series, the validation), each written atomically."""
     from symid.plots import bode_plot, start_convergence_plot
     from symid.runlog import write_atomic, write_json_atomic
 
@@ -401,6 +422,13 @@ def _write_identify(out, entry, model, data, res, truth, args) -> list:
         written.append(start_convergence_plot(
             best, out / "convergence.png", truth=None if truth is None else model.theta_vector(truth),
             title=f"{entry.name}: SCR convergence of the reported start"))
+    if validation is not None:
+        write_json_atomic(out / "validation.json", validation.to_dict(), indent=2)
+        with write_atomic(out / "validation.txt") as fh:
+            fh.write(validation.summary() + "\n")
+        written += [out / "validation.json", out / "validation.txt"]
+        written += list(validation.plot(out / "validation.png", output_units=list(entry.output_units) or None,
+                                        title=f"{entry.name}: estimate against the measured samples"))
     _say(args, "wrote " + ", ".join(str(p) for p in written))
     return written
 
@@ -547,7 +575,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "substitution=both; VALUE is a number, true/false/none, JSON, or text")
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
     p.add_argument("--out", metavar="DIR",
-                   help="write result.json, summary.txt, bode.png and (SCR) convergence.png here")
+                   help="write result.json, summary.txt, bode.png and (SCR) convergence.png here; for time series "
+                        "also validation.json, validation.txt, validation_output.png and validation_residual.png")
     p.add_argument("--json", action="store_true",
                    help="print the result as JSON on standard output (the human report goes to standard error)")
     p.set_defaults(func=_cmd_identify)
