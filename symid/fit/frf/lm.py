@@ -41,10 +41,13 @@ from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, frf_weights
 from symid.fit.options import check_bool, check_float, check_int, check_scale, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.sensitivity import frf_sensitivity
+from symid.fit.success import EXACT_FIT
 
 __all__ = ["AutoFRF", "LmFRF"]
 
 _LOG_BOX = math.log(1e6)  # |φₖ| ≤ log 1e6 for positive parameters: no estimate beyond a factor 1e6 of the start
+_EXACT_STOP = 1e-20  # a misfit at rounding level: no further pass can do better
+_EXTRA_PASSES = 3  # passes tried after a fit that is exact only at the 1e-10 level
 
 
 class _Budget(Exception):
@@ -68,6 +71,10 @@ class LmFRF(FrfEstimator):
     spread : float, optional
         Restart points are drawn log-uniformly within a factor ``spread`` of the start
         (default 10: two decades around it).
+    bands : int, optional
+        Continuation over frequency: stage 1 first fits the lowest 1/``bands`` of the
+        lines, then 2/``bands``, ..., then all of them (default 1, no continuation, for
+        ``"lm"``; 8 for ``"auto"``).
     max_nfev : int, optional
         Function evaluations per stage of a pass (default 300).
     tol : float, optional
@@ -99,11 +106,12 @@ class LmFRF(FrfEstimator):
 
     method: ClassVar[str] = "lm"
     default_restarts: ClassVar[int] = 0
+    default_bands: ClassVar[int] = 1
     default_time_limit: ClassVar[float | None] = None
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, restarts: int | None = None,
                  spread: float = 10.0, max_nfev: int = 300, tol: float = 1e-12, time_limit: float | None = None,
-                 seed: int = 0, variance: Any = "data", verbose: bool = False,
+                 bands: int | None = None, seed: int = 0, variance: Any = "data", verbose: bool = False,
                  callback: Callable[[int, dict[str, Any]], Any] | None = None):
         self.model, self.data = model, data
         l = model.n_parameters
@@ -111,6 +119,7 @@ class LmFRF(FrfEstimator):
         restarts = self.default_restarts if restarts is None else check_int("restarts", restarts, low=0,
                                                                             high=10**6)
         spread = check_float("spread", spread, low=1.0)
+        bands = self.default_bands if bands is None else check_int("bands", bands, low=1, high=10**4)
         max_nfev = check_int("max_nfev", max_nfev, low=1, high=10**7)
         tol = check_float("tol", tol, low=0, strict_low=True)
         if time_limit is None:
@@ -123,6 +132,7 @@ class LmFRF(FrfEstimator):
         self.line_weights = frf_weights(data, variance)
         self.callback = callback
         self.options = {"scale": None if self.scale is None else self.scale.tolist(), "restarts": restarts,
+                        "bands": bands,
                         "spread": spread, "max_nfev": max_nfev, "tol": tol, "time_limit": time_limit, "seed": seed,
                         "variance": "given" if not isinstance(variance, str) and variance is not None else variance,
                         "verbose": verbose}
@@ -153,9 +163,11 @@ class LmFRF(FrfEstimator):
                         unit)
 
     # -- one pass ---------------------------------------------------------------------------------
-    def _residual(self, kind: str, centre: np.ndarray, unit: np.ndarray, deadline: float | None
+    def _residual(self, kind: str, centre: np.ndarray, unit: np.ndarray, deadline: float | None, lines: int
                   ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
-        H, mask = self._H, self._mask
+        """Residual and Jacobian in φ of criterion ``kind`` over the first ``lines`` frequencies."""
+        H, mask = self._H[:lines], self._mask[:lines]
+        logH, sqrtw, w = self._logH[:lines], self._sqrtw[:lines], self._w[:lines]
         big = 1e3 * math.sqrt(H.size)
 
         def fun(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -164,7 +176,7 @@ class LmFRF(FrfEstimator):
             th = self._theta(phi, centre, unit)
             try:
                 with np.errstate(all="ignore"):
-                    Hm, dH = frf_sensitivity(self.model, th, self._w)
+                    Hm, dH = frf_sensitivity(self.model, th, w)
             except (ModelError, np.linalg.LinAlgError):
                 Hm = None
             if Hm is None or not (np.all(np.isfinite(Hm)) and np.all(np.isfinite(dH))):
@@ -175,17 +187,17 @@ class LmFRF(FrfEstimator):
                 ok = mask & (np.abs(Hm) > 0)
                 with np.errstate(all="ignore"):
                     if kind == "log":
-                        r = np.where(ok, np.log(np.where(ok, Hm, 1.0)) - self._logH, 0.0)
+                        r = np.where(ok, np.log(np.where(ok, Hm, 1.0)) - logH, 0.0)
                         J = np.where(ok[..., None], dH / np.where(ok, Hm, 1.0)[..., None], 0.0)
                     else:
                         absH = np.where(mask, np.abs(H), 1.0)
                         r = np.where(mask, (Hm - H) / absH, 0.0)
                         J = np.where(mask[..., None], dH / absH[..., None], 0.0)
-                r = r * self._sqrtw
-                J = J * self._sqrtw[..., None]
+                r = r * sqrtw
+                J = J * sqrtw[..., None]
             else:
-                r = self._sqrtw * (Hm - H) / self._hnorm
-                J = dH * (self._sqrtw / self._hnorm)[..., None]
+                r = sqrtw * (Hm - H) / self._hnorm
+                J = dH * (sqrtw / self._hnorm)[..., None]
             r = r.ravel()
             J = J.reshape(-1, phi.size)
             out_r = np.concatenate([r.real, r.imag])
@@ -197,9 +209,9 @@ class LmFRF(FrfEstimator):
 
         return fun
 
-    def _stage(self, kind: str, phi: np.ndarray, centre: np.ndarray, unit: np.ndarray, deadline: float | None
-               ) -> tuple[np.ndarray, int]:
-        fun = self._residual(kind, centre, unit, deadline)
+    def _stage(self, kind: str, phi: np.ndarray, centre: np.ndarray, unit: np.ndarray, deadline: float | None,
+               lines: int | None = None) -> tuple[np.ndarray, int]:
+        fun = self._residual(kind, centre, unit, deadline, self._w.size if lines is None else lines)
         memo: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
         def value(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -224,7 +236,12 @@ class LmFRF(FrfEstimator):
         """Stage 1 (log H, then the relative error of each line) and stage 2 (the judged criterion);
         (θ, evaluations, budget spent)."""
         nfev = 0
+        s = self._w.size
+        bands = self.options["bands"]
         try:
+            for b in range(1, bands):  # the log criterion on a growing band of the lowest frequencies
+                phi, k = self._stage("log", phi, centre, unit, deadline, max(3, math.ceil(b * s / bands)))
+                nfev += k
             for kind in ("log", "rel", "abs"):
                 phi, k = self._stage(kind, phi, centre, unit, deadline)
                 nfev += k
@@ -249,6 +266,7 @@ class LmFRF(FrfEstimator):
         status = "max_restarts"
         passes = 0
         phi = np.zeros(x0.size)
+        first_fit = opts["restarts"] + 1
         for k in range(opts["restarts"] + 1):
             if k > 0:
                 if deadline is not None and time.perf_counter() >= deadline:
@@ -272,12 +290,20 @@ class LmFRF(FrfEstimator):
                 status = "stopped"
                 break
             if best.success:
-                status = "fits"
-                break
+                # an exact fit only at the 1e-10 level on data that look noise-free can be a near-solution
+                # in a sloppy direction (measured: chains of 5 masses, misfit 4e-15 at 47 % parameter error):
+                # a few more passes look for a fit to rounding before settling for it
+                loose = _EXACT_STOP < best.cost <= EXACT_FIT
+                if not loose or k >= first_fit + _EXTRA_PASSES:
+                    status = "fits"
+                    break
+                first_fit = min(first_fit, k)
             if spent:
                 status = "time_limit"
                 break
         assert best is not None
+        if status == "max_restarts" and best.success:
+            status = "fits"
         wall = time.perf_counter() - t0
         what = {"fits": f"a fit after {passes} pass(es)",
                 "max_restarts": f"no fit in {passes} pass(es) (restarts={opts['restarts']})",
@@ -301,6 +327,7 @@ class AutoFRF(LmFRF):
                                             "the start until the estimate fits.")
     method: ClassVar[str] = "auto"
     default_restarts: ClassVar[int] = 30
+    default_bands: ClassVar[int] = 8
     default_time_limit: ClassVar[float | None] = 120.0
 
 
