@@ -41,7 +41,9 @@ The analysis
    band and two residual terms, one below and one above it, that stand for the modes
    outside the band; 24 parameters, kᵣ = ωᵣ² and vᵣ = 2ζᵣωᵣ declared positive.
 3. The fit: ``si.identify(model, frf, method=..., starts=..., seed=0)`` with the
-   library's own starts (no start computed here), IPOPT and SCR routes side by side.
+   library's own starts (no start computed here), side by side: ``"auto"``
+   (Levenberg–Marquardt on log-parameters with restarts), ``"ipopt"`` and SCR followed
+   by an IPOPT polish; each start within ``--time-limit`` seconds.
 4. Validation on the other record: the model's steady-state response to the
    validation force is computed line by line, Ŷ(ωₖ) = H(jωₖ, θ̂) U(ωₖ), on the DFT lines
    of the two steady-state periods in 2–15 Hz, and compared with the measured
@@ -201,14 +203,15 @@ def validation_fit(model: Any, theta: Any, val: dict[str, np.ndarray]) -> tuple[
     return float(fit), y, y_hat
 
 
-def fit_routes(model: Any, frf: si.FrequencyData, *, starts: int, time_limit: float, scr: bool
+ROUTES = {"auto": {"method": "auto"}, "ipopt": {"method": "ipopt"}, "scr+polish": {"method": "scr", "polish": True}}
+
+
+def fit_routes(model: Any, frf: si.FrequencyData, *, methods: list[str], starts: int, time_limit: float
                ) -> dict[str, Any]:
-    """IPOPT and (optionally) SCR with the library's starts; each result kept with its wall time."""
+    """The chosen routes with the library's starts; each result kept with its wall time."""
     routes: dict[str, Any] = {}
-    plans = [("ipopt", {"method": "ipopt"})]
-    if scr:
-        plans.append(("scr+polish", {"method": "scr", "polish": True}))
-    for name, kw in plans:
+    for name in methods:
+        kw = ROUTES[name]
         t0 = time.perf_counter()
         res = si.identify(model, frf, starts=starts, seed=0, time_limit=time_limit, identifiability_check=False,
                           **kw)
@@ -258,7 +261,9 @@ def plots(out: Path, parts: dict[str, Any], model: Any, theta: Any, y: np.ndarra
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", help="folder holding the two F-16 .mat files (default: $SYMID_F16_DATA)")
-    ap.add_argument("--quick", action="store_true", help="the committed subset, one IPOPT start, no SCR")
+    ap.add_argument("--quick", action="store_true", help="the committed subset, one start of 'auto' only")
+    ap.add_argument("--methods", default=None,
+                    help=f"routes, comma-separated, of {', '.join(ROUTES)} (default all; --quick auto)")
     ap.add_argument("--make-subset", action="store_true", help="rewrite examples/data/f16_subset.npz and stop")
     ap.add_argument("--starts", type=int, default=None, help="starts per route (default 5; --quick 1)")
     ap.add_argument("--time-limit", type=float, default=None, help="seconds per start (default 120; --quick 10)")
@@ -283,7 +288,11 @@ def main(argv: list[str] | None = None) -> int:
     model = modal_model()
     starts = args.starts or (1 if args.quick else 5)
     limit = args.time_limit or (10.0 if args.quick else 120.0)
-    routes = fit_routes(model, frf, starts=starts, time_limit=limit, scr=not args.quick)
+    methods = (args.methods or ("auto" if args.quick else ",".join(ROUTES))).split(",")
+    unknown = [m for m in methods if m not in ROUTES]
+    if unknown:
+        ap.error(f"unknown route(s) {', '.join(unknown)}; choose from {', '.join(ROUTES)}")
+    routes = fit_routes(model, frf, methods=methods, starts=starts, time_limit=limit)
     best_name, best = None, None
     for name, r in routes.items():
         res = r["result"]
