@@ -118,3 +118,16 @@ def test_combinations_do_not_wait_for_the_groebner_basis(monkeypatch):
     exprs = {c["expression"] for c in rep.combinations}
     assert {"theta2*theta4", "theta1 + theta2 + theta3 + theta4"} <= exprs
     assert all(c["global"] in (True, None) for c in rep.combinations)
+
+
+def test_square_free_test_is_exact():
+    # the quotient algebra's radical test: square-free modulo a prime proves square-free over ℚ;
+    # a repeated root is never missed (here one that only a prime dividing a denominator could hide)
+    from symid.structural.global_ import _square_free
+
+    x = sp.Symbol("x")
+    p = 2**31 - 1
+    assert _square_free(sp.Poly((x - sp.Rational(1, 3)) * (x + 2) * (x - 5), x), x)
+    assert not _square_free(sp.Poly((x - sp.Rational(1, 3)) ** 2 * (x + 2), x), x)
+    assert not _square_free(sp.Poly((x - sp.Rational(1, p)) ** 2 * (x - 1), x), x)  # falls back to ℚ
+    assert _square_free(sp.Poly((x - sp.Rational(1, p)) * (x - sp.Rational(2, p)), x), x)

@@ -301,6 +301,25 @@ def _charpoly_expr(M: DomainMatrix, x: sp.Symbol) -> sp.Poly:
     return sp.Poly([QQ.to_sympy(c) for c in coeffs], x, domain="QQ")
 
 
+def _square_free(cp: sp.Poly, x: sp.Symbol) -> bool:
+    """Whether a monic rational polynomial is square-free: modulo a prime first (sufficient), else exactly.
+
+    A repeated factor over ℚ stays repeated modulo any prime that divides no
+    denominator (the polynomial is monic, so its degree is kept): square-free modulo
+    such a prime proves square-free over ℚ.
+    """
+    for prime in (2**31 - 1, 2**31 - 19):
+        F = sp.GF(prime)
+        try:
+            coeffs = [F(int(c.p)) / F(int(c.q)) for c in cp.all_coeffs()]
+        except ZeroDivisionError:
+            continue
+        fp = sp.Poly([F.to_sympy(c) for c in coeffs], x, modulus=prime)
+        if fp.degree() == cp.degree() and fp.gcd(fp.diff(x)).degree() == 0:
+            return True
+    return sp.degree(sp.gcd(cp, cp.diff(x)), x) == 0
+
+
 def _in_radical(G, R: PolyRing, f: PolyElement) -> bool:
     if f.rem(G) == R.zero:
         return True
@@ -583,7 +602,7 @@ def _solve_numeric(mm: dict[int, DomainMatrix], theta_idx, rng: random.Random, x
         r = [rng.randint(1, 10**6) for _ in range(nv)]
         Ml = sum((mm[v] * QQ(r[v]) for v in range(1, nv)), mm[0] * QQ(r[0]))
         cp = _charpoly_expr(Ml, x)
-        if cp.degree() == D and sp.degree(sp.gcd(cp, cp.diff(x)), x) == 0:
+        if cp.degree() == D and _square_free(cp, x):
             break
     else:  # three random forms (coefficients up to 1e6) fail to separate only at a multiple solution
         raise NonGenericPoint(f"{D} solutions counted with multiplicity, and no linear form separates them: "
