@@ -310,10 +310,9 @@ def _square_free(cp: sp.Poly, x: sp.Symbol) -> bool:
     """
     for prime in (2**31 - 1, 2**31 - 19):
         F = sp.GF(prime)
-        try:
-            coeffs = [F(int(c.p)) / F(int(c.q)) for c in cp.all_coeffs()]
-        except ZeroDivisionError:
-            continue
+        if any(int(c.q) % prime == 0 for c in cp.all_coeffs()):
+            continue  # the prime divides a denominator: the reduction says nothing
+        coeffs = [F(int(c.p)) / F(int(c.q)) for c in cp.all_coeffs()]
         fp = sp.Poly([F.to_sympy(c) for c in coeffs], x, modulus=prime)
         if fp.degree() == cp.degree() and fp.gcd(fp.diff(x)).degree() == 0:
             return True
