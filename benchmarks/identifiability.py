@@ -117,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
             verdict = f"{r['verdict']} (proven by witnesses)"
             k = f">={r['n_solutions_at_least']}"
         else:
-            verdict = f"{r['verdict']} (global undetermined)"
+            verdict = r["verdict"] if "undetermined" in r["verdict"] else f"{r['verdict']} (global undetermined)"
             k = f"~>={1 + r['n_witnesses']}" if r["n_witnesses"] else "?"
         ok = "yes" if r["wall_s"] < TARGET_S else "NO"
         label = f"{r['model']} (exact_count)" if r["exact_count"] else r["model"]

@@ -1,8 +1,11 @@
 """Structural identifiability of linear grey-box models (thesis §1-2, §6-6).
 
 ``identifiability(model)`` answers, before any estimation, which parameters can be
-recovered from noise-free input-output data: per parameter "global", "local" or
-"none", the number of solutions, identifiable combinations and a reparameterisation.
+recovered from noise-free input-output data: per parameter "global", "local" (proven
+not global), "local, global undetermined" or "none", the number of solutions,
+identifiable combinations and a reparameterisation. The random point θ* is checked to
+be generic and global claims are confirmed at a second point; the report is a
+deterministic function of the model, the options and the seed.
 
 Modules: :mod:`~symid.structural.summary` (exhaustive summary),
 :mod:`~symid.structural.local` (exact Jacobian rank),
