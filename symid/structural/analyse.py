@@ -272,7 +272,7 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
     else:
         if out.limit is not None:
             why = out.limit
-        elif n_cert and not args.exact_count:
+        elif out.proven_by_witnesses and not args.exact_count:
             why = "the Gröbner basis was stopped once certified solutions settled the verdicts; exact_count=True " \
                   "keeps it running until the timeout"
         elif n_cert:
