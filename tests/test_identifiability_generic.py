@@ -131,3 +131,15 @@ def test_square_free_test_is_exact():
     assert not _square_free(sp.Poly((x - sp.Rational(1, 3)) ** 2 * (x + 2), x), x)
     assert not _square_free(sp.Poly((x - sp.Rational(1, p)) ** 2 * (x - 1), x), x)  # falls back to ℚ
     assert _square_free(sp.Poly((x - sp.Rational(1, p)) * (x - sp.Rational(2, p)), x), x)
+
+
+def test_partial_witnesses_prove_local_only_for_the_parameters_they_move(monkeypatch):
+    # the Gröbner step made to hang: the certified witness (a2 + a21, a1 − a21, a21) moves a1 and a2,
+    # which are then proven "local"; a21 (global in truth) is never moved, so it stays undetermined and
+    # the Gröbner step keeps its budget
+    monkeypatch.setattr("symid.structural.steps.generic_global", lambda *args, **kwargs: time.sleep(600))
+    rep = si.identifiability(_two_compartments(), timeout=2.0)
+    assert not rep.global_determined and rep.verdict == "local"
+    assert rep.verdicts == {"a2": "local", "a21": "local, global undetermined", "a1": "local"}
+    assert rep.n_solutions_at_least == 2 and not rep.verdicts_proven
+    assert "did not finish within the timeout of 2 s" in rep.global_status
