@@ -45,6 +45,7 @@ import sympy as sp
 from sympy import QQ
 from sympy.polys.groebnertools import groebner
 from sympy.polys.matrices import DomainMatrix
+from sympy.polys.polyerrors import NotInvertible
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
 from symid.errors import ModelError, SolverError
@@ -403,10 +404,17 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
     names = [p.name for p in params]
     theta2 = {n: str(v) for n, v in zip(names, star, strict=True)}
     pt = [QQ.from_sympy(v) for v in star]
-    modulus = _mod_p_modulus(rng)
-    R, eqs, _ = _system(summ, params, pt, modulus)
-    dom = R.domain
-    ptp = [dom(int(v.numerator)) / dom(int(v.denominator)) for v in pt]
+    for _ in range(10):  # a prime that divides a denominator of the system cannot reduce it: take another
+        modulus = _mod_p_modulus(rng)
+        try:
+            R, eqs, _ = _system(summ, params, pt, modulus)
+            dom = R.domain
+            ptp = [dom(int(v.numerator)) / dom(int(v.denominator)) for v in pt]
+            break
+        except (ZeroDivisionError, NotInvertible):
+            continue
+    else:  # pragma: no cover - ten random 31-bit primes dividing the denominators: practically impossible
+        raise ExactStepLimit("no prime found that reduces the system at θ**")
     G = groebner(eqs, R)
     nv = R.ngens
     if not _is_zero_dimensional(G, nv):
