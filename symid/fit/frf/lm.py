@@ -76,7 +76,8 @@ class LmFRF(FrfEstimator):
         lines, then 2/``bands``, ..., then all of them (default 1, no continuation, for
         ``"lm"``; 8 for ``"auto"``).
     max_nfev : int, optional
-        Function evaluations per stage of a pass (default 300).
+        Function evaluations per stage of a pass (default 300; ten times that for the
+        last stage, the judged criterion).
     tol : float, optional
         Relative tolerance on the criterion and the step (SciPy's ``ftol``, ``xtol``;
         default 1e-12).
@@ -139,7 +140,6 @@ class LmFRF(FrfEstimator):
         H = np.asarray(data.H)
         self._H = H
         self._mask = np.abs(H) > 0
-        self._logH = np.log(np.where(self._mask, H, 1.0))
         wts = np.ones(H.shape) if self.line_weights is None else self.line_weights
         self._sqrtw = np.sqrt(wts)
         self._hnorm = float(np.sqrt(np.sum(wts * np.abs(H) ** 2)))
@@ -167,7 +167,7 @@ class LmFRF(FrfEstimator):
                   ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
         """Residual and Jacobian in φ of criterion ``kind`` over the first ``lines`` frequencies."""
         H, mask = self._H[:lines], self._mask[:lines]
-        logH, sqrtw, w = self._logH[:lines], self._sqrtw[:lines], self._w[:lines]
+        sqrtw, w = self._sqrtw[:lines], self._w[:lines]
         big = 1e3 * math.sqrt(H.size)
 
         def fun(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -186,8 +186,8 @@ class LmFRF(FrfEstimator):
             if kind in ("log", "rel"):
                 ok = mask & (np.abs(Hm) > 0)
                 with np.errstate(all="ignore"):
-                    if kind == "log":
-                        r = np.where(ok, np.log(np.where(ok, Hm, 1.0)) - logH, 0.0)
+                    if kind == "log":  # log(Hm / H): the phase error wrapped to (−π, π], never 2π off
+                        r = np.where(ok, np.log(np.where(ok, Hm, 1.0) / np.where(mask, H, 1.0)), 0.0)
                         J = np.where(ok[..., None], dH / np.where(ok, Hm, 1.0)[..., None], 0.0)
                     else:
                         absH = np.where(mask, np.abs(H), 1.0)
@@ -224,8 +224,11 @@ class LmFRF(FrfEstimator):
         # stage 1 only has to bring the estimate into the basin: a looser tolerance (measured: the
         # tight one spends most passes' time creeping along the log criterion)
         tol = max(self.options["tol"], 1e-8) if kind == "log" else self.options["tol"]
+        # the judged criterion gets ten times the evaluations: on noisy data of a sloppy model its minimum
+        # lies at the end of a long valley (measured: 250-850 evaluations on a 2-mass chain at 1 % noise)
+        nfev = self.options["max_nfev"] * (10 if kind == "abs" else 1)
         sol = least_squares(lambda p: value(p)[0], phi, jac=lambda p: value(p)[1], method="trf", x_scale=1.0,
-                            max_nfev=self.options["max_nfev"], ftol=tol, xtol=tol, gtol=min(tol, 1e-10))
+                            max_nfev=nfev, ftol=tol, xtol=tol, gtol=min(tol, 1e-10))
         return self._clip(sol.x), int(sol.nfev)
 
     def _clip(self, phi: np.ndarray) -> np.ndarray:
