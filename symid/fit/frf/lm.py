@@ -48,6 +48,8 @@ __all__ = ["AutoFRF", "LmFRF"]
 _LOG_BOX = math.log(1e6)  # |φₖ| ≤ log 1e6 for positive parameters: no estimate beyond a factor 1e6 of the start
 _EXACT_STOP = 1e-20  # a misfit at rounding level: no further pass can do better
 _EXTRA_PASSES = 3  # passes tried after a fit that is exact only at the 1e-10 level
+_PRIOR = 0.1  # weight of φ − φ_pass-start in the band stages: what a partial band cannot see stays put
+_REPEATS = 3  # restarts stop once this many passes have ended at the best misfit (to 1e-6): a confirmed minimum
 
 
 class _Budget(Exception):
@@ -210,15 +212,20 @@ class LmFRF(FrfEstimator):
         return fun
 
     def _stage(self, kind: str, phi: np.ndarray, centre: np.ndarray, unit: np.ndarray, deadline: float | None,
-               lines: int | None = None) -> tuple[np.ndarray, int]:
+               lines: int | None = None, anchor: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+        """One least-squares stage from φ; with ``anchor``, plus the prior term _PRIOR·(φ − anchor)."""
         fun = self._residual(kind, centre, unit, deadline, self._w.size if lines is None else lines)
         memo: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        eye = _PRIOR * np.eye(phi.size)
 
         def value(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             key = p.tobytes()
             if key not in memo:
                 memo.clear()
-                memo[key] = fun(p)
+                r, J = fun(p)
+                if anchor is not None:
+                    r, J = np.concatenate([r, _PRIOR * (p - anchor)]), np.vstack([J, eye])
+                memo[key] = (r, J)
             return memo[key]
 
         # stage 1 only has to bring the estimate into the basin: a looser tolerance (measured: the
@@ -242,8 +249,9 @@ class LmFRF(FrfEstimator):
         s = self._w.size
         bands = self.options["bands"]
         try:
+            anchor = phi.copy()
             for b in range(1, bands):  # the log criterion on a growing band of the lowest frequencies
-                phi, k = self._stage("log", phi, centre, unit, deadline, max(3, math.ceil(b * s / bands)))
+                phi, k = self._stage("log", phi, centre, unit, deadline, max(3, math.ceil(b * s / bands)), anchor)
                 nfev += k
             for kind in ("log", "rel", "abs"):
                 phi, k = self._stage(kind, phi, centre, unit, deadline)
@@ -270,6 +278,7 @@ class LmFRF(FrfEstimator):
         passes = 0
         phi = np.zeros(x0.size)
         first_fit = opts["restarts"] + 1
+        repeats = 0
         for k in range(opts["restarts"] + 1):
             if k > 0:
                 if deadline is not None and time.perf_counter() >= deadline:
@@ -282,8 +291,12 @@ class LmFRF(FrfEstimator):
             passes += 1
             cand = self.outcome(x0, theta, finished=not spent, status="time_limit" if spent else "converged",
                                 message="", iterations=total_nfev, wall_time=time.perf_counter() - t0)
-            if best is None or cand.cost < best.cost:
-                best = cand
+            if best is None or cand.cost < best.cost * (1 - 1e-6):
+                best, repeats = cand, 1
+            elif cand.cost <= best.cost * (1 + 1e-6):
+                repeats += 1
+                if cand.cost < best.cost:
+                    best = cand
             info = {"theta": dict(zip(self.model.parameter_names, theta.tolist(), strict=True)), "misfit": cand.cost,
                     "fits": cand.success, "elapsed": time.perf_counter() - t0}
             if opts["verbose"]:
@@ -304,6 +317,9 @@ class LmFRF(FrfEstimator):
             if spent:
                 status = "time_limit"
                 break
+            if repeats >= _REPEATS:  # the same minimum from several points: no restart is likely to beat it
+                status = "repeated"
+                break
         assert best is not None
         if status == "max_restarts" and best.success:
             status = "fits"
@@ -311,7 +327,8 @@ class LmFRF(FrfEstimator):
         what = {"fits": f"a fit after {passes} pass(es)",
                 "max_restarts": f"no fit in {passes} pass(es) (restarts={opts['restarts']})",
                 "time_limit": f"time limit of {limit:g} s reached after {passes} pass(es)" if limit else "",
-                "stopped": f"stopped by the callback after {passes} pass(es)"}[status]
+                "stopped": f"stopped by the callback after {passes} pass(es)",
+                "repeated": f"{_REPEATS} of {passes} passes ended at the same best misfit"}[status]
         return self.outcome(x0, best.theta, finished=status != "time_limit" or best.success, status=status,
                             message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}",
                             iterations=total_nfev, wall_time=wall)
