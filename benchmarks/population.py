@@ -161,31 +161,36 @@ def summarise(log: RunLog) -> dict[str, Any]:
         name, noise_key, kind, method, what = parts
         prob = problems[name]
         cell = cells[(prob["cls"], method, noise_key, kind)]
+        by_size = cells[(f"n={prob['n']}", method, noise_key, kind)]
         if what == "setup":
             cell["setup"] += float(rec.get("setup_time", 0.0))
+            by_size["setup"] += float(rec.get("setup_time", 0.0))
             continue
         globally = bool(prob["info"].get("global", False))
         model_positive = np.asarray([True] * prob["n_parameters"])  # every generated parameter is declared positive
         ref = None if noise_key == "noise0" else refs.get((name, noise_key))
         ok = start_success(rec.get("theta"), rec.get("cost"), np.asarray(prob["truth"]), model_positive, globally,
                            ref)
-        cell["starts"] += 1
-        cell["success"] += int(ok)
-        cell["times"].append(float(rec["wall_time"]))
-        cell["problems"].add(name)
-    rows = []
+        for c in (cell, by_size):
+            c["starts"] += 1
+            c["success"] += int(ok)
+            c["times"].append(float(rec["wall_time"]))
+            c["problems"].add(name)
+    rows, size_rows = [], []
     for (cls, method, noise_key, kind), c in sorted(cells.items()):
+        if not c["starts"]:  # a method set up whose starts have not finished yet
+            continue
         total = c["setup"] + sum(c["times"])
-        rows.append({"class": cls, "method": method, "noise": float(noise_key.removeprefix("noise")),
-                     "starts_kind": kind,
-                     "problems": len(c["problems"]), "starts": c["starts"], "successes": c["success"],
-                     "success_rate": c["success"] / c["starts"] if c["starts"] else None,
-                     "median_time": float(np.median(c["times"])) if c["times"] else None,
-                     "time_to_solution": total / c["success"] if c["success"] else None})
+        row = {"class": cls, "method": method, "noise": float(noise_key.removeprefix("noise")), "starts_kind": kind,
+               "problems": len(c["problems"]), "starts": c["starts"], "successes": c["success"],
+               "success_rate": c["success"] / c["starts"], "median_time": float(np.median(c["times"])),
+               "time_to_solution": total / c["success"] if c["success"] else None}
+        (size_rows if cls.startswith("n=") else rows).append(row)
     sizes = defaultdict(set)
     for prob in problems.values():
         sizes[prob["cls"]].add(int(prob["n"]))
-    return {"rows": rows, "problems": len(problems), "sizes": {k: sorted(v) for k, v in sizes.items()}}
+    return {"rows": rows, "size_rows": size_rows, "problems": len(problems),
+            "sizes": {k: sorted(v) for k, v in sizes.items()}}
 
 
 def _git_commit() -> str:
@@ -199,7 +204,7 @@ def _git_commit() -> str:
 def print_table(summary: dict[str, Any]) -> None:
     head = ("class", "method", "noise", "starts", "problems", "success", "median s/start", "time to solution s")
     print(" | ".join(head))
-    for r in summary["rows"]:
+    for r in [*summary["rows"], *summary["size_rows"]]:
         rate = "—" if r["success_rate"] is None else f"{r['successes']}/{r['starts']} ({100 * r['success_rate']:.0f} %)"
         med = "—" if r["median_time"] is None else f"{r['median_time']:.3g}"
         tts = "inf" if r["time_to_solution"] is None else f"{r['time_to_solution']:.3g}"

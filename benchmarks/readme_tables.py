@@ -167,7 +167,41 @@ def n4sid_oversampling_table(doc: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def population_table(doc: dict) -> str:
+    """benchmarks/population.py: per class (then per size) × method, successes per noise level and kind of
+    start, and the time figures of the uninformed noise-free starts."""
+    cols = [(0.0, "informed"), (0.0, "uninformed"), (0.01, "informed"), (0.01, "uninformed")]
+    head = ["| class | method | exact, informed | exact, uninformed | 1 %, informed | 1 %, uninformed | "
+            "median s/start (exact, uninf.) | time to solution s (exact, uninf.) |",
+            "|---|---|---|---|---|---|---|---|"]
+
+    def block(rows: list[dict]) -> list[str]:
+        out = []
+        index = {(r["class"], r["method"], r["noise"], r["starts_kind"]): r for r in rows}
+        keys = sorted({(r["class"], r["method"]) for r in rows},
+                      key=lambda k: (k[0].startswith("n=") and int(k[0][2:]), k[0], k[1]))
+        last = None
+        for cls, method in keys:
+            cells = []
+            for noise, kind in cols:
+                r = index.get((cls, method, noise, kind))
+                cells.append("—" if r is None else f"{r['successes']}/{r['starts']}")
+            r = index.get((cls, method, 0.0, "uninformed"))
+            med = "—" if r is None or r["median_time"] is None else f"{r['median_time']:.3g}"
+            tts = "—" if r is None else ("∞" if r["time_to_solution"] is None else f"{r['time_to_solution']:.3g}")
+            out.append(f"| {cls if cls != last else ''} | {method} | " + " | ".join(cells) + f" | {med} | {tts} |")
+            last = cls
+        return out
+
+    lines = [*head, *block(doc["rows"]), "", "By size (masses, states or compartments; every class):", "", *head,
+             *block(doc["size_rows"])]
+    sizes = "; ".join(f"{k} {', '.join(map(str, v))}" for k, v in sorted(doc["sizes"].items()))
+    lines.append(f"\n{doc['problems']} problems (sizes: {sizes}); code {doc['commit']}.")
+    return "\n".join(lines) + "\n"
+
+
 TABLES: dict[str, Callable[[dict], str]] = {
+    "benchmarks/results/population.json": population_table,
     "benchmarks/results/n4sid_oversampling.json": n4sid_oversampling_table,
     "benchmarks/results/psd.json": psd_table,
     "benchmarks/results/similarity_study.json": similarity_table,
