@@ -242,6 +242,7 @@ def make_problem(cls: str, n: int, index: int, *, seed: int = 0, check: bool = T
     if cls not in CLASSES:
         raise ValueError(f"unknown class {cls!r}; choose among {', '.join(CLASSES)}")
     draws = range(max_draws) if draw is None else (int(draw),)
+    refused: list[str] = []
     for draw in draws:
         rng = np.random.default_rng([seed, CLASSES.index(cls), n, index, draw])
         model, truth, typical, info = _draw(cls, n, rng)
@@ -255,8 +256,10 @@ def make_problem(cls: str, n: int, index: int, *, seed: int = 0, check: bool = T
             # globally identifiable: every parameter proven global (never assumed from an undetermined step)
             info["global"] = bool(rep.global_determined) and all(str(v) == "global" for v in rep.verdicts.values())
             if any(str(v) == "none" for v in rep.verdicts.values()):
-                info.setdefault("refused", []).append(rep.verdict)
+                refused.append(rep.verdict)
                 continue
+        if refused:
+            info["refused"] = refused
         w = _grid(model, truth)
         return Problem(name=f"{cls}-n{n}-{index}", cls=cls, model=model, truth=truth, typical=typical, w=w,
                        n_size=n, info=info)

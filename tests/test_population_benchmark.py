@@ -1,0 +1,98 @@
+"""benchmarks/population.py and its generator (issue 14, item 1): identifiable problems only, the starts and
+the success rule as documented, a run that resumes from its log and summarises it."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import symid as si
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+
+
+@pytest.fixture(scope="module")
+def bench():
+    sys.path.insert(0, str(BENCH))
+    try:
+        yield importlib.import_module("population_models"), importlib.import_module("population")
+    finally:
+        sys.path.remove(str(BENCH))
+
+
+@pytest.mark.parametrize("cls", ["chain", "chain_sensors", "gains", "state_space", "compartment"])
+def test_generated_problems_are_checked_and_physical(bench, cls):
+    pm, _ = bench
+    p = pm.make_problem(cls, 2, 0, timeout=20)
+    assert "none" not in p.info["verdicts"].values()
+    assert np.all(p.truth > 0) and all(p.model.positive)
+    # the grid covers every mode: from 0.3x the slowest to 3x the fastest |λ| of the true model
+    lam = np.abs(np.linalg.eigvals(p.model.state_space(p.truth).A))
+    assert p.w[0] <= lam[lam > 0].min() and p.w[-1] >= lam.max()
+    # rebuilt from its draw without checking again: the same problem
+    q = pm.make_problem(cls, 2, 0, check=False, draw=p.info["draw"])
+    np.testing.assert_array_equal(q.truth, p.truth)
+
+
+def test_a_draw_the_identifiability_check_rejects_is_drawn_again(bench, monkeypatch):
+    pm, _ = bench
+    real = pm._draw
+    calls = []
+
+    def fake(cls, n, rng):
+        calls.append(1)
+        if len(calls) == 1:  # m1 and m2 only ever appear as their sum: neither is identifiable
+            m1, m2, k = si.parameters("m1 m2 k", positive=True)
+            model = si.SecondOrderModel(M=[[m1 + m2]], V=[[1]], K=[[k]], B=[[1]], C=[[1]])
+            return model, np.array([1.0, 2.0, 3.0]), np.ones(3), {}
+        return real(cls, n, rng)
+
+    monkeypatch.setattr(pm, "_draw", fake)
+    p = pm.make_problem("chain", 2, 0, timeout=20)
+    assert p.info["draw"] == 1 and p.info["refused"] == ["none"]
+
+
+def test_starts_are_where_the_docstring_says(bench):
+    pm, _ = bench
+    p = pm.make_problem("gains", 3, 0, check=False)
+    inf, uninf = p.starts("informed", 50), p.starts("uninformed", 50)
+    assert np.all(np.abs(np.log(inf / p.truth)) <= np.log(3) + 1e-12)
+    assert np.all(np.abs(np.log10(uninf / p.typical)) <= 1 + 1e-12)
+    with pytest.raises(ValueError, match="informed"):
+        p.starts("clever", 1)
+
+
+def test_success_rule(bench):
+    _, pop = bench
+    truth, pos = np.array([1.0, 2.0]), np.array([True, True])
+    assert pop.start_success([1.0, 2.0005], 1e-20, truth, pos, True, None)  # 2e-4 relative error
+    assert not pop.start_success([1.5, 0.5], 1e-20, truth, pos, True, None)  # another solution, but global
+    assert pop.start_success([1.5, 0.5], 1e-20, truth, pos, False, None)  # an admissible other solution
+    assert not pop.start_success([1.5, -0.5], 1e-20, truth, pos, False, None)  # not admissible
+    assert not pop.start_success(None, None, truth, pos, False, None)
+    ref = {"error": 0.01, "cost": 1e-4}
+    assert pop.start_success([1.0, 2.03], 2e-4, truth, pos, True, ref)  # 1.3 % < 2 x 1 %
+    assert not pop.start_success([1.0, 2.1], 2e-4, truth, pos, True, ref)
+    assert pop.start_success([1.3, 1.0], 1.0005e-4, truth, pos, False, ref)  # fits as well as the reference
+
+
+def test_a_tiny_run_logs_resumes_and_summarises(bench, tmp_path):
+    _, pop = bench
+    log, out = tmp_path / "pop.jsonl", tmp_path / "pop.json"
+    argv = ["--classes", "compartment", "--sizes", "2", "--problems", "1", "--starts", "1", "--methods", "lm,ipopt",
+            "--noise", "0,0.01", "--kinds", "uninformed", "--time-limit", "30", "--log", str(log), "--out", str(out)]
+    assert pop.main(argv) == 0
+    first = log.read_text(encoding="utf-8").splitlines()
+    # the problem, the noisy reference, and per noise level each method's setup and start
+    assert len(first) == 1 + 1 + 2 * 2 * 2
+    assert pop.main(argv) == 0  # resumed: nothing run again
+    assert log.read_text(encoding="utf-8").splitlines() == first
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    cells = {(r["method"], r["noise"]) for r in doc["rows"]}
+    assert cells == {("lm", 0.0), ("ipopt", 0.0), ("lm", 0.01), ("ipopt", 0.01)}
+    assert all(r["starts"] == 1 and r["problems"] == 1 for r in doc["rows"])
