@@ -295,7 +295,10 @@ def _run_identify(identify, model, data, args, x0, opts: dict, from_file: set[st
     method does not use them: the file describes the model, not one method.
     """
     from symid.errors import OptionError
+    from symid.fit.registry import data_kind
 
+    if args.method is None:  # the data kind's default (auto for a frequency response)
+        args.method = data_kind(data).default_method
     while True:
         try:
             return identify(model, data, method=args.method, x0=x0, starts=args.starts, seed=args.seed,
@@ -545,9 +548,10 @@ def build_parser() -> argparse.ArgumentParser:
                                    "--units; without --data, from the zoo's own recipe.")
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     _add_data_arguments(p, "simulate the zoo recipe")
-    p.add_argument("--method", choices=all_methods(), default="scr",
-                   help="estimator (default: scr); als and gb (alternating least squares, gradient-based BFGS, "
-                        "thesis appendix C) take black-box or I/O data, oe (output error) time series")
+    p.add_argument("--method", choices=all_methods(), default=None,
+                   help="estimator (default: auto for a frequency response, scr for other data); als and gb "
+                        "(alternating least squares, gradient-based BFGS, thesis appendix C) take black-box or I/O "
+                        "data, oe (output error) time series")
     p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=1, metavar="N",
                    help="number of starts (default: 1)")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")

@@ -20,7 +20,7 @@ from symid.progress import progress_bar
 __all__ = ["identify"]
 
 
-def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, starts: int = 1,
+def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None, starts: int = 1,
              seed: int | None = None, polish: bool = False, progress: bool | None = None,
              identifiability_check: bool = True, noise_floor: float | None = None,
              noise_std: Any = None, **options: Any) -> IdentificationResult:
@@ -36,8 +36,12 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
         :mod:`symid.fit.spectra` (ch. 5), a black box or input/output records (then
         N4SID and an exact zero-order-hold ``d2c`` first) to
         :mod:`symid.fit.similarity` (ch. 6, 7).
-    method : str
-        ``"scr"`` (sequential convex relaxation), ``"ipopt"`` (nonlinear least squares
+    method : str, optional
+        Default: the data kind's default (:attr:`symid.fit.registry.DataKind.default_method`):
+        ``"auto"`` for a frequency response (:mod:`symid.fit.frf.lm`: least squares on
+        log-parameters, restarted around the start until the estimate fits; the most
+        reliable method on the generated population of ``benchmarks/population.py``),
+        ``"scr"`` otherwise. ``"scr"`` (sequential convex relaxation), ``"ipopt"`` (nonlinear least squares
         with CasADi/IPOPT), ``"ls"`` (a linear special case, where it applies), and for
         black-box data ``"als"``, ``"gb"``. ``"scr"`` on a second-order model whose C or
         B is known, square and invertible runs the exact linear least squares instead
@@ -103,6 +107,10 @@ def identify(model: Any, data: Any, method: str = "scr", *, x0: Any = None, star
     >>> [round(v, 6) for v in res.theta.values()], res.success
     ([2.0, 0.5, 3.0], True)
     """
+    if method is None:
+        from symid.fit.registry import data_kind
+
+        method = data_kind(data).default_method
     polish = check_bool("polish", polish)
     identifiability_check = check_bool("identifiability_check", identifiability_check)
     if progress is not None:

@@ -29,11 +29,16 @@ class DataKind:
         Names of the :mod:`symid.data` classes it takes.
     package : str
         The :mod:`symid.fit` package.
+    default_method : str
+        What :func:`symid.identify` runs when no method is named: ``"auto"`` for a
+        frequency response (measured on ``benchmarks/population.py``), ``"scr"`` for
+        the others.
     """
 
     name: str
     data_types: tuple[str, ...]
     package: str
+    default_method: str = "scr"
 
     @property
     def methods(self) -> tuple[str, ...]:
@@ -47,7 +52,7 @@ class DataKind:
 
 
 _KINDS = (
-    DataKind("frequency response", ("FrequencyData",), "symid.fit.frf"),
+    DataKind("frequency response", ("FrequencyData",), "symid.fit.frf", default_method="auto"),
     DataKind("spectra", ("SpectralData",), "symid.fit.spectra"),
     DataKind("time series", ("IOData", "TimeSeries"), "symid.fit.timeseries"),
     DataKind("black box", ("BlackBox",), "symid.fit.similarity"),

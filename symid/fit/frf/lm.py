@@ -77,9 +77,12 @@ class LmFRF(FrfEstimator):
         Continuation over frequency: stage 1 first fits the lowest 1/``bands`` of the
         lines, then 2/``bands``, ..., then all of them (default 1, no continuation, for
         ``"lm"``; 8 for ``"auto"``).
-    max_nfev : int, optional
-        Function evaluations per stage of a pass (default 300; ten times that for the
-        last stage, the judged criterion).
+    max_iter : int, optional
+        Function evaluations (iterations of the trust-region method) per stage of a pass
+        (default 300; ten times that for the last stage, the judged criterion).
+    positivity : bool, optional
+        Parameters declared positive are θₖ = sₖ·exp(φₖ), so they stay positive (default
+        ``True``); ``False`` treats them as the others (θₖ = x0ₖ + sₖ·φₖ).
     tol : float, optional
         Relative tolerance on the criterion and the step (SciPy's ``ftol``, ``xtol``;
         default 1e-12).
@@ -113,8 +116,9 @@ class LmFRF(FrfEstimator):
     default_time_limit: ClassVar[float | None] = None
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, restarts: int | None = None,
-                 spread: float = 10.0, max_nfev: int = 300, tol: float = 1e-12, time_limit: float | None = None,
-                 bands: int | None = None, seed: int = 0, variance: Any = "data", verbose: bool = False,
+                 spread: float = 10.0, max_iter: int = 300, positivity: bool = True, tol: float = 1e-12,
+                 time_limit: float | None = None, bands: int | None = None, seed: int = 0,
+                 variance: Any = "data", verbose: bool = False,
                  callback: Callable[[int, dict[str, Any]], Any] | None = None):
         self.model, self.data = model, data
         l = model.n_parameters
@@ -123,7 +127,8 @@ class LmFRF(FrfEstimator):
                                                                             high=10**6)
         spread = check_float("spread", spread, low=1.0)
         bands = self.default_bands if bands is None else check_int("bands", bands, low=1, high=10**4)
-        max_nfev = check_int("max_nfev", max_nfev, low=1, high=10**7)
+        max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
+        positivity = check_bool("positivity", positivity)
         tol = check_float("tol", tol, low=0, strict_low=True)
         if time_limit is None:
             time_limit = self.default_time_limit
@@ -136,7 +141,8 @@ class LmFRF(FrfEstimator):
         self.callback = callback
         self.options = {"scale": None if self.scale is None else self.scale.tolist(), "restarts": restarts,
                         "bands": bands,
-                        "spread": spread, "max_nfev": max_nfev, "tol": tol, "time_limit": time_limit, "seed": seed,
+                        "spread": spread, "max_iter": max_iter,
+                        "positivity": positivity, "tol": tol, "time_limit": time_limit, "seed": seed,
                         "variance": "given" if not isinstance(variance, str) and variance is not None else variance,
                         "verbose": verbose}
         H = np.asarray(data.H)
@@ -145,7 +151,7 @@ class LmFRF(FrfEstimator):
         wts = np.ones(H.shape) if self.line_weights is None else self.line_weights
         self._sqrtw = np.sqrt(wts)
         self._hnorm = float(np.sqrt(np.sum(wts * np.abs(H) ** 2)))
-        self._positive = np.asarray(model.positive, dtype=bool)
+        self._positive = np.asarray(model.positive, dtype=bool) & positivity
         self._w = np.asarray(data.w, dtype=float)
 
     # -- parametrisation ------------------------------------------------------------------------
@@ -233,7 +239,7 @@ class LmFRF(FrfEstimator):
         tol = max(self.options["tol"], 1e-8) if kind == "log" else self.options["tol"]
         # the judged criterion gets ten times the evaluations: on noisy data of a sloppy model its minimum
         # lies at the end of a long valley (measured: 250-850 evaluations on a 2-mass chain at 1 % noise)
-        nfev = self.options["max_nfev"] * (10 if kind == "abs" else 1)
+        nfev = self.options["max_iter"] * (10 if kind == "abs" else 1)
         sol = least_squares(lambda p: value(p)[0], phi, jac=lambda p: value(p)[1], method="trf", x_scale=1.0,
                             max_nfev=nfev, ftol=tol, xtol=tol, gtol=min(tol, 1e-10))
         return self._clip(sol.x), int(sol.nfev)
