@@ -33,7 +33,8 @@ def frf():
 
 @pytest.mark.parametrize(("method", "options", "match"), [
     ("scr", {"max_iters": 5}, r"no option 'max_iters' \(did you mean 'max_iter'\?\); its options are: .*max_iter"),
-    ("ipopt", {"bounds": False}, r"no option 'bounds'.*positivity"),
+    ("ipopt", {"lower": 0.0}, r"no option 'lower'.*positivity"),
+    ("ipopt", {"bounds": False}, r"bounds must be a dict of \(low, high\) by parameter name or an array"),
     ("scr", {"seed": -1}, "seed must be an integer between 0 and"),
     ("scr", {"seed": 1.5}, "seed must be an integer between 0 and"),
     ("scr", {"seed": "abc"}, "seed must be an integer between 0 and"),

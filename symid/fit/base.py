@@ -118,6 +118,11 @@ class Estimator(abc.ABC):
         """The local refinement ``polish=True`` / ``"scr+polish"`` uses after this method, or ``None``."""
         return None
 
+    def check_start(self, x0: np.ndarray) -> None:
+        """Refuse a user's start this method cannot take (an :class:`OptionError` saying why), before any
+        start runs; e.g. one outside the method's ``bounds``. Default: every start is taken."""
+        return None
+
     def run_polished(self, x0: np.ndarray, polisher: Estimator) -> StartOutcome:
         """This method from ``x0``, then ``polisher`` from its estimate (kept when it lowers the misfit)."""
         from symid.fit.polish import polish_outcome

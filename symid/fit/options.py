@@ -21,13 +21,17 @@ __all__ = [
     "MAX_SEED",
     "MAX_STARTS",
     "check_bool",
+    "check_bounds",
     "check_choice",
     "check_float",
     "check_int",
     "check_known_names",
     "check_scale",
     "check_seed",
+    "check_start_bounds",
     "check_time_limit",
+    "moved_onto_bounds",
+    "parameter_bounds",
 ]
 
 MAX_SEED = 2**63 - 1
@@ -149,6 +153,68 @@ def check_scale(name: str, value: Any, size: int) -> np.ndarray:
     return arr.copy()
 
 
+def check_bounds(name: str, value: Any, parameter_names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds per parameter: a dict by name of (low, high), or an (l, 2) array.
+
+    A side given as ``None`` or ±inf is open; parameters a dict leaves out are unbounded.
+    An unknown name, a wrong shape, NaN, or low > high is an :class:`OptionError` naming it.
+
+    Examples
+    --------
+    >>> from symid.fit.options import check_bounds
+    >>> lo, hi = check_bounds("bounds", {"k": (10, None)}, ["m", "k"])
+    >>> lo.tolist(), hi.tolist()
+    ([-inf, 10.0], [inf, inf])
+    >>> check_bounds("bounds", {"k": (5, 1)}, ["m", "k"])
+    Traceback (most recent call last):
+    ...
+    symid.errors.OptionError: bounds: k has lower bound 5 > upper bound 1
+    """
+    names = list(parameter_names)
+    l = len(names)
+    lower, upper = np.full(l, -np.inf), np.full(l, np.inf)
+
+    def side(v: Any, what: str, key: str) -> float:
+        if v is None:
+            return -np.inf if what == "lower" else np.inf
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+            raise OptionError(f"{name}: the {what} bound of {key} must be a number or None; got {v!r}")
+        x = float(v)
+        if np.isnan(x):
+            raise OptionError(f"{name}: the {what} bound of {key} is NaN")
+        return x
+
+    if isinstance(value, Mapping):
+        for key, pair in value.items():
+            if key not in names:
+                close = difflib.get_close_matches(str(key), names, n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                raise OptionError(f"{name}: {key!r} is not a parameter of the model{hint}; its parameters are: "
+                                  f"{', '.join(names)}")
+            if isinstance(pair, (str, bytes)) or not isinstance(pair, Sequence) or len(pair) != 2:
+                raise OptionError(f"{name}: {key} needs a pair (low, high); got {pair!r}")
+            k = names.index(key)
+            lower[k], upper[k] = side(pair[0], "lower", key), side(pair[1], "upper", key)
+    else:
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise OptionError(f"{name} must be a dict of (low, high) by parameter name or an array of shape "
+                              f"({l}, 2); got {type(value).__name__}") from None
+        if arr.shape != (l, 2):
+            raise OptionError(f"{name} must be a dict of (low, high) by parameter name or an array of shape "
+                              f"({l}, 2) (one row per parameter: {', '.join(names)}); got shape {arr.shape}")
+        if np.isnan(arr).any():
+            k = int(np.argwhere(np.isnan(arr))[0][0])
+            raise OptionError(f"{name}: the bounds of {names[k]} contain NaN (use ±inf for an open side)")
+        lower, upper = arr[:, 0].copy(), arr[:, 1].copy()
+    bad = lower > upper
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise OptionError(f"{name}: {names[k]} has lower bound {lower[k]:g} > upper bound {upper[k]:g}")
+    return lower, upper
+
+
 def check_time_limit(name: str, value: Any) -> float | None:
     """A wall-time budget in seconds: ``None`` (no limit) or a finite number > 0.
 
@@ -183,3 +249,83 @@ def check_known_names(owner: str, given: Mapping[str, Any], valid: Iterable[str]
     noun = "option" if len(unknown) == 1 else "options"
     raise OptionError(f"{owner} has no {noun} {', '.join(parts)}; its options are: "
                       f"{', '.join(valid) if valid else '(none)'}")
+
+
+def parameter_bounds(model: Any, bounds: Any, positivity: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds on θ: ``bounds`` (:func:`check_bounds`) and, with
+    ``positivity``, θₖ ≥ 0 for parameters declared positive; an :class:`OptionError` when they leave a
+    parameter no admissible value.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.fit.options import parameter_bounds
+    >>> m, k = si.parameters("m k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[0.1]], K=[[k]], B=[[1]], C=[[1]])
+    >>> [b.tolist() for b in parameter_bounds(model, {"k": (10, 100)}, True)]
+    [[0.0, 10.0], [inf, 100.0]]
+    """
+    names = list(model.parameter_names)
+    if bounds is None:
+        lower, upper = np.full(len(names), -np.inf), np.full(len(names), np.inf)
+    else:
+        lower, upper = check_bounds("bounds", bounds, names)
+    if positivity:
+        pos = np.asarray(model.positive, dtype=bool)
+        lower = np.where(pos, np.fmax(lower, 0.0), lower)
+        bad = pos & (upper < 0)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise OptionError(f"bounds: {names[k]} is declared positive, but its upper bound {upper[k]:g} is below "
+                              "0: no value is admissible (raise the bound, or pass positivity=False)")
+    return lower, upper
+
+
+def _outside(x0: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> list[int]:
+    """Indices of the entries of x0 outside [lower, upper] beyond rounding."""
+    slack = 1e-12 * np.fmax(1.0, np.abs(x0))
+    with np.errstate(invalid="ignore"):
+        bad = (x0 < lower - slack) | (x0 > upper + slack)
+    return [int(k) for k in np.flatnonzero(bad)]
+
+
+def check_start_bounds(x0: Any, lower: np.ndarray, upper: np.ndarray, names: Sequence[str]) -> None:
+    """Refuse a start of the wrong length or outside [lower, upper] (an :class:`OptionError` naming the parameter).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.options import check_start_bounds
+    >>> check_start_bounds([5.0, 1.0], np.array([10.0, 0.0]), np.array([100.0, np.inf]), ["k", "m"])
+    Traceback (most recent call last):
+    ...
+    symid.errors.OptionError: the start k = 5 lies outside its bounds [10, 100]; move the start inside or ...
+    """
+    x = np.asarray(x0, dtype=float).reshape(-1)
+    if x.size != len(names):
+        raise OptionError(f"the start has {x.size} values; the model has {len(names)} parameters ({', '.join(names)})")
+    out = _outside(x, lower, upper)
+    if out:
+        k = out[0]
+        raise OptionError(f"the start {names[k]} = {x[k]:g} lies outside its bounds [{lower[k]:g}, {upper[k]:g}]; "
+                          "move the start inside or widen the bounds")
+
+
+def moved_onto_bounds(x0: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Sequence[str]) -> str:
+    """``"; start moved onto the bounds: k 5 → 10"`` for the entries of a start outside them ('' if none).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.options import moved_onto_bounds
+    >>> moved_onto_bounds(np.array([5.0, 1.0]), np.array([10.0, 0.0]), np.array([100.0, np.inf]), ["k", "m"])
+    '; start moved onto the bounds: k 5 → 10'
+    """
+    x = np.asarray(x0, dtype=float).reshape(-1)
+    if x.shape != np.shape(lower):
+        return ""
+    out = _outside(x, lower, upper)
+    if not out:
+        return ""
+    return "; start moved onto the bounds: " + ", ".join(
+        f"{names[k]} {x[k]:.4g} → {float(np.clip(x[k], lower[k], upper[k])):.4g}" for k in out)

@@ -7,6 +7,13 @@ Estimated from the residuals, the noise is taken as **relative**, independent ci
 complex Gaussian with E|eᵢ|² = ε_j² |H_j(ωᵢ, θ̂)|² for output j (each part half of it),
 the model ``si.simulate_frf(..., noise=ε)`` follows and the success rule assumes
 (:mod:`symid.fit.success`); ``noise_std=`` gives it per frequency or entry instead.
+
+A noise-weighted fit (``line_weights`` w = 1/σ² per entry, set by an estimator's
+``variance=`` option) minimises Σ w|Hᵢ − H(ωᵢ, θ)|² / Σ w|Hᵢ|²: its residual vector is
+√w (Hᵢ − H(ωᵢ, θ)) / ‖√w H‖ and the Jacobian likewise, and when the estimator knows the
+variance itself (``line_variance``) that is the noise of the uncertainty unless
+``noise_std`` is given (Pintelon & Schoukens, §7.2: the maximum-likelihood criterion
+with known noise variances; its covariance is the inverse Fisher information).
 """
 
 from __future__ import annotations
@@ -17,7 +24,7 @@ import numpy as np
 import scipy.linalg
 
 from symid.fit.sensitivity import frf_sensitivity
-from symid.fit.uncertainty import FisherInformation, broadcast_noise
+from symid.fit.uncertainty import FisherInformation, Uncertainty, broadcast_noise
 
 __all__ = ["FrfFisher"]
 
@@ -44,17 +51,26 @@ class FrfFisher(FisherInformation):
     model: Any
     data: Any
     method: ClassVar[str]
+    line_weights: np.ndarray | None = None
+    line_variance: np.ndarray | None = None
+
+    def _sqrt_weights(self) -> np.ndarray:
+        """√w per entry of H (ones without noise weighting)."""
+        w = self.line_weights
+        return np.ones(np.shape(self.data.H)) if w is None else np.sqrt(np.asarray(w, dtype=float))
 
     def _norm(self) -> float:
-        return float(np.sqrt(np.sum(np.abs(np.asarray(self.data.H)) ** 2))) or 1.0
+        return float(np.sqrt(np.sum((self._sqrt_weights() * np.abs(np.asarray(self.data.H))) ** 2))) or 1.0
 
     def jacobian(self, theta: Any) -> tuple[np.ndarray, np.ndarray]:
-        """Real and imaginary parts of (H − H(θ)) / ‖H‖ (entry order s, p, m) and their Jacobian."""
+        """Real and imaginary parts of √w (H − H(θ)) / ‖√w H‖ (entry order s, p, m; w = 1 without weights) and
+        their Jacobian."""
         H = np.asarray(self.data.H)
         Hm, dH = frf_sensitivity(self.model, theta, self.data.w)
         nrm = self._norm()
-        R = (H - Hm) / nrm
-        D = -dH.reshape(-1, dH.shape[-1]) / nrm
+        sw = self._sqrt_weights()
+        R = sw * (H - Hm) / nrm
+        D = -(dH * sw[..., None]).reshape(-1, dH.shape[-1]) / nrm
         return np.concatenate([R.real.ravel(), R.imag.ravel()]), np.vstack([D.real, D.imag])
 
     def residual_channels(self) -> np.ndarray:
@@ -66,15 +82,22 @@ class FrfFisher(FisherInformation):
     def noise_shape(self, theta: Any) -> np.ndarray:
         """|H(ωᵢ, θ)| / (√2 ‖H‖) per part: relative noise."""
         Hm = np.asarray(self.model.frequency_response(theta, self.data.w))
-        a = np.abs(Hm).ravel() / (np.sqrt(2.0) * self._norm())
+        a = (self._sqrt_weights() * np.abs(Hm)).ravel() / (np.sqrt(2.0) * self._norm())
         return np.concatenate([a, a])
 
     def given_noise(self, noise_std: Any) -> tuple[np.ndarray, np.ndarray]:
         """``noise_std``: a number, one per frequency (s,), or (s, p, m); E|eᵢ|² = std² for each complex entry."""
         H = np.asarray(self.data.H)
         arr = broadcast_noise(noise_std, H.shape, f"the frequency response H (s, p, m) = {H.shape}")
-        a = arr.ravel() / (np.sqrt(2.0) * self._norm())
+        a = (self._sqrt_weights() * arr).ravel() / (np.sqrt(2.0) * self._norm())
         return np.concatenate([a, a]), arr.ravel()
+
+    def uncertainty(self, theta: Any, parameter_names: tuple[str, ...], noise_std: Any = None) -> Uncertainty:
+        """As :meth:`FisherInformation.uncertainty`; a noise-weighted fit whose variance is known
+        (``line_variance``) takes σ = √variance as the given noise unless ``noise_std`` is given."""
+        if noise_std is None and self.line_variance is not None:
+            noise_std = np.sqrt(np.asarray(self.line_variance, dtype=float))
+        return super().uncertainty(theta, parameter_names, noise_std=noise_std)
 
     def estimate_sensitivity(self, theta: Any) -> np.ndarray | None:
         """For ``ls``: the first-order map from the noise on H to θ̂ of the equation-error least squares."""

@@ -150,7 +150,9 @@ class LinearFRF(FrfEstimator):
         J = np.vstack(rowsJ)
         self._J = np.vstack([J.real, J.imag])
         self._r0 = np.concatenate([r0.real, r0.imag])
-        rank = np.linalg.matrix_rank(self._J)
+        norms = np.linalg.norm(self._J, axis=0)  # unit-norm columns: the solution does not depend on units
+        self._norms = np.where(norms > 0, norms, 1.0)
+        rank = np.linalg.matrix_rank(self._J / self._norms)
         if rank < l:
             raise ModelError(f"the linear least-squares problem has rank {rank} < {l} parameters: the data do not "
                              f"determine θ (add frequencies, or check identifiability)")
@@ -159,8 +161,7 @@ class LinearFRF(FrfEstimator):
         """min ‖Jθ + r0‖ with θₖ ≥ 0 where ``pos``: bounded-variable least squares on unit-norm columns."""
         from scipy.optimize import lsq_linear
 
-        norms = np.linalg.norm(self._J, axis=0)
-        norms = np.where(norms > 0, norms, 1.0)
+        norms = self._norms
         lower = np.where(pos, 0.0, -np.inf)
         sol = lsq_linear(self._J / norms, -self._r0, bounds=(lower, np.inf), method="bvls")
         theta = sol.x / norms
@@ -173,7 +174,7 @@ class LinearFRF(FrfEstimator):
     def run(self, x0: np.ndarray | None = None) -> StartOutcome:
         """Solve the least squares (the start is irrelevant; kept for a uniform signature)."""
         t0 = time.perf_counter()
-        theta, *_ = np.linalg.lstsq(self._J, -self._r0, rcond=None)
+        theta = np.linalg.lstsq(self._J / self._norms, -self._r0, rcond=None)[0] / self._norms
         start = np.zeros(self.model.n_parameters) if x0 is None else np.asarray(x0, dtype=float)
         msg = f"linear least squares ({self.case} case)"
         pos = np.array(self.model.positive, dtype=bool)

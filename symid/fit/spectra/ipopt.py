@@ -7,8 +7,19 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from symid.engine.ipopt import HESSIANS, IpoptSolver, casadi_frf, casadi_matrices, positivity_bounds
-from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale
+from symid.engine.ipopt import HESSIANS, ScaledIpopt, casadi_frf, casadi_matrices, iteration_reporter
+from symid.errors import OptionError
+from symid.fit.options import (
+    check_bool,
+    check_choice,
+    check_float,
+    check_int,
+    check_scale,
+    check_start_bounds,
+    check_time_limit,
+    moved_onto_bounds,
+    parameter_bounds,
+)
 from symid.fit.result import StartOutcome
 from symid.fit.spectra.equations import SpectraEstimator, check_spectral, spectral_equations
 
@@ -30,7 +41,10 @@ class IpoptPSD(SpectraEstimator):
 
     Every fair advantage is on by default: exact Hessian by automatic differentiation,
     an objective normalised by Σᵢ ‖Φyyᵢ‖²_F (or weighted per frequency), bounds θ ≥ 0 on
-    parameters declared positive, and optional parameter scaling.
+    parameters declared positive, and IPOPT working on θ / s with s the start's own
+    magnitudes (or ``scale``), on the objective divided by its start's decade, with a
+    barrier that does not push a start at a converged fit away
+    (:class:`symid.engine.ipopt.ScaledIpopt`).
 
     Parameters
     ----------
@@ -47,7 +61,12 @@ class IpoptPSD(SpectraEstimator):
         ``"frequency"``: each frequency's term divided by its own ‖Φyyᵢ‖²_F (or ‖Qᵢ‖²_F),
         so that the weak high-frequency spectra count as much as the strong ones.
     scale : array_like, optional
-        Typical magnitude of each parameter; IPOPT works on θ / scale. Default 1.
+        Typical magnitude of each parameter; IPOPT works on θ / scale. Default: each
+        start's own magnitudes |θ₀| (where θ₀ is 0: the largest finite bound, else 1).
+    bounds : dict or array_like, optional
+        Lower and upper bounds: a dict by parameter name of (low, high) (``None`` for an
+        open side), or an (l, 2) array; combined with ``positivity``. A start outside
+        them is moved onto them.
     positivity : bool
         θₖ ≥ 0 for parameters declared ``positive=True`` (default True).
     hessian : {"exact", "limited-memory"}
@@ -56,6 +75,14 @@ class IpoptPSD(SpectraEstimator):
         IPOPT iteration limit (default 3000).
     tol : float
         IPOPT tolerance (default 1e-12 on the normalised objective).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds (IPOPT's ``max_wall_time``). Default: none.
+    callback : callable, optional
+        Called after every IPOPT iteration with a
+        :class:`~symid.engine.ipopt.IpoptIteration` (iteration, objective, elapsed, θ); a
+        true return value stops the start.
+    verbose : bool, optional
+        Print one line per iteration (iteration, objective, elapsed). Default False.
 
     Examples
     --------
@@ -73,27 +100,38 @@ class IpoptPSD(SpectraEstimator):
     method: ClassVar[str] = "ipopt"
 
     def __init__(self, model: Any, data: Any, *, objective: str = "output", weighting: str = "none",
-                 scale: Any = None, positivity: bool = True, hessian: str = "exact", max_iter: int = 3000,
-                 tol: float = 1e-12):
+                 scale: Any = None, bounds: Any = None, positivity: bool = True, hessian: str = "exact",
+                 max_iter: int = 3000, tol: float = 1e-12, time_limit: float | None = None, callback: Any = None,
+                 verbose: bool = False):
         objective = check_choice("objective", objective, _OBJECTIVES)
         weighting = check_choice("weighting", weighting, _WEIGHTINGS)
         hessian = check_choice("hessian", hessian, HESSIANS)
         positivity = check_bool("positivity", positivity)
         max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         tol = check_float("tol", tol, low=0, strict_low=True)
+        time_limit = check_time_limit("time_limit", time_limit)
+        verbose = check_bool("verbose", verbose)
+        if callback is not None and not callable(callback):
+            raise OptionError(f"callback must be a function of one IpoptIteration (or None); got "
+                              f"{type(callback).__name__}")
         check_spectral(model, data)
         self.model, self.data = model, data
         l = model.n_parameters
-        self.scale = np.ones(l) if scale is None else check_scale("scale", scale, l)
-        self.options = {"objective": objective, "weighting": weighting, "scale": self.scale.tolist(),
-                        "positivity": positivity, "hessian": hessian, "max_iter": max_iter, "tol": tol}
-        z = ca.MX.sym("z", l)
-        theta = z * ca.DM(self.scale)
+        self.scale = None if scale is None else check_scale("scale", scale, l)
+        self.lower, self.upper = parameter_bounds(model, bounds, positivity)
+        named = {n: [float(lo), float(hi)] for n, lo, hi in zip(model.parameter_names, self.lower, self.upper,
+                                                                strict=True) if np.isfinite(lo) or np.isfinite(hi)}
+        self.options = {"objective": objective, "weighting": weighting,
+                        "scale": "start" if self.scale is None else self.scale.tolist(), "bounds": named or None,
+                        "positivity": positivity, "hessian": hessian, "max_iter": max_iter, "tol": tol,
+                        "time_limit": time_limit, "callback": None if callback is None else "given",
+                        "verbose": verbose}
+        theta = ca.MX.sym("theta", l)
         parts = (self._objective_output(theta) if objective == "output"
                  else self._objective_equation(theta, spectral_equations(model, data)))
-        lbz, ubz = positivity_bounds(model.positive, positivity, self.scale)
-        self._solver = IpoptSolver("symid_ipopt_psd", z, self._weighted_sum(parts), lbz=lbz, ubz=ubz,
-                                   max_iter=max_iter, tol=tol, hessian=hessian)
+        self._solver = ScaledIpopt("symid_ipopt_psd", theta, self._weighted_sum(parts), lower=self.lower,
+                                   upper=self.upper, scale=self.scale, max_iter=max_iter, tol=tol, hessian=hessian,
+                                   time_limit=time_limit, callback=iteration_reporter(callback, verbose))
 
     def _objective_output(self, theta: Any) -> list[tuple[Any, np.ndarray]]:
         """Per frequency (squared misfit, reference spectrum) of (5-13)."""
@@ -127,9 +165,19 @@ class IpoptPSD(SpectraEstimator):
         total = float(norms.sum())
         return f / (total if total > 0 else 1.0)
 
-    def run(self, x0: np.ndarray) -> StartOutcome:
-        """Solve from the start ``x0`` (parameter vector); never raises on solver failure."""
+    def run(self, x0: np.ndarray, *, max_iter: int | None = None, time_limit: float | None = None) -> StartOutcome:
+        """Solve from the start ``x0`` (parameter vector); never raises on solver failure.
+
+        ``max_iter`` and ``time_limit`` cap this start below the estimator's own.
+        """
         x0 = np.asarray(x0, dtype=float)
-        run = self._solver.solve(x0 / self.scale)
-        return self.outcome(x0, run.z * self.scale, finished=run.finished, status=run.status, message=run.status,
+        if max_iter is not None:
+            max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
+        run = self._solver.solve(x0, max_iter=max_iter, time_limit=check_time_limit("time_limit", time_limit))
+        message = run.status + moved_onto_bounds(x0, self.lower, self.upper, self.model.parameter_names)
+        return self.outcome(x0, run.z, finished=run.finished, status=run.status, message=message,
                             iterations=run.iterations, wall_time=run.seconds)
+
+    def check_start(self, x0: Any) -> None:
+        """Refuse a start outside the bounds (an :class:`OptionError` naming the parameter)."""
+        check_start_bounds(x0, self.lower, self.upper, self.model.parameter_names)
