@@ -311,7 +311,9 @@ def _run_identify(identify, model, data, args, x0, opts: dict, from_file: set[st
                 for n in dropped:
                     opts.pop(n)
                 from_file -= set(dropped)
-                _say(args, f"note: method {args.method!r} does not use the model file's {', '.join(dropped)}")
+                what = [f"the model file's {n}" if n != "bounds" else "the bounds (the estimate is checked against "
+                        "them)" for n in dropped]
+                _say(args, f"note: method {args.method!r} does not use {' or '.join(what)}")
                 continue
             flags = [f for f, n in {**_FLAG_OPTIONS, "--scale": "scale"}.items() if n in opts and f"'{n}'" in text]
             if flags:
@@ -340,6 +342,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         opts["scale"] = [spec.scale[n] for n in model.parameter_names]
         if not args.scale:
             from_file.add("scale")
+    if spec.bounds:  # a method that takes bounds= keeps its estimate inside; for the others they are checked after
+        opts["bounds"] = {n: tuple(b) for n, b in spec.bounds.items()}
+        from_file.add("bounds")
     try:
         res, opts = _run_identify(identify, model, data, args, x0, opts, from_file)
     except Interrupted as exc:  # keep the finished starts

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from symid.cli import build_parser, main
+from symid.cli import NO_FIT, build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
 COMMANDS = ["models", "show", "identify", "compare", "demo", "identifiability"]
@@ -299,13 +299,25 @@ def test_known_scale_bounds_and_options_reach_the_estimator(tmp_path, capsys):
     assert "centre of the bounds" not in out
 
 
+BOUNDS = ["--bounds", "m1=0.5:2", "m2=0.5:2", "c1=0.01:1", "c2=0.01:1", "k1=3:10", "k2=0.1:10"]
+
+
 def test_bounds_give_the_first_start_and_flag_estimates_outside(capsys):
-    code = main(["identify", "mass_damper_2dof", "--method", "ipopt", "--bounds", "m1=0.5:2", "m2=0.5:2",
-                 "c1=0.01:1", "c2=0.01:1", "k1=3:10", "k2=0.1:10", "--json"])
-    doc = json.loads(capsys.readouterr().out)
+    code = main(["identify", "mass_damper_2dof", "--method", "lm", *BOUNDS, "--json"])  # lm takes no bounds
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out)
     start = doc["result"]["starts"][0]["start"]
     np.testing.assert_allclose(start, [1.0, 1.0, 0.1, 0.1, np.sqrt(30), 1.0], rtol=1e-12)  # geometric centres
     assert code == 0 and doc["outside_bounds"] == {"k1": pytest.approx(2.0, rel=1e-6)}  # the truth k1 = 2 < 3
+    assert "note: method 'lm' does not use the bounds" in captured.err
+
+
+def test_bounds_reach_a_method_that_takes_them(capsys):
+    code = main(["identify", "mass_damper_2dof", "--method", "ipopt", *BOUNDS, "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert "'k1': [3.0, 10.0]" in str(doc["result"]["options"]["bounds"])  # JSON keeps a dict option as its text
+    assert doc["outside_bounds"] == {} and doc["result"]["theta"]["k1"] == 3.0  # held at the bound the truth lies below
+    assert code == NO_FIT  # no fit of these data inside the bounds: said by the exit status
 
 
 OPTION_ERRORS = {

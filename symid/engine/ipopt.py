@@ -440,7 +440,7 @@ class ScaledIpopt:
         return bool(self.callback(info)) if self.callback is not None else False
 
     def solve(self, theta0: np.ndarray, *, max_iter: int | None = None, time_limit: float | None = None) -> IpoptRun:
-        """Run IPOPT from ``theta0`` (clipped to the bounds); ``IpoptRun.z`` is θ.
+        """Run IPOPT from ``theta0`` (clipped to the bounds); ``IpoptRun.z`` is θ, within the bounds.
 
         ``max_iter`` and ``time_limit`` cap this solve below the solver's own (e.g. a trial
         polish). Never raises on solver failure (as :meth:`IpoptSolver.solve`).
@@ -459,7 +459,8 @@ class ScaledIpopt:
             with native_interrupts(raise_now=True):
                 sol = solver(x0=theta0 / s, p=s, lbx=self.lower / s, ubx=self.upper / s)
             stats = solver.stats()
-            theta = np.asarray(sol["x"]).reshape(-1) * s
+            # IPOPT relaxes the bounds by 1e-8 (bound_relax_factor): the estimate returned lies within them
+            theta = np.clip(np.asarray(sol["x"]).reshape(-1) * s, self.lower, self.upper)
             status = str(stats.get("return_status", "unknown"))
             iters_done = int(stats.get("iter_count", 0))
         except RuntimeError as exc:  # CasADi evaluation errors (NaN in the linear solve)
