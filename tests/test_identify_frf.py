@@ -90,7 +90,7 @@ def test_ipopt_2dof_with_bounds():
 def test_multistart_keeps_every_start_and_returns_best():
     model = belt_drive()
     frf = si.simulate_frf(model, BELT_TRUTH, W_BELT)
-    res = si.identify(model, frf, method="ipopt", starts=6, seed=1)
+    res = si.identify(model, frf, method="ipopt", starts=6, seed=1, draws="normal")
     assert res.n_starts == 6
     np.testing.assert_array_equal(res.starts[0].start, np.zeros(4))  # thesis ch. 3: zero start first
     assert res.cost == min(s.cost for s in res.starts)
@@ -132,7 +132,7 @@ def test_scr_belt_drive_from_zeros():
     """Thesis §3-6: from the all-zero start ‖θ̂ − θ*‖₂ ≤ 1e-6 (thesis (3-21): 3.5e-7). With C and the first
     two rows of A known, presolve turns (3-10) into linear equalities that fix every Γᵢ."""
     entry = si.load_model("belt_drive")
-    res = si.identify(entry.model, entry.data(), method="scr")
+    res = si.identify(entry.model, entry.data(), method="scr", draws="normal")  # the thesis start: θ = 0
     assert res.method == "scr" and res.success, res.message
     np.testing.assert_array_equal(res.starts[0].start, np.zeros(4))
     truth = entry.model.theta_vector(entry.truth)  # thesis (3-18)

@@ -15,7 +15,7 @@ from symid.errors import DataError, ModelError, OptionError
 from symid.fit.options import check_float
 from symid.fit.registry import data_kind, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
-from symid.fit.starts import make_starts
+from symid.fit.starts import draw_starts
 from symid.interrupt import Interrupted
 from symid.progress import progress_bar
 from symid.runlog import RunLog
@@ -160,8 +160,8 @@ class Comparison:
 def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *,
             starts: int | Sequence[Any] = 10, seed: int | None = 0, truth: Any = None, x0: Any = None,
             param_tol: float = 1e-3, progress: bool | None = None, options: dict[str, dict[str, Any]] | None = None,
-            noise_floor: float | None = None, log: RunLog | None = None, executor: Executor | None = None
-            ) -> Comparison:
+            noise_floor: float | None = None, log: RunLog | None = None, executor: Executor | None = None,
+            draws: str | None = None) -> Comparison:
     """Run several methods from identical starts and tabulate success and time.
 
     Parameters
@@ -177,9 +177,9 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         built and run on its own, so its setup and time per start (method + every
         polish) share nothing with the plain row.
     starts : int or sequence of parameter vectors
-        Number of starts (every method gets the same list, :func:`symid.fit.starts.make_starts`),
+        Number of starts (every method gets the same list, :func:`symid.fit.starts.draw_starts`),
         or the starts themselves: a sequence of dicts or vectors in ``parameter_names``
-        order (then ``seed`` and ``x0`` play no part).
+        order (then ``seed``, ``x0`` and ``draws`` play no part).
     seed : int, optional
         Seed of the random starts.
     truth : dict or sequence, optional
@@ -200,6 +200,10 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         are read back instead of run, so an interrupted comparison resumes where it
         stopped. Use :meth:`~symid.runlog.RunLog.scoped` to keep several comparisons in
         one file. A log written with other starts is refused.
+    draws : {"scale", "normal"}, optional
+        How the random starts are drawn, as in :func:`symid.identify`; with ``"scale"``,
+        the typical values are the first compared method's ``scale=`` option, else the
+        data's (frequency responses).
     executor : concurrent.futures.Executor, optional
         Run the starts of each method as tasks of this executor: a
         ``concurrent.futures.ProcessPoolExecutor`` on one machine, or a Dask cluster's
@@ -249,7 +253,8 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         raise ModelError(f"options given for methods not compared: {', '.join(sorted(unknown))}")
     param_tol = check_float("param_tol", param_tol, low=0, strict_low=True)
     truth_vec = None if truth is None else model.theta_vector(truth)
-    x0s = _start_list(model, starts, seed, x0)
+    scale = next((o["scale"] for o in options.values() if isinstance(o, dict) and o.get("scale") is not None), None)
+    x0s = _start_list(model, data, starts, seed, x0, draws, scale)
     if log is not None and not isinstance(log, RunLog):
         raise ModelError(f"log must be a symid.runlog.RunLog; got {type(log).__name__}")
     if executor is not None and not isinstance(executor, Executor):
@@ -303,10 +308,11 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     return partial()
 
 
-def _start_list(model: Any, starts: Any, seed: int | None, x0: Any) -> list[np.ndarray]:
+def _start_list(model: Any, data: Any, starts: Any, seed: int | None, x0: Any, draws: str | None, scale: Any
+                ) -> list[np.ndarray]:
     """The starts of a comparison: drawn (``starts`` a count) or given (a sequence of starts)."""
     if isinstance(starts, (int, np.integer)) and not isinstance(starts, bool):
-        return make_starts(model, int(starts), seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+        return draw_starts(model, data, int(starts), seed, x0, draws=draws, scale=scale)
     if isinstance(starts, (str, bytes, Mapping)) or not isinstance(starts, (Sequence, np.ndarray)) or len(starts) == 0:
         raise OptionError(f"starts must be a number of starts or a non-empty sequence of starts (dicts or vectors "
                           f"of {model.n_parameters} values); got {type(starts).__name__}")

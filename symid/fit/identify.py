@@ -12,7 +12,7 @@ from symid.errors import OptionError
 from symid.fit.options import check_bool
 from symid.fit.registry import prepare
 from symid.fit.result import IdentificationResult, StartOutcome
-from symid.fit.starts import make_starts
+from symid.fit.starts import draw_starts
 from symid.fit.uncertainty import FisherInformation
 from symid.interrupt import Interrupted
 from symid.progress import progress_bar
@@ -23,7 +23,7 @@ __all__ = ["identify"]
 def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None, starts: int = 1,
              seed: int | None = None, polish: bool = False, progress: bool | None = None,
              identifiability_check: bool = True, noise_floor: float | None = None,
-             noise_std: Any = None, **options: Any) -> IdentificationResult:
+             noise_std: Any = None, draws: str | None = None, **options: Any) -> IdentificationResult:
     """Estimate the parameters of a symbolic model from data.
 
     Parameters
@@ -49,10 +49,16 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     x0 : dict or sequence, optional
         A start; it becomes the first of ``starts``.
     starts : int
-        Number of starts (1 … 100 000). Default starts: for a state-space model the
-        first is θ = 0 (thesis ch. 3), then seeded N(0, 1) draws per parameter name
-        (:func:`symid.fit.starts.make_starts`), positive parameters in absolute value.
-        Every method gets the same starts for the same ``seed``.
+        Number of starts (1 … 100 000): ``x0`` first when given, then seeded draws per
+        parameter name (:func:`symid.fit.starts.draw_starts`); every method gets the
+        same starts for the same ``seed``.
+    draws : {"scale", "normal"}, optional
+        How the random starts are drawn. ``"scale"`` (default for a frequency response):
+        log-uniformly within a factor 3 of each parameter's typical value — the
+        ``scale=`` option when given, else read off the data by dimensional analysis
+        (:func:`symid.fit.frf.scale.typical_scale`: band centre and response level).
+        ``"normal"`` (default for other data): N(0, 1), positive parameters in absolute
+        value, and θ = 0 first for a state-space model, as in the thesis (ch. 3-4).
     seed : int, optional
         Seed of the random starts (``None``: a fresh one).
     polish : bool
@@ -124,7 +130,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         raise OptionError(f"method {estimator.method!r} has no polish step (polish=True applies to SCR)")
     if polisher is not None:
         polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
-    x0s = make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+    x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"))
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
 

@@ -45,6 +45,11 @@ class DataKind:
         """The method names of this kind."""
         return tuple(importlib.import_module(self.package).METHODS)
 
+    def typical_scale(self, model: Any, data: Any) -> Any:
+        """Typical parameter values from the data (the package's ``typical_scale``), or ``None`` if it has none."""
+        fn = getattr(importlib.import_module(self.package), "typical_scale", None)
+        return None if fn is None else fn(model, data)
+
     def prepare(self, model: Any, data: Any, method: str, options: dict[str, Any], *,
                 noise_floor: float | None = None) -> Estimator:
         """Build the estimator of ``method`` (options validated)."""

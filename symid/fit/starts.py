@@ -1,8 +1,16 @@
 """Initial points for multi-start estimation, identical for every method and tied to parameter names.
 
-Each parameter draws its own stream of N(0, 1) values, seeded by ``seed`` and its
-name: the same seed gives a parameter the same starting values whatever the order in
-which the model declares its parameters, and whatever other parameters it has.
+Each parameter draws its own stream of values, seeded by ``seed`` and its name: the same
+seed gives a parameter the same starting values whatever the order in which the model
+declares its parameters, and whatever other parameters it has. Two distributions:
+
+- ``"normal"``: N(0, 1), in absolute value for parameters declared positive (the
+  thesis's starts, chapters 3-4);
+- ``"scale"``, around typical values s (the user's ``scale=``, or
+  :func:`symid.fit.frf.scale.typical_scale` from a frequency response): s · 3^U(−1, 1)
+  for parameters declared positive (log-uniform within a factor 3 of s), s · N(0, 1) for
+  the others — starts of the right physical order of magnitude, no wider than the
+  typical values are uncertain (the restarts of method ``"auto"`` search wider).
 """
 
 from __future__ import annotations
@@ -15,15 +23,18 @@ import numpy as np
 from symid.errors import OptionError
 from symid.fit.options import MAX_STARTS, check_int, check_seed
 
-__all__ = ["make_starts"]
+__all__ = ["DRAWS", "draw_starts", "make_starts"]
+
+DRAWS = ("scale", "normal")
+"""How :func:`draw_starts` draws random starts (module docstring)."""
 
 
 def _name_key(name: str) -> int:
     return zlib.crc32(name.encode("utf-8"))
 
 
-def make_starts(model: Any, starts: int, seed: int | None, x0: Any = None, *, zero_first: bool = False
-                ) -> list[np.ndarray]:
+def make_starts(model: Any, starts: int, seed: int | None, x0: Any = None, *, zero_first: bool = False,
+                typical: Any = None, spread: float = 3.0) -> list[np.ndarray]:
     """The list of initial parameter vectors.
 
     Parameters
@@ -37,7 +48,13 @@ def make_starts(model: Any, starts: int, seed: int | None, x0: Any = None, *, ze
         A user start; it becomes the first start.
     zero_first : bool
         Make the first start θ = 0 when ``x0`` is not given (the thesis's chapter-3
-        initialisation).
+        initialisation; not with ``typical``).
+    typical : array_like, optional
+        Typical magnitude of each parameter (> 0): the draws are s · spread^U(−1, 1) for
+        parameters declared positive and s · N(0, 1) for the others. Default: N(0, 1)
+        draws (module docstring).
+    spread : float
+        With ``typical``: the factor within which positive parameters are drawn (default 3).
 
     Returns
     -------
@@ -63,20 +80,79 @@ def make_starts(model: Any, starts: int, seed: int | None, x0: Any = None, *, ze
         seed = int(np.random.SeedSequence().generate_state(1, dtype=np.uint64)[0] >> np.uint64(1))
     seed = check_seed("seed", seed)
     l = model.n_parameters
+    if typical is not None:
+        typical = np.asarray(typical, dtype=float).reshape(-1)
+        if typical.size != l or not np.all(np.isfinite(typical)) or np.any(typical <= 0):
+            raise OptionError(f"typical values must be {l} finite numbers > 0; got {typical!r}")
     out: list[np.ndarray] = []
     if x0 is not None:
         try:
             out.append(model.theta_vector(x0))
         except ValueError as exc:
             raise OptionError(f"x0: {exc}") from None
-    elif zero_first:
+    elif zero_first and typical is None:
         out.append(np.zeros(l))
     n_draws = starts - len(out)
     if n_draws > 0:
         cols = []
-        for name, pos in zip(model.parameter_names, model.positive, strict=True):
-            draws = np.random.default_rng([seed, _name_key(name)]).standard_normal(n_draws)
-            cols.append(np.abs(draws) if pos else draws)
+        for j, (name, pos) in enumerate(zip(model.parameter_names, model.positive, strict=True)):
+            rng = np.random.default_rng([seed, _name_key(name)])
+            if typical is None:
+                draws = rng.standard_normal(n_draws)
+                cols.append(np.abs(draws) if pos else draws)
+            elif pos:
+                cols.append(typical[j] * float(spread) ** rng.uniform(-1.0, 1.0, n_draws))
+            else:
+                cols.append(typical[j] * rng.standard_normal(n_draws))
         table = np.column_stack(cols) if cols else np.zeros((n_draws, 0))
         out.extend(table[k].copy() for k in range(n_draws))
     return out[:starts]
+
+
+def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = None, *, draws: str | None = None,
+                scale: Any = None) -> list[np.ndarray]:
+    """The starts of :func:`symid.identify` and :func:`symid.compare`: ``x0`` first, then random draws.
+
+    Parameters
+    ----------
+    model, data
+        The model and the data (the data kind picks the default).
+    starts, seed, x0
+        As in :func:`make_starts`.
+    draws : {"scale", "normal"}, optional
+        ``"scale"``: within a factor 3 of typical values — ``scale`` when given, else the
+        data kind's (:func:`symid.fit.frf.scale.typical_scale` for a frequency response);
+        ``"normal"``: N(0, 1), with θ = 0 first for a state-space model (the thesis).
+        Default: ``"scale"`` for a frequency response, ``"normal"`` for other data.
+    scale : float or array_like, optional
+        The user's typical values (the methods' ``scale=`` option).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.starts import draw_starts
+    >>> m, k = si.parameters("m k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[0.5]], K=[[k]], B=[[1]], C=[[1]])
+    >>> frf = si.simulate_frf(model, [50.0, 2e5], np.logspace(1, 3, 40))
+    >>> x = np.array(draw_starts(model, frf, 20, seed=0))
+    >>> bool(np.all((x[:, 1] > 1e3) & (x[:, 1] < 1e7)))      # stiffnesses drawn at the data's scale
+    True
+    """
+    from symid.fit.options import check_choice, check_scale
+    from symid.fit.registry import data_kind
+
+    kind = data_kind(data)
+    if draws is None:
+        draws = "scale" if kind.name == "frequency response" else "normal"
+    draws = check_choice("draws", draws, DRAWS)
+    if draws == "normal":
+        return make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+    if scale is not None:
+        typical = np.abs(check_scale("scale", scale, model.n_parameters))
+    else:
+        typical = kind.typical_scale(model, data)
+        if typical is None:
+            raise OptionError(f"draws='scale' needs typical values: give scale= (one value or one per parameter); "
+                              f"{kind.name} data give none of their own")
+    return make_starts(model, starts, seed, x0, typical=typical)

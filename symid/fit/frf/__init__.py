@@ -19,9 +19,10 @@ from typing import Any
 from symid.errors import ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.frf.misfit import check_frf
+from symid.fit.frf.scale import typical_scale
 from symid.fit.options import check_bool, check_known_names
 
-__all__ = ["METHODS", "prepare"]
+__all__ = ["METHODS", "prepare", "typical_scale"]
 
 METHODS = ("scr", "ipopt", "ls", "lm", "auto")
 
