@@ -165,7 +165,7 @@ def _section(cls: str, problems: int, n_starts: int, variants: list[str]) -> Any
 def _f16_section(variants: list[str]) -> Any:
     def run(log: Any) -> dict[str, Any]:
         sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-        import f16
+        import f16_gvt as f16
 
         frf = f16.read_subset()["frf"]
         model = f16.modal_model()

@@ -17,7 +17,7 @@ QUICK = {  # example → arguments of its reduced variant
     "belt_drive_ipopt.py": [],
     "belt_drive_scr.py": ["--quick"],
     "emps.py": ["--quick", "--out", "{tmp}"],
-    "f16.py": ["--quick", "--out", "{tmp}"],
+    "f16_gvt.py": ["--quick", "--out", "{tmp}"],
     "mass_damper_2dof_scr.py": ["--quick"],
     "psd_output_only.py": ["--quick", "--out", "{tmp}"],
 }

@@ -18,7 +18,7 @@ import pytest
 import symid as si
 from symid.fit.frf.misfit import relative_misfit
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "f16.py"
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "f16_gvt.py"
 
 
 @pytest.fixture(scope="module")

@@ -2,10 +2,10 @@
 
 Run::
 
-    .venv/bin/python examples/f16.py --data DIR          # DIR holds the two .mat files below
-    SYMID_F16_DATA=DIR .venv/bin/python examples/f16.py   # the same, the folder from the environment
-    .venv/bin/python examples/f16.py --quick             # the committed derived subset, fewer starts
-    .venv/bin/python examples/f16.py --data DIR --make-subset   # rewrite examples/data/f16_subset.npz
+    .venv/bin/python examples/f16_gvt.py --data DIR          # DIR holds the two .mat files below
+    SYMID_F16_DATA=DIR .venv/bin/python examples/f16_gvt.py   # the same, the folder from the environment
+    .venv/bin/python examples/f16_gvt.py --quick             # the committed derived subset, fewer starts
+    .venv/bin/python examples/f16_gvt.py --data DIR --make-subset   # rewrite examples/data/f16_subset.npz
 
 The data
 --------
