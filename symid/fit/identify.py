@@ -131,6 +131,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     if polisher is not None:
         polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
     x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"))
+    if x0 is not None:
+        estimator.check_start(x0s[0])  # the user's own start: refused with a reason (e.g. outside the bounds)
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
 
