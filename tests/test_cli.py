@@ -264,7 +264,8 @@ def test_interrupted_identify_writes_the_finished_starts(tmp_path, monkeypatch, 
 
 def test_no_fit_is_exit_status_4_with_the_result_written(tmp_path, capsys):
     """One IPOPT iteration from θ = 0 cannot fit the belt drive: the result is still printed and written."""
-    code = main(["identify", "belt_drive", "--method", "ipopt", "--max-iter", "1", "--out", str(tmp_path)])
+    code = main(["identify", "belt_drive", "--method", "ipopt", "--max-iter", "1", "--x0", "theta1=0", "theta2=0",
+                 "theta3=0", "theta4=0", "--out", str(tmp_path)])
     captured = capsys.readouterr()
     assert code == 4
     assert "no start fitted the data (exit status 4)" in captured.out

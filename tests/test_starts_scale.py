@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import symid as si
+from symid.fit.frf.modal import black_box_start
 from symid.fit.frf.scale import parameter_roles, typical_scale
 from symid.fit.starts import draw_starts
 
@@ -42,12 +43,18 @@ def test_default_draws_are_at_the_data_scale_and_normal_draws_are_the_thesis():
     model, truth = chain()
     frf = si.simulate_frf(model, truth, np.logspace(1.5, 3.5, 60))
     typ = typical_scale(model, frf)
+    bb = black_box_start(model, frf, typ, seed=0)
     x = np.array(draw_starts(model, frf, 200, seed=0))
-    assert np.all(np.abs(np.log(x / typ)) <= np.log(3) + 1e-12)  # log-uniform within a factor 3
+    np.testing.assert_array_equal(x[0], bb.theta)  # the black-box start first
+    assert np.all(np.abs(np.log(x[1:] / bb.typical)) <= np.log(3) + 1e-12)  # log-uniform within a factor 3
+    assert np.all(np.abs(np.log10(bb.typical / typ)) < 1.5)  # its magnitudes refine the dimensional analysis
     normal = np.array(draw_starts(model, frf, 200, seed=0, draws="normal"))
     assert np.all(normal >= 0) and np.max(normal) < 6  # |N(0, 1)|: the thesis's draws, not at physical scale
-    given = np.array(draw_starts(model, frf, 50, seed=0, scale=truth))  # the user's scale= wins
-    assert np.all(np.abs(np.log(given / truth)) <= np.log(3) + 1e-12)
+    given = np.array(draw_starts(model, frf, 50, seed=0, scale=truth))  # the user's scale= wins for the draws
+    assert np.all(np.abs(np.log(given[1:] / truth)) <= np.log(3) + 1e-12)
+    own = np.array(draw_starts(model, frf, 5, seed=0, x0=truth))  # a user's start replaces the black-box start
+    np.testing.assert_array_equal(own[0], truth)
+    assert np.all(np.abs(np.log(own[1:] / typ)) <= np.log(3) + 1e-12)
 
 
 def test_identify_without_a_start_reaches_a_physical_model():

@@ -57,6 +57,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         log-uniformly within a factor 3 of each parameter's typical value — the
         ``scale=`` option when given, else read off the data by dimensional analysis
         (:func:`symid.fit.frf.scale.typical_scale`: band centre and response level).
+        On a frequency response without ``x0``, the first start is the black-box start
+        (:func:`symid.fit.frf.modal.black_box_start`: the model's poles placed on those
+        of a vector fit of the data), and the draws are around its magnitudes.
         ``"normal"`` (default for other data): N(0, 1), positive parameters in absolute
         value, and θ = 0 first for a state-space model, as in the thesis (ch. 3-4).
     seed : int, optional
@@ -130,14 +133,15 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         raise OptionError(f"method {estimator.method!r} has no polish step (polish=True applies to SCR)")
     if polisher is not None:
         polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
-    x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"))
+    linear = estimator.method in ("ls", "svf")  # linear least squares: the start plays no part
+    x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"), black_box=not linear)
     if x0 is not None:
         estimator.check_start(x0s[0])  # the user's own start: refused with a reason (e.g. outside the bounds)
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
 
         warn_if_not_identifiable(model, stacklevel=2)
-    if estimator.method in ("ls", "svf"):  # linear least squares: one start says it all
+    if linear:  # one start says it all
         x0s = x0s[:1]
     options_used = dict(estimator.options)
     outcomes: list[StartOutcome] = []

@@ -79,7 +79,7 @@ def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndar
                   + 1j * w[:, None, None, None] * _coef(maps["V"])[None])  # (s, l, n, n)
             G = C @ ZB
             dG = (np.einsum("kpn,snm->spmk", _coef(maps["C"]), ZB)
-                  - np.einsum("spn,sknr,srm->spmk", CZ, dZ, ZB)
+                  - np.einsum("spn,sknr,srm->spmk", CZ, dZ, ZB, optimize=True)
                   + np.einsum("spn,knm->spmk", CZ, _coef(maps["B"])))
             f = {"position": np.ones(w.size, complex), "velocity": 1j * w,
                  "acceleration": -(w**2) + 0j}[model.output]
@@ -92,7 +92,7 @@ def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndar
                                          np.broadcast_to(C.T.astype(complex), (w.size, *C.T.shape))), 1, 2)
         H = C @ RB + D
         dH = (np.einsum("kpn,snm->spmk", _coef(maps["C"]), RB)
-              + np.einsum("spn,knr,srm->spmk", CR, _coef(maps["A"]), RB)
+              + np.einsum("spn,knr,srm->spmk", CR, _coef(maps["A"]), RB, optimize=True)
               + np.einsum("spn,knm->spmk", CR, _coef(maps["B"])))
         if "D" in maps:
             dH = dH + np.moveaxis(_coef(maps["D"]), 0, -1)[None]

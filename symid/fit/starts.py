@@ -11,6 +11,10 @@ declares its parameters, and whatever other parameters it has. Two distributions
   for parameters declared positive (log-uniform within a factor 3 of s), s · N(0, 1) for
   the others — starts of the right physical order of magnitude, no wider than the
   typical values are uncertain (the restarts of method ``"auto"`` search wider).
+  On a frequency response without a user's start, the first start is the black-box
+  start of :func:`symid.fit.frf.modal.black_box_start` (the model's poles placed on
+  those of a vector fit of the data) when there is one, and the typical values of the
+  further draws are its magnitudes.
 """
 
 from __future__ import annotations
@@ -110,7 +114,7 @@ def make_starts(model: Any, starts: int, seed: int | None, x0: Any = None, *, ze
 
 
 def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = None, *, draws: str | None = None,
-                scale: Any = None) -> list[np.ndarray]:
+                scale: Any = None, black_box: bool = True) -> list[np.ndarray]:
     """The starts of :func:`symid.identify` and :func:`symid.compare`: ``x0`` first, then random draws.
 
     Parameters
@@ -122,10 +126,16 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
     draws : {"scale", "normal"}, optional
         ``"scale"``: within a factor 3 of typical values — ``scale`` when given, else the
         data kind's (:func:`symid.fit.frf.scale.typical_scale` for a frequency response);
+        for a frequency response and no ``x0``, the black-box start
+        (:func:`symid.fit.frf.modal.black_box_start`) first when there is one, and its
+        magnitudes as the typical values unless ``scale`` is given.
         ``"normal"``: N(0, 1), with θ = 0 first for a state-space model (the thesis).
         Default: ``"scale"`` for a frequency response, ``"normal"`` for other data.
     scale : float or array_like, optional
         The user's typical values (the methods' ``scale=`` option).
+    black_box : bool, optional
+        Build the black-box start (default ``True``); ``False`` for a method that does not
+        use its start (the linear least squares), where it would only cost time.
 
     Examples
     --------
@@ -155,4 +165,12 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         if typical is None:
             raise OptionError(f"draws='scale' needs typical values: give scale= (one value or one per parameter); "
                               f"{kind.name} data give none of their own")
+    if black_box and x0 is None and kind.name == "frequency response":
+        from symid.fit.frf.modal import black_box_start
+
+        found = black_box_start(model, data, typical, seed=0 if seed is None else check_seed("seed", seed))
+        if found is not None:
+            x0 = found.theta
+            if scale is None:
+                typical = found.typical
     return make_starts(model, starts, seed, x0, typical=typical)

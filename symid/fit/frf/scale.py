@@ -15,9 +15,21 @@ a gain, 1. State-space models ẋ = A x + B u, y = C x + D u: a parameter in A i
 in B, C or D a gain, L (of the level of H · ω₀ when both B and C hold one). A parameter in
 several matrices takes the role of the first in the order M, V, K, A, B, C, D.
 
-These typical values are what :func:`symid.fit.starts.draw_starts` draws around
-(log-uniformly within a factor 3) when no start is given: a start of the right order
-of magnitude, not an estimate.
+A second-order model with a known entry in M, V or K (a known mass, say) and gains
+(parameters in B, C or D) is different: the known entry fixes what L means, and the
+level of |H| belongs to the gains. There L is chosen so that the model's natural
+frequencies at the typical values centre on ω₀ (their geometric mean is ω₀, as they are
+when every entry is a parameter), and the gains g from the level, log g the mean
+log-ratio of the data to the response at g = 1 (when H is homogeneous in the gains,
+H ∝ g^κ, checked numerically; otherwise the rule above). Before, the stiffnesses took
+the level of |H| and the modes left the band (the F-16 modal model of
+``examples/f16_gvt.py``, M = I: every k = 1.3e6, modes at 185 Hz for a band of 2–15 Hz;
+now k = 1.2e3, 5.5 Hz).
+
+These typical values are where :func:`symid.fit.frf.modal.black_box_start` starts, and
+what :func:`symid.fit.starts.draw_starts` draws around (log-uniformly within a factor 3)
+when there is no black-box start: a start of the right order of magnitude, not an
+estimate.
 """
 
 from __future__ import annotations
@@ -116,14 +128,81 @@ def typical_scale(model: Any, data: Any) -> np.ndarray:
             return float("inf")
         return float(np.sum((np.log(mag) - logH) ** 2))
 
+    level = _search(misfit)
+    if level is None:
+        return np.abs(theta(0.0))
+    if second and (gain_b or gain_c) and _pinned(model):
+        gains = _gain_level(model, w, mask, logH, theta, roles)
+        if gains is not None:
+            level, log_gain = gains
+            out = theta(level)
+            out[[r in ("B", "C", "D") for r in roles]] = math.exp(log_gain)
+            return np.abs(out)
+    return np.abs(theta(level))
+
+
+def _search(misfit: Any) -> float | None:
+    """The minimiser of a function of one log-level: a coarse grid, then a bounded search in its bracket."""
     # the level enters H as 1/L (second order) or L (state space, through the gains): a 1-D search over
     # 2 × 80 natural-log units covers any unit system; the grid picks the bracket, the bounded search refines
     grid = np.linspace(-80.0, 80.0, 81)
     values = np.array([misfit(g) for g in grid])
     if not np.any(np.isfinite(values)):
-        return np.abs(theta(0.0))
+        return None
     k = int(np.nanargmin(np.where(np.isfinite(values), values, np.inf)))
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     best = minimize_scalar(misfit, bounds=(lo, hi), method="bounded", options={"xatol": 1e-3})
-    level = float(best.x) if np.isfinite(best.fun) and best.fun <= values[k] else float(grid[k])
-    return np.abs(theta(level))
+    return float(best.x) if np.isfinite(best.fun) and best.fun <= values[k] else float(grid[k])
+
+
+def _pinned(model: Any) -> bool:
+    """M, V or K holds a known nonzero entry: the mechanical level is fixed against it, not free."""
+    return any(np.any(np.asarray(model.maps[n].X0) != 0) for n in ("M", "V", "K"))
+
+
+def _gain_level(model: Any, w: np.ndarray, mask: np.ndarray, logH: np.ndarray, theta: Any,
+                roles: tuple[str, ...]) -> tuple[float, float] | None:
+    """Level L and gain g, for a second-order model with a known entry in M, V or K and gains.
+
+    With a mass (say) known, the stiffness level L is what places the resonances, and
+    the gains (parameters of B, C, D) set the response level. L is chosen so that the
+    model's natural frequencies at the typical values centre on ω₀ (their geometric mean
+    is ω₀, as for a model made of parameters only); when H is homogeneous in the gains,
+    H(L, g) = g^κ H(L, 1) (checked numerically; otherwise ``None``), log g is then the
+    mean log-ratio of the data to H(L, 1).
+    """
+    w0 = math.sqrt(float(w[0]) * float(w[-1]))
+    is_gain = np.array([r in ("B", "C", "D") for r in roles])
+
+    def response(log_level: float, log_gain: float) -> np.ndarray | None:
+        th = theta(log_level)
+        th[is_gain] = math.exp(log_gain)
+        try:
+            with np.errstate(all="ignore"):
+                Hm = np.asarray(model.frequency_response(th, w))
+        except (ModelError, np.linalg.LinAlgError):
+            return None
+        mag = np.abs(Hm[mask])
+        if not np.all(np.isfinite(mag)) or np.any(mag == 0):
+            return None
+        return np.log(mag)
+
+    def centre(log_level: float) -> float:
+        try:
+            with np.errstate(all="ignore"):
+                lam = np.abs(np.linalg.eigvals(model.state_space(theta(log_level)).A))
+        except (ModelError, np.linalg.LinAlgError, ValueError):
+            return float("inf")
+        lam = lam[np.isfinite(lam) & (lam > 0)]
+        return float((np.mean(np.log(lam)) - math.log(w0)) ** 2) if lam.size else float("inf")
+
+    found = _search(centre)
+    if found is None:
+        return None
+    h0, h1 = response(found, 0.0), response(found, 1.0)
+    if h0 is None or h1 is None:
+        return None
+    kappa = float(np.mean(h1 - h0))
+    if not (kappa > 0.5 and np.max(np.abs(h1 - h0 - kappa)) < 1e-6 * max(1.0, kappa)):
+        return None  # not homogeneous in the gains
+    return found, float(np.mean(logH - h0)) / kappa
