@@ -181,7 +181,17 @@ def test_starts_follow_names_not_declaration_order(frf):
                                       [rev.theta_dict(sb)[n] for n in fwd.parameter_names])
     ra = si.identify(fwd, frf, method="ipopt", starts=4, seed=7, identifiability_check=False)
     rb = si.identify(rev, frf, method="ipopt", starts=4, seed=7, identifiability_check=False)
-    assert [s.success for s in ra.starts] == [s.success for s in rb.starts]
+    # identify's own starts follow the names too: the draws exactly, the first (a black-box start, a least-squares
+    # solution computed in declaration order) to its solver's precision (measured 6e-9 relative)
+    for sa, sb in zip(ra.starts, rb.starts, strict=True):
+        np.testing.assert_allclose([fwd.theta_dict(sa.start)[n] for n in fwd.parameter_names],
+                                   [rev.theta_dict(sb.start)[n] for n in fwd.parameter_names], rtol=1e-6)
+    # Which start IPOPT takes to the global minimum is not asserted: its linear algebra pivots in declaration
+    # order, and from one of these starts (measured, start 2) one order ends at a local minimum (misfit 0.44)
+    # and the other at the truth. The best estimate is the truth either way (thesis (4-20), exact data).
+    assert ra.success and rb.success
+    np.testing.assert_allclose(list(ra.theta.values()), [TRUTH_2DOF[n] for n in ra.theta], rtol=1e-6)
+    np.testing.assert_allclose([rb.theta[n] for n in ra.theta], [TRUTH_2DOF[n] for n in ra.theta], rtol=1e-6)
     assert all(s >= 0 for st in a for s in st)  # declared positive: drawn in absolute value
 
 
