@@ -36,7 +36,7 @@ from symid.engine.scr.backend_admm import ADMMOptions
 from symid.engine.scr.compiled import INCONSISTENT_TOL, CompiledProblem, compile
 from symid.engine.scr.maps import Affine
 from symid.engine.scr.problem import Bilinear, BilinearProblem, SumSquares
-from symid.engine.scr.result import Iteration, SCRSolution
+from symid.engine.scr.result import Iteration, ScrProgress, SCRSolution
 from symid.engine.scr.solve import solve
 from symid.engine.scr.variables import Layout, Variable
 
@@ -50,6 +50,7 @@ __all__ = [
     "Iteration",
     "Layout",
     "SCRSolution",
+    "ScrProgress",
     "SumSquares",
     "Variable",
     "compile",

@@ -22,9 +22,11 @@ over-relaxation α (Boyd et al. 2011, §3.4.3):
   ``check_every`` inner iterations. The relative part of the dual tolerance is scaled by
   ρ‖u‖ times the RMS column norm of 𝒜 rather than by ‖𝒜ᵀΛ‖, which vanishes at the
   optimum of a feasibility problem;
-* the tolerances shrink with the last bilinear residual (``tighten``), so the reachable
-  SCR residual is not capped by the ADMM tolerance (with fixed loose tolerances the
-  bilinear residual stalls near them: tests/test_scr_problem.py shows it);
+* the tolerances shrink with the last bilinear residual, or a tenth of the last SCR step
+  when that is smaller (``tighten``), so the reachable SCR residual is not capped by the ADMM
+  tolerance (with fixed loose tolerances the bilinear residual stalls near them:
+  tests/test_scr_problem.py shows it), and on noisy data, where the residual cannot
+  fall, the steps settle instead of jittering at the residual's level;
 * ρ is rebalanced from the ratio of the normalised residuals (residual balancing, as in
   OSQP) when they differ by more than a factor 5; the KKT matrix is then refactorised.
 
@@ -79,9 +81,10 @@ class ADMMOptions:
         Smallest number of inner iterations between two changes of ρ.
     tighten : float or None
         Inexact SCR: the primal tolerance of a sub-problem is lowered to ``tighten`` × the
-        last bilinear residual when that is smaller (the dual one in proportion), so the
-        sub-problems get more accurate as SCR converges instead of capping the reachable
-        residual at the ADMM tolerance. ``None`` keeps the fixed tolerances.
+        smaller of the last bilinear residual and a tenth of the last SCR step when that is smaller
+        (the dual one in proportion), so the sub-problems get more accurate as SCR
+        converges instead of capping the reachable residual at the ADMM tolerance.
+        ``None`` keeps the fixed tolerances.
 
     Examples
     --------
@@ -265,10 +268,15 @@ class ADMMBackend:
         self.taus = [g.weight / rho for g in self.groups]
 
     def step(self, built: list[tuple[np.ndarray, np.ndarray]], W: list[np.ndarray] | None,
-             z0: np.ndarray, residual: float = np.inf) -> tuple[np.ndarray, bool, str, dict]:
+             z0: np.ndarray, residual: float = np.inf, deadline: float | None = None
+             ) -> tuple[np.ndarray, bool, str, dict]:
         """One SCR sub-problem for the blocks M = m0 + G z of ``built``; returns (z, ok, message, timing).
 
-        ``residual`` is the last bilinear residual; with ``tighten`` the tolerances shrink with it.
+        ``deadline`` (a ``time.perf_counter()`` value): the inner loop stops at the first check
+        after it, keeping its inexact iterate (``timing["time_limit"]`` is then true).
+
+        ``residual`` is the accuracy SCR asks for (the smaller of the last bilinear residual and a tenth
+        of the last step); with ``tighten`` the tolerances shrink with it.
         """
         red, opt = self.red, self.opt
         nz, m = red.nz, self.m
@@ -303,6 +311,7 @@ class ADMMBackend:
         check = max(1, int(opt.check_every))
         accuracy = opt.tighten * residual if opt.tighten is not None else np.inf
         last_change = 0
+        timed_out = False
         shifts: list[np.ndarray | None] = [None] * len(self.groups)
         for it in range(1, cap + 1):
             rho, u = self.rho, self.u
@@ -338,6 +347,10 @@ class ADMMBackend:
                 if rp <= eps_p and rd <= eps_d:
                     ok = True
                     break
+                if deadline is not None and time.perf_counter() >= deadline:
+                    timed_out = True
+                    y = y_new
+                    break
                 if opt.adaptive_rho and it - last_change >= opt.adapt_every and rp > 0 and rd > 0:
                     ratio = np.sqrt((rp / max(scale_p, 1e-300)) / (rd / max(scale_d, 1e-300)))
                     if not 0.2 <= ratio <= 5.0:
@@ -360,5 +373,9 @@ class ADMMBackend:
         tm["rho"] = self.rho
         if not np.all(np.isfinite(z)):
             return z0, False, "ADMM diverged (non-finite iterate)", tm
-        msg = "" if ok else f"ADMM stopped at its cap of {cap} inner iterations (primal {rp:.2e}, dual {rd:.2e})"
+        tm["time_limit"] = timed_out
+        if timed_out:
+            msg = f"ADMM stopped by the time limit after {it} inner iterations (primal {rp:.2e}, dual {rd:.2e})"
+        else:
+            msg = "" if ok else f"ADMM stopped at its cap of {cap} inner iterations (primal {rp:.2e}, dual {rd:.2e})"
         return z, True, msg, tm

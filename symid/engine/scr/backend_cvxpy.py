@@ -101,10 +101,13 @@ class CvxpyBackend:
         """Nothing to adapt: the interior-point solve is exact."""
 
     def step(self, built: list[tuple[np.ndarray, np.ndarray]], W: list[np.ndarray] | None,
-             z0: np.ndarray, residual: float = np.inf) -> tuple[np.ndarray, bool, str, dict]:
+             z0: np.ndarray, residual: float = np.inf, deadline: float | None = None
+             ) -> tuple[np.ndarray, bool, str, dict]:
         """One SCR sub-problem for the blocks M = m0 + G z of ``built``; returns (z, ok, message, timing).
 
         ``residual`` (the last bilinear residual) is not needed: the interior-point solve is exact.
+        ``deadline`` (a ``time.perf_counter()`` value): Clarabel gets the time left as its
+        ``time_limit``; a solve it cuts short is discarded (``ok`` false, ``timing["time_limit"]`` true).
         """
         tm = {"build": 0.0, "solve": 0.0}
         t = time.perf_counter()
@@ -127,11 +130,19 @@ class CvxpyBackend:
         solver = self.solver
         if solver == "CLARABEL" and INTERRUPTIBLE_CLARABEL is not None:
             solver = INTERRUPTIBLE_CLARABEL  # the same solve, stopped by Ctrl-C within an iteration
+        opts = {"warm_start": False, **self.solver_options}
+        if deadline is not None:
+            left = deadline - time.perf_counter()
+            if left <= 0:
+                tm["time_limit"] = True
+                return z0, False, "the time limit was spent before the sub-problem started", tm
+            if self.solver == "CLARABEL":
+                opts["time_limit"] = min(float(opts.get("time_limit", np.inf)), left)
         try:
             with warnings.catch_warnings(), native_interrupts(raise_now=False):
                 # an inaccurate solve is reported through the status below
                 warnings.filterwarnings("ignore", message="Solution may be inaccurate", category=UserWarning)
-                self.problem.solve(solver=solver, **{"warm_start": False, **self.solver_options})
+                self.problem.solve(solver=solver, **opts)
         except cp.error.SolverError as exc:
             tm["solve"] = time.perf_counter() - t
             return z0, False, f"cvxpy/{self.solver} failed: {exc}", tm
@@ -149,6 +160,9 @@ class CvxpyBackend:
             self.compile_time += tm["compilation"]
         st = self.problem.status
         if st not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or self.z.value is None:
+            if deadline is not None and time.perf_counter() >= deadline:
+                tm["time_limit"] = True
+                return z0, False, f"cvxpy/{self.solver} stopped by the time limit (status {st!r})", tm
             return z0, False, f"cvxpy/{self.solver} returned status {st!r}", tm
         msg = "" if st == cp.OPTIMAL else f"cvxpy/{self.solver}: {st}"
         return np.asarray(self.z.value, dtype=float).copy(), True, msg, tm

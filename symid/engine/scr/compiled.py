@@ -19,15 +19,12 @@ from collections.abc import Mapping
 from typing import Any
 
 from symid.engine.scr.blocks import LMIGroup, TermGroup, group_lmis, group_terms
-from symid.engine.scr.presolve import Reduced
+from symid.engine.scr.presolve import INCONSISTENT_TOL, Reduced
 from symid.engine.scr.presolve import presolve as _presolve
 from symid.engine.scr.problem import BilinearProblem
 from symid.errors import ModelError
 
 __all__ = ["INCONSISTENT_TOL", "CompiledProblem", "compile"]
-
-#: Residual of the linear equalities above which the presolve calls them inconsistent.
-INCONSISTENT_TOL = 1e-8
 
 
 class CompiledProblem:

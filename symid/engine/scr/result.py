@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Iteration", "SCRSolution"]
+__all__ = ["Iteration", "SCRSolution", "ScrProgress", "print_progress"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,46 @@ class Iteration:
     def to_dict(self) -> dict[str, Any]:
         return {"objective": self.objective, "relaxation": self.relaxation, "residuals": list(self.residuals),
                 "residual": self.residual, "step": self.step, "time": self.time, "timing": dict(self.timing)}
+
+
+@dataclass(frozen=True)
+class ScrProgress:
+    """One SCR iteration of an estimator's start, as its ``callback`` receives it.
+
+    Attributes
+    ----------
+    iteration : int
+        1, 2, …
+    residual : float
+        Largest normalised bilinear residual after the iteration (SCR's stopping measure).
+    misfit : float
+        The estimator's data misfit at the iterate's θ (its ``cost``; ``inf`` where the
+        model cannot be evaluated).
+    elapsed : float
+        Seconds since the start began.
+    theta : numpy.ndarray
+        The parameter iterate.
+    """
+
+    iteration: int
+    residual: float
+    misfit: float
+    elapsed: float
+    theta: np.ndarray = field(repr=False)
+
+
+def print_progress(info: ScrProgress) -> None:
+    """One line per SCR iteration (iteration, residual, misfit, elapsed seconds): what ``verbose=True`` prints.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.engine.scr.result import ScrProgress, print_progress
+    >>> print_progress(ScrProgress(12, 3.1e-4, 2.5e-6, 1.25, np.zeros(3)))
+    scr    iteration    12  residual 3.100e-04  misfit 2.500000e-06       1.25 s
+    """
+    print(f"scr    iteration {info.iteration:5d}  residual {info.residual:.3e}  misfit {info.misfit:.6e}  "
+          f"{info.elapsed:9.2f} s", flush=True)
 
 
 def _jsonable(v: Any) -> Any:
