@@ -231,6 +231,33 @@ class ScrEstimator(Estimator):
             opts["admm"] = admm
         return opts
 
+    def _progress_options(self, callback: Any, verbose: Any) -> None:
+        """Validate and keep ``callback`` (a function of one :class:`symid.engine.scr.ScrProgress`) and
+        ``verbose`` (print one line per iteration)."""
+        if callback is not None and not callable(callback):
+            raise OptionError(f"callback must be a function of one ScrProgress (or None); got "
+                              f"{type(callback).__name__}")
+        self._callback, self._verbose = callback, check_bool("verbose", verbose)
+
+    def engine_monitor(self, theta_of: Callable[[Mapping[str, Any]], Any], t0: float) -> Any:
+        """The engine's ``monitor`` reporting each iteration to ``callback``/``verbose`` as a
+        :class:`symid.engine.scr.ScrProgress` (θ from the iterate by ``theta_of``, its data misfit,
+        seconds since ``t0``); ``None`` when neither is asked for (nothing is computed then)."""
+        from symid.engine.scr.result import ScrProgress, print_progress
+
+        callback, verbose = getattr(self, "_callback", None), getattr(self, "_verbose", False)
+        if callback is None and not verbose:
+            return None
+
+        def monitor(k: int, x: Mapping[str, Any], it: Any, elapsed: float) -> bool:
+            theta = np.asarray(theta_of(x), dtype=float).reshape(-1)
+            info = ScrProgress(k, float(it.residual), self.misfit(theta), time.perf_counter() - t0, theta)
+            if verbose:
+                print_progress(info)
+            return bool(callback(info)) if callback is not None else False
+
+        return monitor
+
     def _setup_engine(self, problem: Any, solve_options: dict[str, Any], *, presolve: bool = True,
                       normalize: bool = True, equalities: str = "exact") -> None:
         from symid import scr
@@ -240,12 +267,13 @@ class ScrEstimator(Estimator):
                                     normalize=check_bool("normalize", normalize), equalities=equalities)
         self._solve_opts = solve_options
 
-    def engine_solve(self, start: Mapping[str, Any], callback: Any = None, compiled: Any = None) -> Any:
+    def engine_solve(self, start: Mapping[str, Any], callback: Any = None, compiled: Any = None,
+                     monitor: Any = None) -> Any:
         """The engine's :class:`symid.engine.scr.SCRSolution` from ``start`` (by variable name)."""
         from symid import scr
 
         return scr.solve(self.compiled if compiled is None else compiled, start, callback=callback,
-                         **self._solve_opts)
+                         monitor=monitor, **self._solve_opts)
 
     @staticmethod
     def engine_finished(sol: Any) -> bool:
