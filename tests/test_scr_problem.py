@@ -128,9 +128,13 @@ def test_max_iter_message_says_when_the_iterate_is_stationary():
     # x² = 1 and x² = 4 cannot both hold: SCR stops moving with a residual it cannot reduce
     inconsistent = scr.BilinearProblem(variables=[x], bilinear=[
         scr.Bilinear(A=[[x]], P=[[1]], B=[[x]], C=[[1]]), scr.Bilinear(A=[[x]], P=[[1]], B=[[x]], C=[[4]])])
-    sol = scr.solve(inconsistent, x0={x: 1.0}, max_iter=5)
+    sol = scr.solve(inconsistent, x0={x: 1.0}, max_iter=5, stationary=None)
     assert sol.status == "max_iter" and not sol.success
     assert "the iterate is stationary" in sol.message and "cannot all hold" in sol.message
+    # by default SCR stops once the iterate has stopped moving (3 steps in a row) short of tol
+    sol = scr.solve(inconsistent, x0={x: 1.0}, max_iter=50)
+    assert sol.status == "stationary" and not sol.success and sol.info["stationary"]
+    assert sol.iterations < 50 and "cannot all hold" in sol.message
     moving = scr.solve(rosenbrock(), x0={x: -1.9, y: 2}, max_iter=1)  # one step from far away
     assert "last step" in moving.message and "stationary" not in moving.message
 
