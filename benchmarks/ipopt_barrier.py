@@ -91,6 +91,12 @@ def _solvers(model: Any, data: Any, variants: list[str], bounded: bool = True) -
                            **VARIANTS[v]) for v in variants}
 
 
+def _cost(rec: dict[str, Any]) -> float:
+    """A logged misfit (a non-finite one is logged as null)."""
+    c = rec.get("cost")
+    return float("inf") if c is None or not np.isfinite(c) else float(c)
+
+
 def _record(model: Any, data: Any, run: Any, truth: np.ndarray) -> dict[str, Any]:
     theta = np.asarray(run.z, dtype=float)
     return {"theta": theta.tolist(), "cost": relative_misfit(model, data, theta), "status": run.status,
@@ -117,7 +123,7 @@ def _case(log: Any, key: str, model: Any, data: Any, truth: np.ndarray, starts: 
     candidates = dict(from_truth)
     if np.all(np.asarray(free["theta"])[np.asarray(model.positive, bool)] >= 0):
         candidates["unbounded"] = free  # admissible: the bounds are not active at the unbounded optimum
-    best = min(candidates, key=lambda v: candidates[v]["cost"] if np.isfinite(candidates[v]["cost"]) else np.inf)
+    best = min(candidates, key=lambda v: _cost(candidates[v]))
     ref = candidates[best]
     ref_theta = np.asarray(ref["theta"])
     out: dict[str, Any] = {"reference": {"cost": ref["cost"], "error": ref["error"], "status": ref["status"],
@@ -129,12 +135,12 @@ def _case(log: Any, key: str, model: Any, data: Any, truth: np.ndarray, starts: 
         for kind, xs in starts.items():
             for i, x in enumerate(xs):
                 r = logged(log, f"{key}/{kind}{i}/{v}", lambda v=v, x=x: _record(model, data, get(v).solve(x), truth))
-                r["success"] = bool(r["error"] <= max(2 * ref["error"], 1e-3)
-                                    or r["cost"] <= ref["cost"] * (1 + 1e-3) + 1e-14)
+                err = np.inf if r["error"] is None else r["error"]
+                r["success"] = bool(err <= max(2 * ref["error"], 1e-3) or _cost(r) <= _cost(ref) * (1 + 1e-3) + 1e-14)
                 runs[f"{kind}{i}"] = {k: r[k] for k in ("cost", "error", "status", "iterations", "seconds", "success")}
         out["variants"][v] = {"stay": {"moved": moved, "cost": stay["cost"], "iterations": stay["iterations"],
                                        "status": stay["status"], "seconds": stay["seconds"],
-                                       "kept": bool(stay["cost"] <= ref["cost"] * (1 + 1e-6) + 1e-14)},
+                                       "kept": bool(_cost(stay) <= _cost(ref) * (1 + 1e-6) + 1e-14)},
                               "runs": runs}
     return out
 
