@@ -34,7 +34,8 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     ``"scr"`` on a second-order model whose C or B is known, square and invertible runs
     the exact linear least squares instead (reported as method ``"ls"``, with the reason
     in ``options["chosen_because"]``); ``force_scr=True`` runs SCR anyway, and SCR
-    options given without it are refused (they would be ignored).
+    options given without it are refused (they would be ignored), except ``variance``,
+    which both take.
     """
     from symid.fit.frf.ipopt import IpoptFRF
     from symid.fit.frf.lm import AutoFRF, LmFRF
@@ -59,11 +60,12 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     check_known_names("method 'scr' (frequency response)", opts, (*ScrFRF.option_names(), "force_scr"))
     case = ls_applicable(model) if isinstance(model, SecondOrderModel) else None
     if case is not None and not force:
+        shared = {k: opts.pop(k) for k in ("variance",) if k in opts}  # options both methods take
         if opts:
             raise OptionError(f"options {', '.join(sorted(opts))} are SCR options, but the linear least squares "
                               f"({case} case, thesis (4-10)/(4-11)) applies and runs instead; pass force_scr=True "
                               "to run SCR")
-        est = LinearFRF.create(model, data, {"case": case}, noise_floor=noise_floor)
+        est = LinearFRF.create(model, data, {"case": case, **shared}, noise_floor=noise_floor)
         est.options["chosen_because"] = f"scr → ls: linear special case ({case})"
         return est
     return ScrFRF.create(model, data, opts, noise_floor=noise_floor)

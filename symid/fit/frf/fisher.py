@@ -104,7 +104,10 @@ class FrfFisher(FisherInformation):
         case = getattr(self, "case", None)
         if self.method != "ls" or case not in ("sensors", "actuators"):
             return None
-        return _ls_sensitivity(self.model, self.data, np.asarray(theta, dtype=float), case) * self._norm()
+        G = _ls_sensitivity(self.model, self.data, np.asarray(theta, dtype=float), case,
+                            getattr(self, "equation_weights", None))
+        sw = self._sqrt_weights().ravel()  # r = √w (H − H(θ)) / ‖√w H‖, so dH = ‖√w H‖ dr / √w
+        return G * (self._norm() / np.concatenate([sw, sw]))[None, :]
 
     def uncertainty_note(self) -> str:
         """Said for the methods that do not minimise the FRF misfit."""
@@ -118,11 +121,14 @@ class FrfFisher(FisherInformation):
                 "least-squares estimate, evaluated at its θ̂ (polish=True reaches that estimate)")
 
 
-def _ls_sensitivity(model: Any, data: Any, theta: np.ndarray, case: str) -> np.ndarray:
+def _ls_sensitivity(model: Any, data: Any, theta: np.ndarray, case: str,
+                    weights: np.ndarray | None = None) -> np.ndarray:
     """G (l, 2spm) with dθ̂ = G [Re dH; Im dH] (entries in (s, p, m) order) for the linear least squares of
     thesis (4-10) (sensors: eᵢ = Zᵢ C⁻¹ Ĥᵢ − B(θ)) or (4-11) (actuators: eᵢ = Ĥᵢ B⁻¹ Zᵢ − C(θ)), Ĥ = H / f(ω),
     Z = K − ω²M + jωV (second order) or jωI − A: dθ̂ = −(JₑᵀJₑ)⁻¹ Jₑᵀ de with de linear in dH (the term in
-    e·dJₑ is of second order in the noise)."""
+    e·dJₑ is of second order in the noise). ``weights`` (one per complex equation, shaped as the equations of
+    every frequency) multiply the equations of the noise-weighted least squares (``LinearFRF.equation_weights``):
+    dθ̂ = −(JₑᵀΩ²Jₑ)⁻¹ JₑᵀΩ² de."""
     w = np.asarray(data.w, dtype=float)
     H = np.asarray(data.H, dtype=complex)
     _, p, m = H.shape
@@ -158,4 +164,8 @@ def _ls_sensitivity(model: Any, data: Any, theta: np.ndarray, case: str) -> np.n
 
     Lc = scipy.linalg.block_diag(*blocks)
     L_real = np.block([[Lc.real, -Lc.imag], [Lc.imag, Lc.real]])
+    if weights is not None:
+        om = np.asarray(weights, dtype=float).ravel()
+        om = np.concatenate([om, om])[:, None]
+        Je_real, L_real = Je_real * om, L_real * om
     return -np.linalg.lstsq(Je_real, L_real, rcond=None)[0]

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from symid.errors import ModelError
-from symid.fit.frf.misfit import FrfEstimator
+from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted
 from symid.fit.options import check_bool, check_choice
 from symid.fit.result import StartOutcome
 
@@ -56,7 +56,7 @@ def _why_not(model: Any) -> str:
     return "; ".join(reasons)
 
 
-class LinearFRF(FrfEstimator):
+class LinearFRF(NoiseWeighted, FrfEstimator):
     """The linear least-squares estimate (thesis (4-10)/(4-11) and their state-space analogue).
 
     For a second-order model, with Z(ω, θ) = K(θ) − ω²M(θ) + jωV(θ) and Ĥ the
@@ -78,6 +78,24 @@ class LinearFRF(FrfEstimator):
     that the data wanted negative usually leaves a large misfit, which is then reported
     as a failure, never as a success.
 
+    Noise weighting (``variance``): the equations of frequency ωᵢ are divided by the
+    standard deviation of the noise they carry from Hᵢ. An error dH in the data enters
+    (4-10) as Z C⁻¹ dĤ (column k of the equation error from column k of dH, i.e. input
+    k, mixed over the outputs by C⁻¹) and (4-11) as dĤ B⁻¹ Z (row j from row j of dH,
+    output j, mixed over the inputs by B⁻¹). So in the sensors case column k of the
+    equations at ωᵢ is divided by σ̄ᵢₖ, σ̄²ᵢₖ = Σⱼ ‖(C⁻¹)₍:,ⱼ₎‖² σ²ᵢⱼₖ / Σⱼ ‖(C⁻¹)₍:,ⱼ₎‖²
+    (the mean variance of the entries of C⁻¹ dHᵢ's column k), and in the actuators case
+    row j by σ̄ᵢⱼ, σ̄²ᵢⱼ = Σₖ ‖(B⁻¹)₍ₖ,:₎‖² σ²ᵢⱼₖ / Σₖ ‖(B⁻¹)₍ₖ,:₎‖²; with one variance per
+    line both are σᵢ. What the equations themselves do to the noise, the factor
+    Z(ωᵢ, θ)/fᵢ (fᵢ = 1, jωᵢ, −ωᵢ² for position, velocity, acceleration), depends on θ
+    and is left as it is in (4-10)/(4-11): the weighted equations carry the equation
+    error the unweighted ones carry on noise of equal variance on every line, so a
+    variance constant over the band gives exactly the unweighted estimate, and the
+    estimate stays linear in the data, in one solve. It is not the maximum-likelihood
+    estimate (``polish=True`` is: IPOPT on the same weights). ``misfit``, the success
+    rule and the uncertainty (propagated through the weighted solve, the variance as
+    the given noise) use the same variance.
+
     Parameters
     ----------
     model : StateSpaceModel or SecondOrderModel
@@ -88,6 +106,7 @@ class LinearFRF(FrfEstimator):
         Keep the parameters declared ``positive=True`` ≥ 0 (default True; bounded least squares).
         ``False`` returns the unconstrained solution, never a success when a declared-positive
         parameter comes out negative.
+    {variance}
 
     Examples
     --------
@@ -103,7 +122,8 @@ class LinearFRF(FrfEstimator):
 
     method = "ls"
 
-    def __init__(self, model: Any, data: Any, *, case: str | None = None, positivity: bool = True):
+    def __init__(self, model: Any, data: Any, *, case: str | None = None, positivity: bool = True,
+                 variance: Any = "data"):
         if case is None:
             case = ls_applicable(model)
         if case is None:
@@ -116,7 +136,8 @@ class LinearFRF(FrfEstimator):
             raise ModelError(f"case='actuators' needs B known, square and invertible; here: {_why_not(model)}")
         self.model, self.data, self.case = model, data, case
         self.positivity = check_bool("positivity", positivity)
-        self.options = {"case": case, "positivity": self.positivity}
+        label = self.set_variance(variance)
+        self.options = {"case": case, "positivity": self.positivity, "variance": label}
         w = np.asarray(data.w, dtype=float)
         H = np.asarray(data.H, dtype=complex)
         second = "M" in model.maps
@@ -128,6 +149,8 @@ class LinearFRF(FrfEstimator):
         maps = model.maps
         l = model.n_parameters
         rows0, rowsJ = [], []
+        self.equation_weights = None if self.line_variance is None else \
+            _equation_weights(self.line_variance, maps, case)
         for i, wi in enumerate(w):
             if second:
                 Z0 = maps["K"].X0 - wi**2 * maps["M"].X0 + 1j * wi * maps["V"].X0
@@ -144,6 +167,9 @@ class LinearFRF(FrfEstimator):
                 G = Hh[i] @ np.linalg.inv(maps["B"].X0)           # Ĥ B⁻¹ = C Z⁻¹
                 r0 = G @ Z0 - maps["C"].X0
                 rJ = np.einsum("pn,knm->kpm", G, Zi) - maps["C"].Xi
+            if self.equation_weights is not None:  # 1/σ̄ per equation (class text)
+                r0 = r0 * self.equation_weights[i]
+                rJ = rJ * self.equation_weights[i][None]
             rows0.append(r0.reshape(-1))
             rowsJ.append(rJ.reshape(l, -1).T)
         r0 = np.concatenate(rows0)
@@ -176,7 +202,7 @@ class LinearFRF(FrfEstimator):
         t0 = time.perf_counter()
         theta = np.linalg.lstsq(self._J / self._norms, -self._r0, rcond=None)[0] / self._norms
         start = np.zeros(self.model.n_parameters) if x0 is None else np.asarray(x0, dtype=float)
-        msg = f"linear least squares ({self.case} case)"
+        msg = f"linear least squares ({self.case} case{'' if self.line_weights is None else ', noise-weighted'})"
         pos = np.array(self.model.positive, dtype=bool)
         negative = [n for n, p, v in zip(self.model.parameter_names, pos, theta, strict=True) if p and v < 0]
         if negative and self.positivity:
@@ -186,3 +212,22 @@ class LinearFRF(FrfEstimator):
             msg += f"; parameters declared positive came out negative: {', '.join(negative)} (positivity=False)"
         return self.outcome(start, theta, finished=True, status="solved", message=msg, iterations=1,
                             wall_time=time.perf_counter() - t0)
+
+
+def _equation_weights(var: np.ndarray, maps: Any, case: str) -> np.ndarray:
+    """1/σ̄ for every complex equation of every frequency, shaped as the equations (s, n, m) (sensors) or
+    (s, p, n) (actuators), scaled to RMS 1 (the class text says which σ̄)."""
+    if case == "sensors":
+        Ci = np.linalg.inv(maps["C"].X0)                      # n × p
+        c = np.sum(np.abs(Ci) ** 2, axis=0)                   # ‖(C⁻¹)₍:,ⱼ₎‖² per output j
+        sbar = np.einsum("j,sjk->sk", c, var) / np.sum(c)     # per input k
+        wts = np.broadcast_to((1.0 / np.sqrt(sbar))[:, None, :], (var.shape[0], Ci.shape[0], var.shape[2]))
+    else:
+        Bi = np.linalg.inv(maps["B"].X0)                      # m × n
+        c = np.sum(np.abs(Bi) ** 2, axis=1)                   # ‖(B⁻¹)₍ₖ,:₎‖² per input k
+        sbar = np.einsum("k,sjk->sj", c, var) / np.sum(c)     # per output j
+        wts = np.broadcast_to((1.0 / np.sqrt(sbar))[:, :, None], (var.shape[0], var.shape[1], Bi.shape[1]))
+    return np.array(wts / np.sqrt(np.mean(wts**2)))
+
+
+LinearFRF.__doc__ = (LinearFRF.__doc__ or "").replace("{variance}", VARIANCE_OPTION_DOC)

@@ -11,7 +11,8 @@ from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.frf.fisher import FrfFisher
 
-__all__ = ["FrfEstimator", "check_frf", "frf_weights", "relative_misfit", "relative_residuals"]
+__all__ = ["FrfEstimator", "NoiseWeighted", "check_frf", "frf_variance", "frf_weights", "relative_misfit",
+           "relative_residuals"]
 
 VARIANCE_OPTION_DOC = """variance : "data", None or array_like, optional
         Noise weighting of the FRF criterion, Σᵢ Σ_jk |Hᵢ,jk − H(ωᵢ, θ)_jk|² / σ²ᵢ,jk
@@ -98,6 +99,45 @@ def frf_weights(data: Any, variance: Any = "data") -> np.ndarray | None:
     return wts / float(np.mean(wts))
 
 
+def frf_variance(data: Any, variance: Any = "data") -> np.ndarray | None:
+    """The noise variance σ² per entry of H behind :func:`frf_weights` (checked the same way).
+
+    Parameters
+    ----------
+    data : FrequencyData
+    variance : "data", None or array_like
+        As :func:`frf_weights`.
+
+    Returns
+    -------
+    numpy.ndarray of shape (s, p, m), or None
+        ``None`` when the fit weighs every entry alike.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.fit.frf.misfit import frf_variance
+    >>> frf = si.FrequencyData([1.0, 2.0], [1.0, 1.0], variance=[1e-4, 4e-4])
+    >>> frf_variance(frf).ravel().tolist()
+    [0.0001, 0.0004]
+    """
+    if frf_weights(data, variance) is None:
+        return None
+    H = np.asarray(data.H)
+    var = np.asarray(data.variance if isinstance(variance, str) else variance, dtype=float)
+    if var.shape == (H.shape[0],):
+        var = np.broadcast_to(var[:, None, None], H.shape)
+    return np.array(var, dtype=float).reshape(H.shape)
+
+
+def variance_label(variance: Any, weights: np.ndarray | None) -> str | None:
+    """How a fit is weighted, for its ``options``: ``"data"``, ``"given"``, ``None`` (equal weights asked for)
+    or ``"data (none: equal weights)"``."""
+    if weights is None:
+        return None if variance is None else "data (none: equal weights)"
+    return "data" if isinstance(variance, str) else "given"
+
+
 def _model_response(model: Any, data: Any, theta: Any) -> np.ndarray | None:
     try:
         Hm = model.frequency_response(theta, data.w)
@@ -168,3 +208,41 @@ class FrfEstimator(Estimator, FrfFisher):
     def n_data(self) -> int:
         """2·s·p·m real values."""
         return 2 * int(np.asarray(self.data.H).size)
+
+
+class NoiseWeighted:
+    """Mixin of an FRF method with a ``variance=`` option: the weights, the variance, and the noise floor it
+    gives, as :class:`~symid.fit.frf.ipopt.IpoptFRF` has them.
+
+    :meth:`set_variance` sets ``line_weights`` (so that ``misfit`` and the success rule are the
+    weighted ones) and ``line_variance`` (the given noise of the uncertainty); ``noise_floor``
+    is then, unless given, Σ w σ² / Σ w |H|², the weighted relative misfit the declared noise
+    alone leaves at the truth, so the fit is judged against that noise.
+    Put it before :class:`FrfEstimator` among the bases.
+    """
+
+    data: Any
+    line_weights: np.ndarray | None = None
+    line_variance: np.ndarray | None = None
+    _noise_floor: float | None = None
+    _variance_floor: float | None = None
+
+    def set_variance(self, variance: Any) -> str | None:
+        """Weights and variance from the ``variance`` option; returns its label for ``options``."""
+        self.line_weights = frf_weights(self.data, variance)
+        self.line_variance = frf_variance(self.data, variance) if self.line_weights is not None else None
+        self._variance_floor = None
+        if self.line_variance is not None:
+            w = self.line_weights
+            self._variance_floor = float(np.sum(w * self.line_variance) /
+                                         np.sum(w * np.abs(np.asarray(self.data.H)) ** 2))
+        return variance_label(variance, self.line_weights)
+
+    @property
+    def noise_floor(self) -> float | None:
+        """The given ``noise_floor``; else, with a variance, the relative misfit that noise leaves at the truth."""
+        return self._noise_floor if self._noise_floor is not None else self._variance_floor
+
+    @noise_floor.setter
+    def noise_floor(self, value: float | None) -> None:
+        self._noise_floor = value

@@ -78,7 +78,7 @@ import numpy as np
 from symid import scr
 from symid.errors import ModelError, OptionError
 from symid.fit.base import ScrEstimator, identity_coef, mvk_lmis, positivity_lmis, theta_coef
-from symid.fit.frf.misfit import FrfEstimator
+from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted
 from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale, check_seed
 from symid.fit.polish import polish_outcome
 from symid.fit.result import StartOutcome
@@ -93,7 +93,7 @@ _AUX_INITS = ("random", "model", "zero")
 _BUILT_KEPT = 4  # problems kept for the automatic scales of the last starts
 
 
-class ScrFRF(ScrEstimator, FrfEstimator):
+class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
     """Sequential convex relaxation on a frequency response, built once, run per start.
 
     Parameters
@@ -113,7 +113,18 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         for a second-order one, each a number or one number per frequency (missing
         families weigh 1). Default: 1 everywhere, as the thesis's examples. The engine
         first equilibrates every term (:mod:`symid.engine.scr.presolve`), so a weight means the
-        same whatever the units of H.
+        same whatever the units of H. With a noise variance (``variance``) every family's
+        weight at ωᵢ is further multiplied by the noise weight of that line (below).
+    {variance}
+        SCR weighs the relaxation of every equation at ωᵢ (λᵢ, γᵢ, δᵢ, ρᵢ) by
+        qᵢ = σ̄⁻¹ᵢ / mean(σ̄⁻¹), σ̄²ᵢ the mean variance of the entries of Hᵢ: a line with
+        ten times the noise weighs ten times less (the nuclear norm grows like the
+        equation error, not its square). Equal variances give q = 1, the unweighted SCR.
+        The misfit SCR reports, its success rule (judged against the declared noise) and
+        the IPOPT polish of ``"scr+polish"`` use the same variance. Equations the presolve
+        solves as linear least squares (the output equations when they and the known
+        rows fix every unknown, e.g. the belt drive) keep their weights by the size of
+        their terms: there the noise enters through the polish only.
     lmis : bool, optional
         Second-order models: M, V, K ⪰ 0 (default True; thesis §5-7 shows they are decisive).
     positivity : bool, optional
@@ -187,7 +198,7 @@ class ScrFRF(ScrEstimator, FrfEstimator):
                  tol: float = 1e-6, aux_init: str = "model", seed: int = 0, presolve: bool = True,
                  heuristic: str = "nuclear", admm: Any = None, scale: Any = None, time_limit: float | None = None,
                  polish_misfit: float | None = 1e-8, trial_max_iter: int = 100, callback: Any = None,
-                 verbose: bool = False):
+                 verbose: bool = False, variance: Any = "data"):
         substitution = check_choice("substitution", substitution, ("gamma", "psi", "both"))
         self.aux_init = check_choice("aux_init", aux_init, _AUX_INITS)
         lmis, positivity = check_bool("lmis", lmis), check_bool("positivity", positivity)
@@ -206,7 +217,12 @@ class ScrFRF(ScrEstimator, FrfEstimator):
         given = not self._auto
         self.scale = check_scale("scale", scale, l) if given else np.ones(l)
         self._aux_scale, self._psi_scale = self._aux_scales(self.scale if given else None)
+        variance_label = self.set_variance(variance)
+        self._variance = variance
         lam = self._weights(weights)
+        if self.line_variance is not None:  # noise weights of the lines (class text)
+            q = 1.0 / np.sqrt(np.mean(self.line_variance.reshape(self.w.size, -1), axis=1))
+            lam = {k: v * (q / np.mean(q)) for k, v in lam.items()}
         solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, heuristic=heuristic,
                                           admm=admm, time_limit=time_limit)
         if admm is None and backend == "admm" and self.second_order:
@@ -216,7 +232,7 @@ class ScrFRF(ScrEstimator, FrfEstimator):
                         "tol": tol, "aux_init": aux_init, "seed": seed, "presolve": presolve,
                         "heuristic": heuristic, "scale": self.scale.tolist() if given else scale,
                         "time_limit": solve_opts["time_limit"], "callback": None if callback is None else "given",
-                        "verbose": self._verbose}
+                        "verbose": self._verbose, "variance": variance_label}
         self.polish_misfit = polish_misfit
         self.trial_max_iter = check_int("trial_max_iter", trial_max_iter, low=1, high=10**7)
         self.options["trial_max_iter"] = self.trial_max_iter
@@ -229,12 +245,13 @@ class ScrFRF(ScrEstimator, FrfEstimator):
 
     def polisher(self) -> Any:
         """IPOPT on the same frequency response (:class:`~symid.fit.frf.ipopt.IpoptFRF`), with the same
-        positivity, scale and time limit (its ``run`` takes per-run ``max_iter``/``time_limit`` caps)."""
+        positivity, scale, noise variance and time limit (its ``run`` takes per-run ``max_iter``/``time_limit``
+        caps)."""
         from symid.fit.frf.ipopt import IpoptFRF
 
         scale = None if self._auto else self.options["scale"]  # IPOPT scales itself from its start
         return IpoptFRF(self.model, self.data, positivity=self.options["positivity"], scale=scale,
-                        time_limit=self.options["time_limit"])
+                        time_limit=self.options["time_limit"], variance=self._variance)
 
     # -- problem construction ---------------------------------------------------------------
     def _families(self) -> dict[str, str]:
@@ -541,3 +558,6 @@ class ScrFRF(ScrEstimator, FrfEstimator):
                 f"each) did not fit") if trials else ""
         return dataclasses.replace(final, iterations=final.iterations + spent, wall_time=time.perf_counter() - t0,
                                    message=final.message + note)
+
+
+ScrFRF.__doc__ = (ScrFRF.__doc__ or "").replace("{variance}", VARIANCE_OPTION_DOC)
