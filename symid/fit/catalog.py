@@ -32,12 +32,13 @@ def estimator_classes() -> list[tuple[str, str, type]]:
     from symid.fit.spectra.ipopt import IpoptPSD
     from symid.fit.spectra.scr import ScrPSD
     from symid.fit.timeseries.oe import OutputError
+    from symid.fit.timeseries.srivc import SimplifiedRIVC
     from symid.fit.timeseries.svf import StateVariableFilter
 
     frf, spec, bb = "frequency response", "spectra", "black box / I/O"
     return [(frf, "scr", ScrFRF), (frf, "ipopt", IpoptFRF), (frf, "ls", LinearFRF),
             (spec, "scr", ScrPSD), (spec, "ipopt", IpoptPSD), ("time series", "oe", OutputError),
-            ("time series", "svf", StateVariableFilter),
+            ("time series", "svf", StateVariableFilter), ("time series", "srivc", SimplifiedRIVC),
             (bb, "scr (state space)", ScrSimilarity), (bb, "als", AlsSimilarity), (bb, "gb", GbSimilarity),
             (bb, "ipopt (state space)", IpoptSimilarity), (bb, "scr (second order)", ScrSimilarity2nd),
             (bb, "ls (second order)", LinearSimilarity2nd), (bb, "ipopt (second order)", IpoptSimilarityFRF)]

@@ -133,7 +133,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         raise OptionError(f"method {estimator.method!r} has no polish step (polish=True applies to SCR)")
     if polisher is not None:
         polisher.noise_floor = estimator.noise_floor  # the polished estimate is judged by the same rule
-    linear = estimator.method in ("ls", "svf")  # linear least squares: the start plays no part
+    # linear least squares (and SRIVC from its own least-squares start): the start plays no part
+    linear = estimator.method in ("ls", "svf") or (estimator.method == "srivc" and estimator.options["init"] == "ls")
     x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"), black_box=not linear)
     if x0 is not None:
         estimator.check_start(x0s[0])  # the user's own start: refused with a reason (e.g. outside the bounds)

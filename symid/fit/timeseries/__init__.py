@@ -14,6 +14,10 @@ one IOData         ``scr``,    the black box of N4SID + exact ``d2c`` (thesis Al
 IOData, TimeSeries ``svf``     least squares on state-variable-filtered derivatives, for models whose
 or a list of them              states are all measured (:mod:`~symid.fit.timeseries.svf`); judged on
                                the samples like the N4SID route
+IOData, TimeSeries ``srivc``   simplified refined instrumental variables: the input-output equation
+or a list of them              D(s, θ) y = N(s, θ) u prefiltered by the model's own 1/D(s, θ̂),
+                               iterated, for models whose transfer-function coefficients are affine
+                               in θ (:mod:`~symid.fit.timeseries.srivc`); judged on the samples
 =================  ==========  =====================================================================
 
 ``oe`` takes non-uniform sample times, several experiments, free responses (u ≡ 0) and
@@ -31,7 +35,7 @@ from symid.fit.base import Estimator
 __all__ = ["BLACK_BOX_METHODS", "METHODS", "prepare"]
 
 BLACK_BOX_METHODS = ("scr", "als", "gb", "ipopt", "ls")
-METHODS = ("oe", "svf", *BLACK_BOX_METHODS)
+METHODS = ("oe", "svf", "srivc", *BLACK_BOX_METHODS)
 
 
 def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
@@ -47,6 +51,10 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
         from symid.fit.timeseries.svf import StateVariableFilter
 
         return StateVariableFilter.create(model, data, options, noise_floor=noise_floor)
+    if method == "srivc":
+        from symid.fit.timeseries.srivc import SimplifiedRIVC
+
+        return SimplifiedRIVC.create(model, data, options, noise_floor=noise_floor)
     if not isinstance(data, IOData):
         raise DataError(f"method {method!r} goes through N4SID, which needs one uniformly sampled record (IOData); "
                         "for several records or non-uniform sample times use method='oe'")
