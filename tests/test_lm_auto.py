@@ -153,3 +153,26 @@ def test_noise_weighting_uses_the_data_variance():
     # 0.032 for the summed squared relative errors (trace of (JᵀΣ⁻¹J)⁻¹ over that of the sandwich
     # (JᵀJ)⁻¹JᵀΣJ(JᵀJ)⁻¹, J = ∂H/∂log θ); with 8 records, a ratio below 0.3 leaves a margin of ten.
     assert np.mean(sq["weighted"]) < 0.3 * np.mean(sq["equal"])
+
+
+def test_the_declared_noise_judges_lm_as_it_judges_ipopt():
+    """With a per-line variance, lm and auto judge an estimate against the noise it declares, as IPOPT does
+    (issue 18: the F-16 fit was 'success' by lm's whiteness rule and not by IPOPT's noise floor)."""
+    model = chain2()
+    w = grid(TRUTH)
+    H = np.asarray(si.simulate_frf(model, TRUTH, w).H)
+    sd = 1e-3 * np.abs(H)
+    rng = np.random.default_rng(0)
+    noisy = H + sd * (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape)) / np.sqrt(2)
+    frf = si.FrequencyData(w, noisy, variance=sd**2)
+    floors = {m: prepare(model, frf, m, {}).noise_floor for m in ("lm", "auto", "ipopt")}
+    # the weighted misfit the declared noise leaves at the truth: Σ wσ² / Σ w|H|² = s / Σ|H/σ|², w = 1/σ²
+    expected = w.size / np.sum(np.abs(noisy / sd) ** 2)
+    np.testing.assert_allclose(list(floors.values()), expected, rtol=1e-12)
+    # the truth fits the declared noise for every method; 2 % off in one spring does not, for any method
+    for theta, fits in ((TRUTH, True), (TRUTH * np.array([1, 1, 1, 1, 1.02, 1]), False)):
+        verdicts = {m: prepare(model, frf, m, {}).outcome(theta, theta, finished=True, status="given", message="",
+                                                          iterations=0, wall_time=0.0).success
+                    for m in ("lm", "auto", "ipopt")}
+        assert verdicts == dict.fromkeys(verdicts, fits), (theta, verdicts)
+    assert prepare(model, frf, "lm", {"variance": None}).noise_floor is None  # equal weights declare no noise

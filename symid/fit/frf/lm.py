@@ -56,7 +56,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from symid.errors import ModelError, OptionError
-from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, frf_weights
+from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted
 from symid.fit.options import check_bool, check_float, check_int, check_scale, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.sensitivity import frf_sensitivity
@@ -75,7 +75,7 @@ class _Budget(Exception):
     """Raised inside a residual evaluation once the time budget is spent."""
 
 
-class LmFRF(FrfEstimator):
+class LmFRF(NoiseWeighted, FrfEstimator):
     """Levenberg–Marquardt (trust-region reflective) on log-parameters, optionally restarted.
 
     Parameters
@@ -156,13 +156,14 @@ class LmFRF(FrfEstimator):
         verbose = check_bool("verbose", verbose)
         if callback is not None and not callable(callback):
             raise OptionError(f"callback must be callable (pass_index, info) -> bool; got {type(callback).__name__}")
-        self.line_weights = frf_weights(data, variance)
+        label = self.set_variance(variance)  # weights, the given noise and the noise floor it declares
+        self._variance = variance
         self.callback = callback
         self.options = {"scale": None if self.scale is None else self.scale.tolist(), "restarts": restarts,
                         "bands": bands,
                         "spread": spread, "max_iter": max_iter,
                         "positivity": positivity, "tol": tol, "time_limit": time_limit, "seed": seed,
-                        "variance": "given" if not isinstance(variance, str) and variance is not None else variance,
+                        "variance": label,
                         "verbose": verbose}
         H = np.asarray(data.H)
         self._H = H
@@ -359,10 +360,10 @@ class LmFRF(FrfEstimator):
                             iterations=total_nfev, wall_time=wall)
 
     def polisher(self) -> Any:
-        """IPOPT on the same frequency response (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
+        """IPOPT on the same frequency response and noise weighting (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
         from symid.fit.frf.ipopt import IpoptFRF
 
-        return IpoptFRF(self.model, self.data)
+        return IpoptFRF(self.model, self.data, variance=self._variance)
 
 
 class AutoFRF(LmFRF):
