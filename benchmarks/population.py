@@ -132,7 +132,8 @@ def run_problem(log: RunLog, p: Problem, args: argparse.Namespace, executor: Exe
         for kind in args.kinds:
             starts = list(p.starts(kind, args.starts, seed=0))
             options = {m: {**({"scale": p.typical} if m in SCALED else {}),
-                           **({"time_limit": args.time_limit} if m in TIMED else {})}
+                           **({"time_limit": args.time_limit} if m in TIMED else {}),
+                           **({"force_scr": True} if m == "scr" else {})}  # SCR itself, even where ls applies
                        for m in {x.removesuffix("+polish") for x in methods}}
             scope = log.scoped(f"{p.name}/noise{noise:g}/{kind}/")
             with warnings.catch_warnings():
@@ -146,9 +147,12 @@ def summarise(log: RunLog) -> dict[str, Any]:
     from every record in the log."""
     problems: dict[str, dict[str, Any]] = {}
     refs: dict[tuple[str, str], dict[str, Any]] = {}
+    runs: list[dict[str, Any]] = []
     for rec in log.records():
         parts = rec["key"].split("/")
-        if parts[-1] == "problem":
+        if parts[0] == "run" and len(parts) == 2:
+            runs.append({k: rec.get(k) for k in ("started", "commit", "methods", "sizes")})
+        elif parts[-1] == "problem":
             problems[parts[0]] = rec
         elif parts[-1] == "reference":
             refs[(parts[0], parts[1])] = rec
@@ -190,7 +194,7 @@ def summarise(log: RunLog) -> dict[str, Any]:
     for prob in problems.values():
         sizes[prob["cls"]].add(int(prob["n"]))
     return {"rows": rows, "size_rows": size_rows, "problems": len(problems),
-            "sizes": {k: sorted(v) for k, v in sizes.items()}}
+            "sizes": {k: sorted(v) for k, v in sizes.items()}, "runs": runs}
 
 
 def _git_commit() -> str:
@@ -268,6 +272,12 @@ def main(argv: list[str] | None = None) -> int:
         executor = client.get_executor()
     elif args.workers > 1:
         executor = ProcessPoolExecutor(max_workers=args.workers, mp_context=get_context("spawn"))
+    # which code ran which rows of a log that several runs fill (a resumed run of the same code adds nothing)
+    run = {"commit": header["commit"], "methods": args.methods, "sizes": sizes}
+    last = [r for r in log.records() if r["key"].startswith("run/")][-1:]
+    if not last or any(last[0].get(k) != v for k, v in run.items()):
+        started = time.strftime("%Y-%m-%dT%H:%M:%S")
+        log.append(f"run/{started}", {"started": started, **run})
     t0 = time.perf_counter()
     try:
         for n in sizes:  # every class at a size before the next size: a partial run covers every class

@@ -88,11 +88,12 @@ def test_a_tiny_run_logs_resumes_and_summarises(bench, tmp_path):
             "--noise", "0,0.01", "--kinds", "uninformed", "--time-limit", "30", "--log", str(log), "--out", str(out)]
     assert pop.main(argv) == 0
     first = log.read_text(encoding="utf-8").splitlines()
-    # the problem, the noisy reference, and per noise level each method's setup and start
-    assert len(first) == 1 + 1 + 2 * 2 * 2
+    # the run's code, the problem, the noisy reference, and per noise level each method's setup and start
+    assert len(first) == 1 + 1 + 1 + 2 * 2 * 2
     assert pop.main(argv) == 0  # resumed: nothing run again
     assert log.read_text(encoding="utf-8").splitlines() == first
     doc = json.loads(out.read_text(encoding="utf-8"))
     cells = {(r["method"], r["noise"]) for r in doc["rows"]}
     assert cells == {("lm", 0.0), ("ipopt", 0.0), ("lm", 0.01), ("ipopt", 0.01)}
     assert all(r["starts"] == 1 and r["problems"] == 1 for r in doc["rows"])
+    assert [(r["methods"], r["sizes"]) for r in doc["runs"]] == [(["lm", "ipopt"], [2])]  # the resume added none
