@@ -104,8 +104,9 @@ class FrfFisher(FisherInformation):
         case = getattr(self, "case", None)
         if self.method != "ls" or case not in ("sensors", "actuators"):
             return None
-        G = _ls_sensitivity(self.model, self.data, np.asarray(theta, dtype=float), case,
-                            getattr(self, "equation_weights", None))
+        theta = np.asarray(theta, dtype=float)
+        whitening = getattr(self, "equation_whitening", None)  # the noise-weighted ls: its weights at θ
+        G = _ls_sensitivity(self.model, self.data, theta, case, whitening(theta) if callable(whitening) else None)
         sw = self._sqrt_weights().ravel()  # r = √w (H − H(θ)) / ‖√w H‖, so dH = ‖√w H‖ dr / √w
         return G * (self._norm() / np.concatenate([sw, sw]))[None, :]
 
@@ -122,13 +123,13 @@ class FrfFisher(FisherInformation):
 
 
 def _ls_sensitivity(model: Any, data: Any, theta: np.ndarray, case: str,
-                    weights: np.ndarray | None = None) -> np.ndarray:
+                    whitening: list[np.ndarray] | None = None) -> np.ndarray:
     """G (l, 2spm) with dθ̂ = G [Re dH; Im dH] (entries in (s, p, m) order) for the linear least squares of
     thesis (4-10) (sensors: eᵢ = Zᵢ C⁻¹ Ĥᵢ − B(θ)) or (4-11) (actuators: eᵢ = Ĥᵢ B⁻¹ Zᵢ − C(θ)), Ĥ = H / f(ω),
     Z = K − ω²M + jωV (second order) or jωI − A: dθ̂ = −(JₑᵀJₑ)⁻¹ Jₑᵀ de with de linear in dH (the term in
-    e·dJₑ is of second order in the noise). ``weights`` (one per complex equation, shaped as the equations of
-    every frequency) multiply the equations of the noise-weighted least squares (``LinearFRF.equation_weights``):
-    dθ̂ = −(JₑᵀΩ²Jₑ)⁻¹ JₑᵀΩ² de."""
+    e·dJₑ is of second order in the noise). ``whitening`` (one matrix Wᵢ per frequency, acting on its flattened
+    equations, ``LinearFRF.equation_whitening``) multiplies the equations of the noise-weighted least squares:
+    dθ̂ = −(JₑᴴWᴴWJₑ)⁻¹ JₑᴴWᴴW de (real parts; the change of W with the noise is of second order too)."""
     w = np.asarray(data.w, dtype=float)
     H = np.asarray(data.H, dtype=complex)
     _, p, m = H.shape
@@ -157,15 +158,14 @@ def _ls_sensitivity(model: Any, data: Any, theta: np.ndarray, case: str,
             Je = np.einsum("pm,kmn->kpn", Hh @ Bi, Zk) - maps["C"].Xi       # (l, p, n)
             K = Bi @ Z / f[i]                                               # de = dH K   (m × n)
             L = np.einsum("ac,bj->ajcb", np.eye(p), K).reshape(p * K.shape[1], p * m)
-        rows_J.append(Je.reshape(l, -1).T)
+        Je = Je.reshape(l, -1).T
+        if whitening is not None:
+            Je, L = whitening[i] @ Je, whitening[i] @ L
+        rows_J.append(Je)
         blocks.append(L)
     Jc = np.vstack(rows_J)
     Je_real = np.vstack([Jc.real, Jc.imag])
 
     Lc = scipy.linalg.block_diag(*blocks)
     L_real = np.block([[Lc.real, -Lc.imag], [Lc.imag, Lc.real]])
-    if weights is not None:
-        om = np.asarray(weights, dtype=float).ravel()
-        om = np.concatenate([om, om])[:, None]
-        Je_real, L_real = Je_real * om, L_real * om
     return -np.linalg.lstsq(Je_real, L_real, rcond=None)[0]

@@ -117,9 +117,14 @@ class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
         weight at ωᵢ is further multiplied by the noise weight of that line (below).
     {variance}
         SCR weighs the relaxation of every equation at ωᵢ (λᵢ, γᵢ, δᵢ, ρᵢ) by
-        qᵢ = σ̄⁻¹ᵢ / mean(σ̄⁻¹), σ̄²ᵢ the mean variance of the entries of Hᵢ: a line with
-        ten times the noise weighs ten times less (the nuclear norm grows like the
-        equation error, not its square). Equal variances give q = 1, the unweighted SCR.
+        qᵢ ∝ gᵢ / σ̄ᵢ (mean 1), σ̄²ᵢ the mean variance of the entries of Hᵢ and gᵢ the size
+        by which SCR divides Γᵢ (``scale``; hᵢ for Ψᵢ): σ̄ᵢ / gᵢ is the noise Hᵢ puts on
+        the unknowns SCR works on, and the nuclear norm grows like the equation error,
+        not its square. Noise of the same relative size on every line (σ̄ᵢ ∝ gᵢ) gives
+        about the unweighted SCR. Measured on the 2-DOF (8 records, from a start within
+        a factor 2.5; noise 0.1 % / 3 % of |H| on the lower / upper half of the band, or
+        rising geometrically between them): mean squared parameter error 0.018 / 0.10
+        of the unweighted SCR's, against 0.030 / 0.30 with qᵢ ∝ 1 / σ̄ᵢ.
         The misfit SCR reports, its success rule (judged against the declared noise) and
         the IPOPT polish of ``"scr+polish"`` use the same variance. Equations the presolve
         solves as linear least squares (the output equations when they and the known
@@ -219,10 +224,7 @@ class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
         self._aux_scale, self._psi_scale = self._aux_scales(self.scale if given else None)
         variance_label = self.set_variance(variance)
         self._variance = variance
-        lam = self._weights(weights)
-        if self.line_variance is not None:  # noise weights of the lines (class text)
-            q = 1.0 / np.sqrt(np.mean(self.line_variance.reshape(self.w.size, -1), axis=1))
-            lam = {k: v * (q / np.mean(q)) for k, v in lam.items()}
+        lam = self._weights(weights)  # the noise weights join them in _build, with the sizes of Γᵢ, Ψᵢ
         solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, heuristic=heuristic,
                                           admm=admm, time_limit=time_limit)
         if admm is None and backend == "admm" and self.second_order:
@@ -290,6 +292,18 @@ class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
         lam = vector(weights, "weights")
         return {k: lam for k in fams}
 
+    def _noise_weighted(self, lam: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """The relaxation weights times the noise weight of every line, gᵢ / σ̄ᵢ for the Γ families and hᵢ / σ̄ᵢ
+        for the Ψ ones (scaled to mean 1; class text); unchanged without a variance."""
+        if self.line_variance is None:
+            return lam
+        sbar = np.sqrt(np.mean(self.line_variance.reshape(self.w.size, -1), axis=1))
+        out = {}
+        for key, v in lam.items():
+            q = (self._psi_scale if key.startswith("psi") else self._aux_scale) / sbar
+            out[key] = v * (q / np.mean(q))
+        return out
+
     def _build(self, lam: dict[str, np.ndarray], lmis: bool, positivity: bool) -> scr.BilinearProblem:
         model, H = self.model, np.asarray(self.data.H, dtype=complex)
         maps = model.maps
@@ -301,6 +315,7 @@ class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
         lmi_list: list[Any] = []
         labels = self._families()
         self.families: dict[str, list[int]] = {}
+        lam = self._noise_weighted(lam)
 
         def add(family: str, i: int, **maps_: Any) -> None:
             """The bilinear term A P B = C of frequency i in a constraint family, with its weight."""
