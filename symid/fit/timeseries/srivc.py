@@ -229,8 +229,10 @@ def transfer_polynomials(model: Any) -> TransferPolynomials:
             if expr == 0:
                 continue
             if any(p in expr.free_symbols for p in params) and sp.Poly(expr, *params).total_degree() > 1:
+                text = str(expr)
+                text = text if len(text) <= 120 else text[:117] + "..."
                 raise ModelError(f"method 'srivc' needs every coefficient of the transfer function affine in θ: the "
-                                 f"coefficient of s^{k} in {what} is {expr}, not affine. Use method='oe' (or "
+                                 f"coefficient of s^{k} in {what} is {text}, not affine. Use method='oe' (or "
                                  "reparametrise the model in its transfer-function coefficients).")
             c0[k] = float(expr.subs({p: 0 for p in params}))
             for i, p in enumerate(params):
@@ -376,8 +378,12 @@ class SimplifiedRIVC(JudgedOnSamples):
             return np.zeros((0, l)), np.zeros(0), (np.zeros((0, l)) if theta is not None else None), 0
         return np.vstack(rows), np.concatenate(rhs), (np.vstack(inst) if theta is not None else None), used
 
-    def _least_squares(self) -> tuple[np.ndarray, int, int]:
-        """θ from least squares on derivatives filtered by (s + λ)ⁿ; rank; samples used."""
+    def least_squares(self) -> tuple[np.ndarray, int, int]:
+        """θ from least squares on derivatives filtered by (s + λ)ⁿ (the default start), its rank, samples used.
+
+        Noise on the outputs enters the filtered derivatives, so this estimate is biased
+        (toward zero for the highest derivative's coefficient); SRIVC's iteration removes that.
+        """
         n = self.poly.order
         den = np.poly(np.full(n, -self._lambda))[1:][::-1].copy()
         Phi, b, _, used = self._equations(den, None)
@@ -400,7 +406,7 @@ class SimplifiedRIVC(JudgedOnSamples):
         start = np.asarray(x0, dtype=float).reshape(-1)
         used = 0
         if self._init == "ls":
-            theta, rank, used = self._least_squares()
+            theta, rank, used = self.least_squares()
             if rank < l:
                 return self.outcome(start, theta, finished=False, status="rank deficient",
                                     message=f"the filtered regression has rank {rank} < {l}: the records do not "
