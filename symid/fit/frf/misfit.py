@@ -93,7 +93,7 @@ def frf_weights(data: Any, variance: Any = "data") -> np.ndarray | None:
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
         raise OptionError(f"{source} must be finite and > 0 to weigh the fit by it: entry {idx} (frequency "
-                          f"{float(np.asarray(data.w)[idx[0]]):g} rad/s) is {var[idx]!r}; give a small positive "
+                          f"{float(np.asarray(data.w)[idx[0]]):g} rad/s) is {float(var[idx])!r}; give a small positive "
                           f"variance for lines measured without noise, or variance=None for equal weights")
     wts = 1.0 / var
     return wts / float(np.mean(wts))
