@@ -20,12 +20,15 @@ Every method runs from the same starts through :func:`symid.compare`, each start
 wall-time budget (``--time-limit``, the methods' ``time_limit=`` option). A start
 succeeds when
 
-- noise-free: ‖θ̂ − θ*‖/‖θ*‖ ≤ 1e-3, or, for a problem not proven globally identifiable,
-  θ̂ fits the data exactly (relative misfit ≤ 1e-10) with every parameter declared
-  positive positive: another admissible solution;
-- 1 % noise: ‖θ̂ − θ*‖/‖θ*‖ ≤ 2 × that of IPOPT started at the truth (the reference
-  estimate), or, for a problem not proven globally identifiable, θ̂ fits at least as
-  well as the reference (misfit ≤ 1.001 × its misfit) with positive parameters.
+- noise-free: maxₖ |θ̂ₖ − θ*ₖ|/|θ*ₖ| ≤ 1e-3, or, for a problem not proven globally
+  identifiable, θ̂ fits the data exactly (relative misfit ≤ 1e-10) with every parameter
+  declared positive positive: another admissible solution;
+- 1 % noise: maxₖ |θ̂ₖ − θ*ₖ|/|θ*ₖ| ≤ 2 × that of IPOPT started at the truth (the
+  reference estimate), or, for a problem not proven globally identifiable, θ̂ fits at
+  least as well as the reference (misfit ≤ 1.001 × its misfit) with positive parameters.
+
+The error is the largest relative error of any parameter, not ‖θ̂ − θ*‖/‖θ*‖: in SI units
+the springs (1e3–1e5 N/m) would dominate that norm and a mass 100 % off would pass.
 
 Tabulated per class × method × noise × start kind: success rate, median seconds per
 start, time to solution (all starts' time / successes).
@@ -65,7 +68,6 @@ import numpy as np
 from population_models import CLASSES, Problem, make_problem  # benchmarks/ (the script's folder) is on the path
 
 import symid as si
-from symid.fit.compare import relative_parameter_error
 from symid.fit.frf.ls import ls_applicable
 from symid.fit.success import EXACT_FIT
 from symid.interrupt import Interrupted
@@ -102,9 +104,15 @@ def _reference(log: RunLog, p: Problem, noise: float, data: Any) -> dict[str, An
     if rec is None:
         res = si.identify(p.model, data, method="ipopt", x0=p.truth, identifiability_check=False, scale=p.typical)
         log.append(key, {"theta": res.theta_vector, "cost": res.cost,
-                         "error": relative_parameter_error(res.theta_vector, p.truth), "status": res.status})
+                         "error": parameter_error(res.theta_vector, p.truth), "status": res.status})
         rec = log.get(key)
     return rec
+
+
+def parameter_error(theta: Any, truth: Any) -> float:
+    """maxₖ |θₖ − θ*ₖ| / |θ*ₖ|: the largest relative error of any parameter, whatever their units."""
+    theta, truth = np.asarray(theta, dtype=float), np.asarray(truth, dtype=float)
+    return float(np.max(np.abs(theta - truth) / np.abs(truth)))
 
 
 def start_success(theta: Any, cost: Any, truth: np.ndarray, positive: np.ndarray, globally: bool,
@@ -115,11 +123,11 @@ def start_success(theta: Any, cost: Any, truth: np.ndarray, positive: np.ndarray
     theta = np.asarray(theta, dtype=float)
     if not np.all(np.isfinite(theta)):
         return False
-    err = relative_parameter_error(theta, truth)
+    err = parameter_error(theta, truth)
     admissible = bool(np.all(theta[positive] > 0))
     if reference is None:  # noise-free
         return err <= 1e-3 or (not globally and admissible and float(cost) <= EXACT_FIT)
-    ref_err, ref_cost = float(reference["error"]), float(reference["cost"])
+    ref_err, ref_cost = parameter_error(reference["theta"], truth), float(reference["cost"])
     return err <= 2 * ref_err or (not globally and admissible and float(cost) <= 1.001 * ref_cost)
 
 
@@ -253,10 +261,10 @@ def main(argv: list[str] | None = None) -> int:
 
     def write_summary() -> dict[str, Any]:
         summary = {**header, **summarise(log), "criteria": {
-            "noise-free": "relative parameter error <= 1e-3, or (not proven globally identifiable) an exact fit "
-                          "(misfit <= 1e-10) with positive parameters",
-            "noisy": "relative parameter error <= 2 x that of IPOPT started at the truth, or (not proven globally "
-                     "identifiable) misfit <= 1.001 x the reference's with positive parameters"}}
+            "noise-free": "largest relative error of any parameter <= 1e-3, or (not proven globally identifiable) "
+                          "an exact fit (misfit <= 1e-10) with positive parameters",
+            "noisy": "largest relative error of any parameter <= 2 x that of IPOPT started at the truth, or (not "
+                     "proven globally identifiable) misfit <= 1.001 x the reference's with positive parameters"}}
         write_json_atomic(args.out, summary)
         return summary
 

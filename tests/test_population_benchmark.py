@@ -75,9 +75,11 @@ def test_success_rule(bench):
     assert pop.start_success([1.5, 0.5], 1e-20, truth, pos, False, None)  # an admissible other solution
     assert not pop.start_success([1.5, -0.5], 1e-20, truth, pos, False, None)  # not admissible
     assert not pop.start_success(None, None, truth, pos, False, None)
-    ref = {"error": 0.01, "cost": 1e-4}
-    assert pop.start_success([1.0, 2.03], 2e-4, truth, pos, True, ref)  # 1.3 % < 2 x 1 %
-    assert not pop.start_success([1.0, 2.1], 2e-4, truth, pos, True, ref)
+    ref = {"theta": [1.01, 2.0], "cost": 1e-4}  # 1 % off in the first parameter
+    assert pop.start_success([1.0, 2.03], 2e-4, truth, pos, True, ref)  # 1.5 % < 2 x 1 %
+    assert not pop.start_success([1.0, 2.1], 2e-4, truth, pos, True, ref)  # 5 %
+    # per parameter, whatever the units: a spring of 1e4 exact does not hide a mass 50 % off
+    assert not pop.start_success([1.5, 1e4], 1e-20, np.array([1.0, 1e4]), pos, True, None)
     assert pop.start_success([1.3, 1.0], 1.0005e-4, truth, pos, False, ref)  # fits as well as the reference
 
 
