@@ -19,9 +19,10 @@ def estimator_classes() -> list[tuple[str, str, type]]:
     --------
     >>> from symid.fit.catalog import estimator_classes
     >>> [(k, m) for k, m, _ in estimator_classes()][:3]
-    [('frequency response', 'scr'), ('frequency response', 'ipopt'), ('frequency response', 'ls')]
+    [('frequency response', 'auto'), ('frequency response', 'lm'), ('frequency response', 'scr')]
     """
     from symid.fit.frf.ipopt import IpoptFRF
+    from symid.fit.frf.lm import AutoFRF, LmFRF
     from symid.fit.frf.ls import LinearFRF
     from symid.fit.frf.scr import ScrFRF
     from symid.fit.similarity.als import AlsSimilarity
@@ -36,7 +37,8 @@ def estimator_classes() -> list[tuple[str, str, type]]:
     from symid.fit.timeseries.svf import StateVariableFilter
 
     frf, spec, bb = "frequency response", "spectra", "black box / I/O"
-    return [(frf, "scr", ScrFRF), (frf, "ipopt", IpoptFRF), (frf, "ls", LinearFRF),
+    return [(frf, "auto", AutoFRF), (frf, "lm", LmFRF), (frf, "scr", ScrFRF), (frf, "ipopt", IpoptFRF),
+            (frf, "ls", LinearFRF),
             (spec, "scr", ScrPSD), (spec, "ipopt", IpoptPSD), ("time series", "oe", OutputError),
             ("time series", "svf", StateVariableFilter), ("time series", "srivc", SimplifiedRIVC),
             (bb, "scr (state space)", ScrSimilarity), (bb, "als", AlsSimilarity), (bb, "gb", GbSimilarity),
