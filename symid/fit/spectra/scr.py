@@ -92,6 +92,16 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         Let the engine equilibrate each term (default False, see the module notes).
     admm : symid.engine.scr.ADMMOptions, optional
         Options of the ADMM back end.
+    time_limit : float, optional
+        Wall-time budget of one start in seconds, the first step from the random Yᵢ
+        included (status ``"time_limit"``; the iteration under way is cut short, see
+        :func:`symid.engine.scr.solve`). Default: none.
+    callback : callable, optional
+        Called after every SCR iteration with a :class:`symid.engine.scr.ScrProgress`
+        (iteration, residual, data misfit, elapsed seconds, θ); a true return value stops
+        the start (status ``"stopped"``).
+    verbose : bool
+        Print one line per SCR iteration (iteration, residual, misfit, elapsed). Default False.
 
     Examples
     --------
@@ -109,7 +119,8 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
     def __init__(self, model: Any, data: Any, *, lmis: bool = True, positivity: bool = True,
                  backend: str = "cvxpy", max_iter: int = 40, tol: float = 1e-8, aux_init: str = "random",
                  aux_std: float = 10.0, aux_sign: int = -1, seed: int = 0, rank_tol: float = 1e-10,
-                 normalize: bool = False, admm: Any = None):
+                 normalize: bool = False, admm: Any = None, time_limit: float | None = None, callback: Any = None,
+                 verbose: bool = False):
         self.aux_init = check_choice("aux_init", aux_init, _AUX_INITS)
         self.aux_std = check_float("aux_std", aux_std, low=0, strict_low=True)
         if aux_sign not in (-1, 1) or isinstance(aux_sign, bool):
@@ -117,13 +128,16 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         rank_tol = check_float("rank_tol", rank_tol, low=0, high=1 - 1e-16)
         lmis, positivity = check_bool("lmis", lmis), check_bool("positivity", positivity)
         self.aux_sign, self.seed = int(aux_sign), check_seed("seed", seed)
-        solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, admm=admm)
+        solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, admm=admm,
+                                          time_limit=time_limit)
+        self._progress_options(callback, verbose)
         self.model, self.data = model, data
         self.eq = spectral_equations(model, data)
         self.options: dict[str, Any] = {"lmis": lmis, "positivity": positivity, "backend": backend,
                                         "max_iter": max_iter, "tol": tol, "aux_init": aux_init, "aux_std": aux_std,
                                         "aux_sign": aux_sign, "seed": seed, "rank_tol": rank_tol,
-                                        "normalize": normalize}
+                                        "normalize": normalize, "time_limit": solve_opts["time_limit"],
+                                        "callback": None if callback is None else "given", "verbose": self._verbose}
         self._normalize = check_bool("normalize", normalize)
         self.scale = float(np.max(np.linalg.norm(self.eq.Q, ord=2, axis=(1, 2)))) or 1.0
         self._U, self._S = self._compress(rank_tol)
@@ -188,9 +202,11 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         return self.aux_sign * (Z @ np.swapaxes(Z, 1, 2))
 
     # -- one start ---------------------------------------------------------------------------
-    def solve(self, x0: np.ndarray) -> tuple[scr.SCRSolution | None, scr.SCRSolution]:
-        """The raw engine solutions from ``x0``: (first step from the random Yᵢ or None, the iteration)."""
+    def solve(self, x0: np.ndarray, monitor: Any = None) -> tuple[scr.SCRSolution | None, scr.SCRSolution]:
+        """The raw engine solutions from ``x0``: (first step from the random Yᵢ or None, the iteration);
+        ``monitor`` as :func:`symid.engine.scr.solve` (the iteration only)."""
         x0 = np.asarray(x0, dtype=float)
+        t0 = time.perf_counter()
         first = None
         start = x0
         if self.aux_init == "random":
@@ -202,18 +218,26 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
             if first.status == "solver_error":
                 return first, first
             start = np.asarray(first.x["theta"], dtype=float)
-        return first, self.engine_solve({"theta": start})
+        opts = dict(self._solve_opts)
+        if opts.get("time_limit") is not None:  # one budget for the first step and the iteration
+            opts["time_limit"] = max(opts["time_limit"] - (time.perf_counter() - t0), 1e-3)
+        return first, scr.solve(self.compiled, {"theta": start}, monitor=monitor, **opts)
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start ``x0``; never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
-        first, sol = self.solve(x0)
+        monitor = self.engine_monitor(lambda x: np.asarray(x["theta"], dtype=float).reshape(-1), t0)
+        first, sol = self.solve(x0, monitor)
         theta = np.asarray(sol.x["theta"], dtype=float).reshape(-1)
         hist = self.engine_history(first) if first is not None and first is not sol else ()
         hist = hist + self.engine_history(sol, offset=len(hist))
         message = sol.message
-        if first is not None:
+        limit = self._solve_opts.get("time_limit")
+        if limit is not None and "time_limit" in (sol.status, getattr(first, "status", None)):
+            message = (f"time limit of {limit:g} s reached after {len(hist)} iterations (the first step from random "
+                       f"Yᵢ included); the last iterate is kept")
+        elif first is not None:
             message = (f"first step from random Yᵢ (§5-6), then {message}" if first is not sol else
                        f"first step from random Yᵢ (§5-6) failed: {first.message}")
         return self.solved_outcome(x0, theta, sol, t0, message=message, history=hist)
