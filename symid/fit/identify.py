@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 from typing import Any
 
 import numpy as np
 
-from symid.errors import OptionError
+from symid.errors import IdentifiabilityWarning, OptionError
 from symid.fit.options import check_bool
 from symid.fit.registry import prepare
 from symid.fit.result import IdentificationResult, StartOutcome
@@ -97,6 +98,14 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         The best start by data misfit, and every start's outcome in ``result.starts``.
         ``success`` means the solver finished and the estimate fits the data.
 
+    Warns
+    -----
+    IdentifiabilityWarning
+        Before estimating, when the local test finds parameters no data of this kind can
+        determine (``identifiability_check``); after, when other starts fit the data as well
+        with different parameters (:meth:`IdentificationResult.alternatives`: several exact
+        solutions, or parameters the data do not pin down).
+
     Raises
     ------
     symid.interrupt.Interrupted
@@ -177,4 +186,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             polished = dataclasses.replace(polished, uncertainty=polisher.uncertainty(
                 polished.theta_vector, model.parameter_names, noise_std=noise_std))
         result = dataclasses.replace(result, polished=polished)
+    ambiguity = result.ambiguity()
+    if ambiguity is not None:
+        warnings.warn(ambiguity, IdentifiabilityWarning, stacklevel=2)
     return result

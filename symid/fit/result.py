@@ -213,6 +213,63 @@ class IdentificationResult:
         """Number of starts run."""
         return len(self.starts)
 
+    def alternatives(self, *, cost_rtol: float = 0.01, theta_rtol: float = 0.01) -> list[StartOutcome]:
+        """Other starts whose estimates fit the data as well as the best one but lie elsewhere.
+
+        A start counts when it is a success, its misfit is within ``cost_rtol`` (relative)
+        of the best one's, and some parameter differs from the best estimate by more than
+        ``theta_rtol`` relative to it — and, where the best estimate has finite standard
+        errors, by more than three of them. Such starts mean the data do not single out
+        one estimate: the model may have several exact solutions (only locally
+        identifiable, see :func:`symid.identifiability`), or the data may not pin some
+        parameters down. :meth:`summary` and :func:`symid.identify` say so.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from symid.fit.result import IdentificationResult, StartOutcome
+        >>> def start(theta, cost):
+        ...     return StartOutcome(start=np.ones(2), theta=np.array(theta), cost=cost, success=True,
+        ...                         finished=True, status="ok", iterations=1, wall_time=0.1)
+        >>> res = IdentificationResult.from_starts("lm", ("a", "b"), [start([1.0, 2.0], 1e-20),
+        ...                                        start([1.0, 5.0], 2e-20)], cost_kind="misfit")
+        >>> [s.theta.tolist() for s in res.alternatives()]
+        [[1.0, 5.0]]
+        """
+        best = self.best_start
+        ref = np.asarray(best.theta, dtype=float)
+        if not (best.success and np.all(np.isfinite(ref)) and np.isfinite(best.cost)):
+            return []
+        scale = np.where(ref != 0, np.abs(ref), 1.0)
+        se = getattr(self.uncertainty, "standard_errors", None)
+        se = np.asarray(se, dtype=float) if se is not None else np.zeros_like(ref)
+        se = np.where(np.isfinite(se), se, np.inf)
+        found = []
+        for s in self.starts:
+            th = np.asarray(s.theta, dtype=float)
+            if s is best or not s.success or not np.all(np.isfinite(th)) or th.shape != ref.shape:
+                continue
+            if not s.cost <= best.cost * (1 + cost_rtol) + 1e-14:
+                continue
+            d = np.abs(th - ref)
+            if np.any((d > theta_rtol * scale) & (d > 3 * se)):
+                found.append(s)
+        return found
+
+    def ambiguity(self) -> str | None:
+        """One sentence on :meth:`alternatives` (``None`` when there are none)."""
+        alts = self.alternatives()
+        if not alts:
+            return None
+        ref = np.asarray(self.best_start.theta, dtype=float)
+        scale = np.where(ref != 0, np.abs(ref), 1.0)
+        rel = np.max([np.abs(np.asarray(s.theta, dtype=float) - ref) / scale for s in alts], axis=0)
+        k = int(np.argmax(rel))
+        return (f"{len(alts)} other start(s) fit the data as well with different parameters (up to "
+                f"{100 * rel[k]:.3g} % in {self.parameter_names[k]}): the data do not single out one estimate. The "
+                "model may have several exact solutions (symid.identifiability gives the global verdict) or the data "
+                "may not pin these parameters down; compare the starts in .starts, or fix known parameters")
+
     def summary(self, truth: dict[str, float] | None = None) -> str:
         """A readable table of the estimate (against ``truth`` when given)."""
         n_ok = sum(s.success for s in self.starts)
@@ -223,6 +280,9 @@ class IdentificationResult:
                  f"total time {self.wall_time:.3f} s"]
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
+        ambiguity = self.ambiguity()
+        if ambiguity is not None:
+            lines.append(f"NOT UNIQUE: {ambiguity}")
         unc = self.uncertainty
         if unc is not None:
             lines.append(unc.summary())
