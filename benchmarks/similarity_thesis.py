@@ -59,8 +59,8 @@ def enose(log: RunLog, starts: int = 10, seed: int = 0) -> dict:
     """SCR, ALS, GB and IPOPT on the e-nose (6-19) from identical random starts."""
     entry = si.load_model("enose")
     cmp = si.compare(entry.model, entry.data(), methods=("scr", "als", "gb", "ipopt"), starts=starts, seed=seed,
-                     truth=entry.truth, param_tol=SUCCESS, progress=True, options={"scr": SCR_OPTIONS},
-                     log=log.scoped("compare/"))
+                     truth=entry.truth, param_tol=SUCCESS, param_error="l2", progress=True,
+                     options={"scr": SCR_OPTIONS}, log=log.scoped("compare/"))
     print(cmp.table())
     truth = entry.model.theta_vector(entry.truth)
     out = {"starts": starts, "seed": seed, "success_threshold": SUCCESS, "thesis_scr": "about 3 of 10",
@@ -138,7 +138,8 @@ def msd3(log: RunLog, starts: int = 3, seed: int = 0) -> dict:
     bb_err = float(np.max(np.abs(sd.frf.H - H0)) / np.max(np.abs(H0)))
     print(f"N4SID + d2c: {t_bb:.2f} s, black-box frequency response off by {bb_err:.2e} (max, relative)")
     cmp = si.compare(model, io, methods=("scr", "scr+polish"), starts=starts, seed=seed, truth=entry.truth,
-                     param_tol=1e-2, progress=True, options={"scr": SCR_OPTIONS}, log=log.scoped("compare/"))
+                     param_tol=1e-2, param_error="l2", progress=True, options={"scr": SCR_OPTIONS},
+                     log=log.scoped("compare/"))
     print(cmp.table())
     out = {"n4sid_time": t_bb, "blackbox_frf_error": bb_err, "starts": starts, "seed": seed, "methods": {}}
     for s in cmp.stats:

@@ -116,7 +116,7 @@ def test_compare_runs_the_four_methods_from_identical_starts():
     for s in starts[1:]:
         np.testing.assert_array_equal(s, starts[0])
     assert cmp["ipopt"].n_success >= 1 and cmp["scr"].n_success >= 1
-    assert "rel. error" in cmp.table()
+    assert "best param. error" in cmp.table() and "largest relative parameter error" in cmp.table()
 
 
 def test_polish_uses_the_similarity_ipopt():

@@ -1,0 +1,39 @@
+"""compare's parameter error: the worst parameter by default, whatever the units (a new-user trial found the
+2-norm error passing a mass 100 % off beside springs of 1e4 N/m)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import symid as si
+from symid.errors import OptionError
+from symid.fit.compare import largest_relative_error, relative_parameter_error
+
+
+def test_largest_relative_error_sees_every_parameter():
+    truth = np.array([2.0, 5.0, 4e4])  # kg, N·s/m, N/m
+    est = np.array([4.0, 5.0, 4e4])  # the mass 100 % off
+    assert relative_parameter_error(est, truth) < 1e-3  # the 2-norm does not see it
+    assert largest_relative_error(est, truth) == pytest.approx(1.0, rel=1e-15)
+    assert largest_relative_error([0.1, 1.0], [0.0, 1.0]) == pytest.approx(0.1, rel=1e-15)  # θ* = 0: absolute
+
+
+def test_compare_counts_by_the_chosen_error():
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    truth = {"m": 2.0, "c": 5.0, "k": 4e4}
+    frf = si.simulate_frf(model, truth, np.logspace(1.5, 2.5, 30))
+    # a "method" that stops at once: IPOPT with one iteration from a start whose mass is 100 % off
+    start = [4.0, 5.0, 4e4]
+    opts = {"ipopt": {"max_iter": 1}}
+    largest = si.compare(model, frf, methods=("ipopt",), starts=[start], truth=truth, options=opts, progress=False)
+    l2 = si.compare(model, frf, methods=("ipopt",), starts=[start], truth=truth, options=opts, progress=False,
+                    param_error="l2")
+    err = largest["ipopt"].best_error
+    assert err > 1e-3 and largest["ipopt"].n_success == 0  # one iteration does not bring the mass back
+    assert l2["ipopt"].best_error == pytest.approx(relative_parameter_error(
+        largest["ipopt"].result.theta_vector, model.theta_vector(truth)), rel=1e-12)
+    assert "largest relative parameter error" in largest.criterion and "‖θ − θ*‖₂" in l2.criterion
+    with pytest.raises(OptionError, match="param_error"):
+        si.compare(model, frf, methods=("ipopt",), starts=1, truth=truth, param_error="rms")
