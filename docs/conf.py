@@ -6,6 +6,7 @@ Build: ``.venv/bin/pip install ".[docs]" && .venv/bin/sphinx-build -W -b html do
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -33,8 +34,9 @@ def _options_page(app) -> None:
     rows = [line.strip("|").split(" | ") for line in options_table().splitlines()[2:]]
     out = [".. list-table::", "   :header-rows: 1", "   :widths: 14 14 14 12 46", "",
            "   * - data", "     - method", "     - option", "     - default", "     - meaning"]
+    bars = re.compile(r"(?<![\\`|])\|([^|\s`][^|`]*?)\|(?![`|_])")  # |H| in plain text is not a substitution
     for row in rows:
-        cells = [c.strip().replace("\\|", "|") for c in row]
+        cells = [bars.sub(lambda m: "\\|" + m.group(1) + "\\|", c.strip().replace("\\|", "|")) for c in row]
         out.append(f"   * - {cells[0]}")
         out.extend(f"     - {c.replace('`', '``') if c.count('`') % 2 == 0 else c}" for c in cells[1:])
     target = Path(app.srcdir) / "_generated"
@@ -50,8 +52,6 @@ _BARS = None
 
 def _plain_bars(app, what, name, obj, options, lines) -> None:
     """Docstrings write magnitudes as |H| in plain text; reST would read |H| as a substitution."""
-    import re
-
     global _BARS
     _BARS = _BARS or re.compile(r"(?<![\\`|])\|([^|\s`][^|`]*?)\|(?![`|_])")
     for k, line in enumerate(lines):
