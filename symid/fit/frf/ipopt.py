@@ -9,7 +9,7 @@ import numpy as np
 
 from symid.engine.ipopt import HESSIANS, ScaledIpopt, casadi_frf, iteration_reporter
 from symid.errors import OptionError
-from symid.fit.frf.misfit import FrfEstimator, frf_weights
+from symid.fit.frf.misfit import FrfEstimator, NoiseWeighted
 from symid.fit.options import (
     check_bool,
     check_choice,
@@ -47,7 +47,7 @@ def frf_objective(model: Any, data: Any, theta: Any, weights: np.ndarray | None 
     return f / (float(np.sum(wts * np.abs(H) ** 2)) or 1.0)
 
 
-class IpoptFRF(FrfEstimator):
+class IpoptFRF(NoiseWeighted, FrfEstimator):
     """Nonlinear least squares on a frequency response with CasADi/IPOPT, built once, run per start.
 
     The objective is the relative misfit Σᵢ ‖Hᵢ − H(ωᵢ, θ)‖²_F / Σᵢ ‖Hᵢ‖²_F (real and
@@ -139,15 +139,12 @@ class IpoptFRF(FrfEstimator):
             raise OptionError(f"callback must be a function of one IpoptIteration (or None); got "
                               f"{type(callback).__name__}")
         self.lower, self.upper = parameter_bounds(model, bounds, positivity)
-        self.line_weights = frf_weights(data, variance)
-        self.line_variance = _line_variance(data, variance) if self.line_weights is not None else None
-        self._noise_floor: float | None = None
-        self._variance_floor = self._floor_from_variance()
+        label = self.set_variance(variance)  # weights, the given noise and the noise floor it declares
         named = {n: [float(lo), float(hi)] for n, lo, hi in zip(model.parameter_names, self.lower, self.upper,
                                                                 strict=True) if np.isfinite(lo) or np.isfinite(hi)}
         self.options = {"scale": "start" if self.scale is None else self.scale.tolist(),
                         "bounds": named or None, "positivity": positivity,
-                        "variance": _variance_label(variance, self.line_weights), "hessian": hessian,
+                        "variance": label, "hessian": hessian,
                         "max_iter": max_iter, "tol": tol, "time_limit": time_limit,
                         "callback": None if callback is None else "given", "verbose": verbose}
         report = iteration_reporter(callback, verbose)
@@ -155,24 +152,6 @@ class IpoptFRF(FrfEstimator):
         self._solver = ScaledIpopt("symid_ipopt_frf", theta, frf_objective(model, data, theta, self.line_weights),
                                    lower=self.lower, upper=self.upper, scale=self.scale, max_iter=max_iter, tol=tol,
                                    hessian=hessian, time_limit=time_limit, callback=report)
-
-    # -- the noise the variance declares --------------------------------------------------------
-    @property
-    def noise_floor(self) -> float | None:  # type: ignore[override]
-        """The given ``noise_floor``; else, with a variance, the relative misfit that noise leaves at the truth,
-        Σ w σ² / Σ w |H|² (so the fit is judged against the declared noise)."""
-        return self._noise_floor if self._noise_floor is not None else self._variance_floor
-
-    @noise_floor.setter
-    def noise_floor(self, value: float | None) -> None:
-        self._noise_floor = value
-
-    def _floor_from_variance(self) -> float | None:
-        if self.line_variance is None:
-            return None
-        H = np.asarray(self.data.H)
-        w = self.line_weights
-        return float(np.sum(w * self.line_variance) / np.sum(w * np.abs(H) ** 2))
 
     # -- starts ---------------------------------------------------------------------------------
     def check_start(self, x0: Any) -> None:
@@ -195,17 +174,3 @@ class IpoptFRF(FrfEstimator):
         return self.outcome(x0, run.z, finished=run.finished, status=run.status, message=message,
                             iterations=run.iterations, wall_time=run.seconds)
 
-
-def _line_variance(data: Any, variance: Any) -> np.ndarray:
-    """σ² per entry of H behind the weights (checked by :func:`frf_weights` already)."""
-    H = np.asarray(data.H)
-    var = np.asarray(data.variance if isinstance(variance, str) else variance, dtype=float)
-    if var.shape == (H.shape[0],):
-        var = np.broadcast_to(var[:, None, None], H.shape)
-    return np.array(var, dtype=float).reshape(H.shape)
-
-
-def _variance_label(variance: Any, weights: np.ndarray | None) -> str | None:
-    if weights is None:
-        return None if variance is None else "data (none: equal weights)"
-    return "data" if isinstance(variance, str) else "given"
