@@ -15,6 +15,12 @@ import numpy as np
 __all__ = ["IdentificationResult", "ScrIteration", "StartOutcome"]
 
 
+def _relative_difference(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|a − b| / max(|a|, |b|) per entry (0 where both are 0): at most 2, and 1 when one of them is 0."""
+    top = np.maximum(np.abs(a), np.abs(b))
+    return np.divide(np.abs(a - b), top, out=np.zeros_like(top), where=top > 0)
+
+
 def _best_index(starts: tuple[StartOutcome, ...] | list[StartOutcome]) -> int:
     """Index of the lowest data misfit (non-finite costs rank last; the first on ties)."""
     return int(np.argmin([s.cost if np.isfinite(s.cost) else np.inf for s in starts]))
@@ -216,11 +222,13 @@ class IdentificationResult:
     def alternatives(self, *, cost_rtol: float = 0.01, theta_rtol: float = 0.01) -> list[StartOutcome]:
         """Other starts whose estimates fit the data as well as the best one but lie elsewhere.
 
-        A start counts when it is a success, its misfit is within ``cost_rtol`` (relative)
-        of the best one's, and some parameter differs from the best estimate by more than
-        ``theta_rtol`` relative to it — and, where the best estimate has finite standard
-        errors, by more than three of them. Such starts mean the data do not single out
-        one estimate: the model may have several exact solutions (only locally
+        A start counts when its misfit is within ``cost_rtol`` (relative) of the best one's
+        and some parameter differs from the best estimate by more than ``theta_rtol``
+        relative to the larger of the two values — and, where that parameter has a finite
+        standard error, by more than three of them. Whether either estimate passes the fit
+        test does not matter: two estimates at the same misfit are equally supported by the
+        data. Such starts mean the data do not single out one estimate: the model may have
+        several exact solutions (only locally
         identifiable, see :func:`symid.identifiability`), or the data may not pin some
         parameters down. :meth:`summary` and :func:`symid.identify` say so.
 
@@ -238,21 +246,19 @@ class IdentificationResult:
         """
         best = self.best_start
         ref = np.asarray(best.theta, dtype=float)
-        if not (best.success and np.all(np.isfinite(ref)) and np.isfinite(best.cost)):
+        if not (np.all(np.isfinite(ref)) and np.isfinite(best.cost)):
             return []
-        scale = np.where(ref != 0, np.abs(ref), 1.0)
         se = getattr(self.uncertainty, "standard_errors", None)
         se = np.asarray(se, dtype=float) if se is not None else np.zeros_like(ref)
-        se = np.where(np.isfinite(se), se, np.inf)
+        se = np.where(np.isfinite(se), se, 0.0)  # no finite standard error: the relative rule alone
         found = []
         for s in self.starts:
             th = np.asarray(s.theta, dtype=float)
-            if s is best or not s.success or not np.all(np.isfinite(th)) or th.shape != ref.shape:
+            if s is best or not np.all(np.isfinite(th)) or th.shape != ref.shape:
                 continue
             if not s.cost <= best.cost * (1 + cost_rtol) + 1e-14:
                 continue
-            d = np.abs(th - ref)
-            if np.any((d > theta_rtol * scale) & (d > 3 * se)):
+            if np.any((_relative_difference(th, ref) > theta_rtol) & (np.abs(th - ref) > 3 * se)):
                 found.append(s)
         return found
 
@@ -262,8 +268,7 @@ class IdentificationResult:
         if not alts:
             return None
         ref = np.asarray(self.best_start.theta, dtype=float)
-        scale = np.where(ref != 0, np.abs(ref), 1.0)
-        rel = np.max([np.abs(np.asarray(s.theta, dtype=float) - ref) / scale for s in alts], axis=0)
+        rel = np.max([_relative_difference(np.asarray(s.theta, dtype=float), ref) for s in alts], axis=0)
         k = int(np.argmax(rel))
         return (f"{len(alts)} other start(s) fit the data as well with different parameters (up to "
                 f"{100 * rel[k]:.3g} % in {self.parameter_names[k]}): the data do not single out one estimate. The "
