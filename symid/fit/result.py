@@ -94,6 +94,11 @@ class StartOutcome:
         How the misfit compares with the noise floor (why it fits or not).
     history : tuple of ScrIteration
         Per-iteration records, when the method keeps them (SCR does).
+    passes : tuple of StartOutcome
+        The local solutions a restarted method reached within this start besides the one it
+        reports (``auto``'s passes), each with its own estimate and misfit; empty for methods
+        that run once. :meth:`IdentificationResult.alternatives` looks at them too, so one
+        start can show that the data do not single out one estimate.
     """
 
     start: np.ndarray
@@ -107,13 +112,17 @@ class StartOutcome:
     message: str = ""
     fit: str = ""
     history: tuple[ScrIteration, ...] = field(default=(), repr=False)
+    passes: tuple[StartOutcome, ...] = field(default=(), repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-Python form (lists and floats), suitable for JSON (the history is left out)."""
-        return {"start": np.asarray(self.start).tolist(), "theta": np.asarray(self.theta).tolist(),
-                "cost": float(self.cost), "success": bool(self.success), "finished": bool(self.finished),
-                "status": self.status, "iterations": int(self.iterations), "wall_time": float(self.wall_time),
-                "message": self.message, "fit": self.fit}
+        out = {"start": np.asarray(self.start).tolist(), "theta": np.asarray(self.theta).tolist(),
+               "cost": float(self.cost), "success": bool(self.success), "finished": bool(self.finished),
+               "status": self.status, "iterations": int(self.iterations), "wall_time": float(self.wall_time),
+               "message": self.message, "fit": self.fit}
+        if self.passes:
+            out["passes"] = [p.to_dict() for p in self.passes]
+        return out
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> StartOutcome:
@@ -133,7 +142,8 @@ class StartOutcome:
         return cls(start=np.asarray(d["start"], dtype=float), theta=np.asarray(d["theta"], dtype=float),
                    cost=float("inf") if cost is None else float(cost), success=bool(d["success"]),
                    finished=bool(d["finished"]), status=str(d["status"]), iterations=int(d["iterations"]),
-                   wall_time=float(d["wall_time"]), message=str(d.get("message", "")), fit=str(d.get("fit", "")))
+                   wall_time=float(d["wall_time"]), message=str(d.get("message", "")), fit=str(d.get("fit", "")),
+                   passes=tuple(cls.from_dict(p) for p in d.get("passes", ())))
 
 
 @dataclass(frozen=True)
@@ -220,7 +230,8 @@ class IdentificationResult:
         return len(self.starts)
 
     def alternatives(self, *, cost_rtol: float = 0.01, theta_rtol: float = 0.01) -> list[StartOutcome]:
-        """Other starts whose estimates fit the data as well as the best one but lie elsewhere.
+        """Other starts (or passes of a restarted start) whose estimates fit the data as well as
+        the best one but lie elsewhere.
 
         A start counts when its misfit is within ``cost_rtol`` (relative) of the best one's
         and some parameter differs from the best estimate by more than ``theta_rtol``
@@ -252,12 +263,14 @@ class IdentificationResult:
         se = np.asarray(se, dtype=float) if se is not None else np.zeros_like(ref)
         se = np.where(np.isfinite(se), se, 0.0)  # no finite standard error: the relative rule alone
         found = []
-        for s in self.starts:
+        for s in (c for start in self.starts for c in (start, *start.passes)):
             th = np.asarray(s.theta, dtype=float)
             if s is best or not np.all(np.isfinite(th)) or th.shape != ref.shape:
                 continue
             if not s.cost <= best.cost * (1 + cost_rtol) + 1e-14:
                 continue
+            if any(np.all(_relative_difference(th, np.asarray(f.theta, dtype=float)) <= theta_rtol) for f in found):
+                continue  # the same estimate again (a start and its own pass)
             if np.any((_relative_difference(th, ref) > theta_rtol) & (np.abs(th - ref) > 3 * se)):
                 found.append(s)
         return found
@@ -270,10 +283,11 @@ class IdentificationResult:
         ref = np.asarray(self.best_start.theta, dtype=float)
         rel = np.max([_relative_difference(np.asarray(s.theta, dtype=float), ref) for s in alts], axis=0)
         k = int(np.argmax(rel))
-        return (f"{len(alts)} other start(s) fit the data as well with different parameters (up to "
-                f"{100 * rel[k]:.3g} % in {self.parameter_names[k]}): the data do not single out one estimate. The "
-                "model may have several exact solutions (symid.identifiability gives the global verdict) or the data "
-                "may not pin these parameters down; compare the starts in .starts, or fix known parameters")
+        return (f"{len(alts)} other estimate(s) from other starts or restarts fit the data as well with different "
+                f"parameters (up to {100 * rel[k]:.3g} % in {self.parameter_names[k]}): the data do not single out "
+                "one estimate. The model may have several exact solutions (symid.identifiability gives the global "
+                "verdict) or the data may not pin these parameters down; compare them in .alternatives(), or fix "
+                "known parameters")
 
     def summary(self, truth: dict[str, float] | None = None) -> str:
         """A readable table of the estimate (against ``truth`` when given)."""

@@ -47,6 +47,7 @@ restarted one with 8 bands.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -305,6 +306,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         phi = np.zeros(x0.size)
         first_fit = opts["restarts"] + 1
         repeats = 0
+        visited: list[StartOutcome] = []  # every pass's outcome: other local solutions for alternatives()
         for k in range(opts["restarts"] + 1):
             if k > 0:
                 if deadline is not None and time.perf_counter() >= deadline:
@@ -317,6 +319,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             passes += 1
             cand = self.outcome(x0, theta, finished=not spent, status="time_limit" if spent else "converged",
                                 message="", iterations=total_nfev, wall_time=time.perf_counter() - t0)
+            visited.append(cand)
             if best is None or cand.cost < best.cost * (1 - 1e-6):
                 best, repeats = cand, 1
             elif cand.cost <= best.cost * (1 + 1e-6):
@@ -355,9 +358,11 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 "time_limit": f"time limit of {limit:g} s reached after {passes} pass(es)" if limit else "",
                 "stopped": f"stopped by the callback after {passes} pass(es)",
                 "repeated": f"{_REPEATS} of {passes} passes ended at the same best misfit"}[status]
-        return self.outcome(x0, best.theta, finished=status != "time_limit" or best.success, status=status,
-                            message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}",
-                            iterations=total_nfev, wall_time=wall)
+        out = self.outcome(x0, best.theta, finished=status != "time_limit" or best.success, status=status,
+                           message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}",
+                           iterations=total_nfev, wall_time=wall)
+        others = tuple(c for c in visited if c is not best)
+        return dataclasses.replace(out, passes=others) if others else out
 
     def polisher(self) -> Any:
         """IPOPT on the same frequency response and noise weighting (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
