@@ -7,7 +7,11 @@ state-space networks with parameters in A, B and C, and catenary or mammillary
 compartment models with a volume in C; true values drawn log-uniformly over physical
 ranges (SI units), frequency grids that cover the modes. Every problem is checked with
 :func:`symid.identifiability` before it is used: one with a parameter that is not
-locally identifiable is drawn again, never counted against a method.
+locally identifiable is drawn again, never counted against a method. A problem whose
+grid cannot resolve the success tolerance — some parameter 10⁻³ off changes the
+relative misfit by less than 10⁻²⁰ (:func:`population_models.resolution`) — is skipped
+and the next problem index taken (at most ``--problems`` + 10 per class and size); the
+summary lists the skipped ones (``unresolved``), which are never counted against a method.
 
 Per problem, noise level (noise-free, 1 % relative) and kind of start:
 
@@ -65,7 +69,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from population_models import CLASSES, Problem, make_problem  # benchmarks/ (the script's folder) is on the path
+from population_models import (  # benchmarks/ (the script's folder) is on the path
+    CLASSES,
+    RESOLUTION_FLOOR,
+    Problem,
+    make_problem,
+    resolution,
+)
 
 import symid as si
 from symid.fit.frf.ls import ls_applicable
@@ -78,6 +88,7 @@ METHODS = ("auto", "lm", "ipopt", "scr", "scr+polish", "ls")
 SCALED = ("auto", "lm", "ipopt", "scr")  # methods that take the user's typical values as scale=
 TIMED = ("auto", "lm", "ipopt", "scr")  # methods that take time_limit=
 MAX_SIZE = {"compartment": 6, "state_space": 8}  # larger sizes of these classes are skipped
+EXTRA_INDICES = 10  # problem indices tried beyond --problems when some are skipped as unresolved
 
 
 def _problem(log: RunLog, cls: str, n: int, index: int, timeout: float) -> Problem:
@@ -86,7 +97,7 @@ def _problem(log: RunLog, cls: str, n: int, index: int, timeout: float) -> Probl
     rec = log.get(key)
     if rec is not None:
         p = make_problem(cls, n, index, check=False, draw=rec["info"]["draw"])
-        p.info.update(rec["info"])
+        p.info.update(rec["info"])  # a problem logged before resolutions were: the one just computed stays
         return p
     t0 = time.perf_counter()
     p = make_problem(cls, n, index, timeout=timeout)
@@ -150,10 +161,25 @@ def run_problem(log: RunLog, p: Problem, args: argparse.Namespace, executor: Exe
                            executor=executor, progress=args.progress, noise_floor=None)
 
 
+def resolved(p: Problem) -> bool:
+    """The grid resolves the success tolerance (module docstring)."""
+    return float(p.info["resolution"]) > RESOLUTION_FLOOR
+
+
+def _logged_resolution(rec: dict[str, Any]) -> float:
+    """The resolution of a logged problem (computed again for logs written before it was recorded)."""
+    info = rec["info"]
+    if "resolution" in info:
+        return float(info["resolution"])
+    p = make_problem(rec["cls"], int(rec["n"]), int(rec["index"]), check=False, draw=info["draw"])
+    return resolution(p.model, p.truth, p.w)
+
+
 def summarise(log: RunLog) -> dict[str, Any]:
     """Success rate, median time per start and time to solution per class × method × noise × start kind,
-    from every record in the log."""
+    from every record in the log (problems the grid does not resolve are listed apart, not counted)."""
     problems: dict[str, dict[str, Any]] = {}
+    unresolved: dict[str, float] = {}
     refs: dict[tuple[str, str], dict[str, Any]] = {}
     runs: list[dict[str, Any]] = []
     for rec in log.records():
@@ -161,7 +187,11 @@ def summarise(log: RunLog) -> dict[str, Any]:
         if parts[0] == "run" and len(parts) == 2:
             runs.append({k: rec.get(k) for k in ("started", "commit", "methods", "sizes")})
         elif parts[-1] == "problem":
-            problems[parts[0]] = rec
+            res = _logged_resolution(rec)
+            if res > RESOLUTION_FLOOR:
+                problems[parts[0]] = rec
+            else:
+                unresolved[parts[0]] = res
         elif parts[-1] == "reference":
             refs[(parts[0], parts[1])] = rec
     cells: dict[tuple, dict[str, Any]] = defaultdict(lambda: {"starts": 0, "success": 0, "times": [], "setup": 0.0,
@@ -202,7 +232,8 @@ def summarise(log: RunLog) -> dict[str, Any]:
     for prob in problems.values():
         sizes[prob["cls"]].add(int(prob["n"]))
     return {"rows": rows, "size_rows": size_rows, "problems": len(problems),
-            "sizes": {k: sorted(v) for k, v in sizes.items()}, "runs": runs}
+            "sizes": {k: sorted(v) for k, v in sizes.items()}, "runs": runs,
+            "unresolved": {k: unresolved[k] for k in sorted(unresolved)}}
 
 
 def _git_commit() -> str:
@@ -263,6 +294,8 @@ def main(argv: list[str] | None = None) -> int:
         summary = {**header, **summarise(log), "criteria": {
             "noise-free": "largest relative error of any parameter <= 1e-3, or (not proven globally identifiable) "
                           "an exact fit (misfit <= 1e-10) with positive parameters",
+            "problems": f"structurally locally identifiable, and a 1e-3 error of any parameter changes the misfit by "
+                        f"more than {RESOLUTION_FLOOR:g} (to first order); the others are listed in 'unresolved'",
             "noisy": "largest relative error of any parameter <= 2 x that of IPOPT started at the truth, or (not "
                      "proven globally identifiable) misfit <= 1.001 x the reference's with positive parameters"}}
         write_json_atomic(args.out, summary)
@@ -292,12 +325,23 @@ def main(argv: list[str] | None = None) -> int:
             for cls in args.classes:
                 if n > MAX_SIZE.get(cls, 8):
                     continue
-                for index in range(args.problems):
+                accepted = 0
+                for index in range(args.problems + EXTRA_INDICES):
+                    if accepted == args.problems:
+                        break
                     p = _problem(log, cls, n, index, args.check_timeout)
+                    if not resolved(p):
+                        print(f"{p.name}: skipped, the grid does not resolve a 1e-3 error (resolution "
+                              f"{p.info['resolution']:.1e} <= {RESOLUTION_FLOOR:g})", flush=True)
+                        continue
+                    accepted += 1
                     print(f"{p.name}: {p.model.n_parameters} parameters, {p.info.get('identifiability')}, "
                           f"{time.perf_counter() - t0:.0f} s", flush=True)
                     run_problem(log, p, args, executor)
                     write_summary()
+                if accepted < args.problems:
+                    print(f"{cls}, n = {n}: only {accepted} of {args.problems} problems resolved in "
+                          f"{args.problems + EXTRA_INDICES} indices", flush=True)
     except (KeyboardInterrupt, Interrupted):
         print(f"\ninterrupted: {len(log)} finished runs are kept in {args.log}; run the same command again to "
               f"resume", file=sys.stderr)

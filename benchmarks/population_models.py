@@ -31,6 +31,23 @@ Classes
 Every problem is checked with :func:`symid.identifiability` before it is used: a
 problem with a parameter that is not locally identifiable is refused and drawn
 again (never counted against a method).
+
+Practical identifiability at the benchmark's tolerance
+------------------------------------------------------
+Structural identifiability says the exact frequency response determines θ; it does not
+say that the 100 lines of the grid determine it to the 10⁻³ the success rule asks for.
+:func:`resolution` is the smallest relative misfit Σ|H(θ) − H(θ*)|²/Σ|H(θ*)|² of any θ
+with some parameter 10⁻³ off (to first order: a box-constrained least-squares problem in
+the relative sensitivities, exact derivatives from :func:`symid.fit.sensitivity.frf_sensitivity`).
+Below :data:`RESOLUTION_FLOOR` = 10⁻²⁰ (a relative residual of 10⁻¹⁰) an estimate 10⁻³
+off fits the data as well as methods' stopping rules can tell (the estimators stop on
+relative cost changes of 10⁻¹² and symid's ``auto`` treats a misfit of 10⁻²⁰ as
+rounding level), so a failure there says nothing about a method. Measured over 12 draws
+per cell (``python benchmarks/population_models.py``): every draw at n = 2, 3 passes;
+at n = 5 chains 92 %, chains with sensors 83 %, compartments 42 %, state-space
+networks none; at n = 8 chains 42 %, with sensors 50 %, gains 75 %, state space none.
+:func:`make_problem` reports the value in ``info["resolution"]``; ``population.py``
+skips such problems (listed in its summary, never counted against a method).
 """
 
 from __future__ import annotations
@@ -43,9 +60,11 @@ import numpy as np
 
 import symid as si
 
-__all__ = ["CLASSES", "Problem", "make_problem"]
+__all__ = ["CLASSES", "RESOLUTION_FLOOR", "Problem", "make_problem", "resolution"]
 
 CLASSES = ("chain", "chain_sensors", "gains", "state_space", "compartment")
+RESOLUTION_FLOOR = 1e-20  # module docstring: below it the data cannot tell a 1e-3 error from the truth
+SUCCESS_TOLERANCE = 1e-3  # the benchmark's noise-free success rule (largest relative parameter error)
 
 # log-uniform ranges of the true values (SI units)
 _MASS = (0.5, 20.0)          # kg
@@ -106,6 +125,35 @@ def _grid(model: Any, theta: np.ndarray, count: int = 100) -> np.ndarray:
     lam = np.abs(np.linalg.eigvals(A))
     lam = lam[lam > 0]
     return np.logspace(math.log10(0.3 * lam.min()), math.log10(3.0 * lam.max()), count)
+
+
+def resolution(model: Any, truth: np.ndarray, w: np.ndarray, tolerance: float = SUCCESS_TOLERANCE) -> float:
+    """Smallest relative misfit of a θ with some parameter ``tolerance`` (relative) off, to first order.
+
+    With S the sensitivities ∂H/∂ln θ over the grid, normalised by ‖H(θ*)‖, this is
+    minₖ min { ‖S δ‖² : δₖ = ±tolerance, |δⱼ| ≤ tolerance } — a bounded least-squares
+    problem per parameter (:func:`scipy.optimize.lsq_linear`); the sign does not matter.
+    """
+    from scipy.optimize import lsq_linear
+
+    from symid.fit.sensitivity import frf_sensitivity
+
+    truth = np.asarray(truth, dtype=float)
+    H, dH = frf_sensitivity(model, truth, w)
+    rel = np.asarray(dH) * truth / np.linalg.norm(H)  # ∂H/∂ln θₖ over ‖H‖, last axis k
+    S = rel.reshape(-1, truth.size)
+    S = np.vstack([S.real, S.imag])
+    best = math.inf
+    for k in range(truth.size):
+        rest = np.delete(S, k, axis=1)
+        b = -tolerance * S[:, k]
+        if rest.shape[1]:
+            sol = lsq_linear(rest, b, bounds=(-tolerance, tolerance), lsmr_tol="auto", method="bvls")
+            r = rest @ sol.x - b
+        else:
+            r = -b
+        best = min(best, float(r @ r))
+    return best
 
 
 def _chain_mvk(n: int, m: list, c: list, k: list) -> tuple[list, list, list]:
@@ -234,6 +282,9 @@ def make_problem(cls: str, n: int, index: int, *, seed: int = 0, check: bool = T
                  max_draws: int = 20, draw: int | None = None) -> Problem:
     """Problem ``index`` of class ``cls`` with size ``n``, drawn until it is locally identifiable.
 
+    ``info["resolution"]`` says whether the grid resolves the success tolerance (module
+    docstring); the benchmark skips a problem where it does not.
+
     ``check=False`` skips :func:`symid.identifiability` (for tests of the generator only,
     or with ``draw``: the draw an earlier checked call accepted, to rebuild the same
     problem without checking it again). The identifiability report's verdicts and
@@ -261,6 +312,29 @@ def make_problem(cls: str, n: int, index: int, *, seed: int = 0, check: bool = T
         if refused:
             info["refused"] = refused
         w = _grid(model, truth)
+        info["resolution"] = resolution(model, truth, w)
         return Problem(name=f"{cls}-n{n}-{index}", cls=cls, model=model, truth=truth, typical=typical, w=w,
                        n_size=n, info=info)
     raise RuntimeError(f"no locally identifiable {cls} problem of size {n} in {max_draws} draws")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print, per class and size, the share of draws whose :func:`resolution` is above the floor."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=main.__doc__)
+    ap.add_argument("--draws", type=int, default=12, help="draws per class and size (default %(default)s)")
+    ap.add_argument("--sizes", default="2,3,5,8")
+    args = ap.parse_args(argv)
+    print("class | n | resolved draws | median resolution | smallest | largest")
+    for cls in CLASSES:
+        for n in (int(v) for v in args.sizes.split(",") if v):
+            vals = np.array([make_problem(cls, n, 0, check=False, draw=d).info["resolution"]
+                             for d in range(args.draws)])
+            print(f"{cls} | {n} | {np.mean(vals > RESOLUTION_FLOOR):.0%} | {np.median(vals):.1e} | {vals.min():.1e} | "
+                  f"{vals.max():.1e}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
