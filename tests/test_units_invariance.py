@@ -171,6 +171,17 @@ def test_ipopt_spectra_frequency_axis_and_data_rescaled(spectra, a):
 
 
 # -- output error on sampled records (oe) -----------------------------------------------------------------
+#
+# oe's cost is a sum over a simulated record, whose rounding is larger than a frequency response's: measured
+# 4e-15 relative at the estimate below (cost at the estimate, 20 perturbations of 1e-15). Once the cost is within
+# that of its minimum, IPOPT's last barrier steps compare costs that differ by less than their rounding, and how many
+# it takes depends on the rounding (measured over 39 unit changes of the set-up below: 10 iterations in 35, 11, 13,
+# 15 and 20 in one each; the code before the start scaling gave 10 in 37 and 11 in 2 of its 39). What does not
+# depend on it is asserted: every iteration whose cost is above the final cost by more than 1e-11 relative is the
+# same iteration with the same iterate (mapped back, rtol 1e-9), and the estimate, cost, status and success are the
+# same. The threshold sits between the two groups, and every run checks that none of its iterations falls near it
+# (between 1e-12 and 1e-10; measured over the runs of this section: the iterations that make progress are 1.5e-9
+# or more above the final cost, the others 9.8e-14 or less).
 
 def oscillator(factors=None) -> si.SecondOrderModel:
     factors = np.ones(3) if factors is None else factors
@@ -182,49 +193,83 @@ def oscillator(factors=None) -> si.SecondOrderModel:
 OE_TRUTH = np.array([2.0, 0.8, 50.0])
 OE_START = OE_TRUTH * np.array([1.5, 0.6, 1.3])
 DT = 0.05
+PROGRESS = 1e-11  # an iteration makes progress while its cost exceeds the final cost by more than this (relative)
+
+
+def oe_run(model, data, x0, **options):
+    """The outcome and the iterations that make progress: (cost, θ) while the cost is above its end by PROGRESS."""
+    seen = []
+    out = OutputError(model, data, callback=seen.append, **options).run(x0)
+    assert seen[-1].objective == pytest.approx(out.cost, rel=1e-9)
+    excess = np.array([i.objective / out.cost - 1 for i in seen])
+    assert not np.any((excess > PROGRESS / 10) & (excess < PROGRESS * 10)), excess  # no iteration near the threshold
+    return out, [(i.objective, i.theta) for i in seen if i.objective > out.cost * (1 + PROGRESS)]
+
+
+def same_oe(run, ref, back):
+    """As :func:`same`, with oe's iterations compared while they make progress (see above)."""
+    (out, path), (base, base_path) = run, ref
+    np.testing.assert_allclose(out.theta * back, base.theta, rtol=RTOL)
+    assert out.cost == pytest.approx(base.cost, rel=1e-7)
+    assert (out.status, out.success) == (base.status, base.success)
+    assert len(path) == len(base_path)
+    for (cost, theta), (cost0, theta0) in zip(path, base_path, strict=True):
+        assert cost == pytest.approx(cost0, rel=1e-9)
+        np.testing.assert_allclose(theta * back, theta0, rtol=1e-9)
 
 
 @pytest.fixture(scope="module")
 def records():
     u = np.random.default_rng(0).standard_normal(200)
     io = si.simulate_io(oscillator(), OE_TRUTH, u, DT, noise=0.01, seed=2)
-    ref = OutputError(oscillator(), io, scale=OE_START).run(OE_START)
-    assert ref.status == "Solve_Succeeded"
+    ref = oe_run(oscillator(), io, OE_START)
+    assert ref[0].status == "Solve_Succeeded" and np.all(np.abs(ref[0].theta / OE_TRUTH - 1) < 0.02)
+    assert len(ref[1]) >= 8  # the path compared is the whole descent from the start, not its last step
     return io, ref
 
 
 @pytest.mark.parametrize("a", (-6, 6))
 @pytest.mark.parametrize("k", range(3))
-def test_oe_parameter_rescaled_with_the_start_as_scale(records, k, a):
+def test_oe_parameter_rescaled(records, k, a):
     io, ref = records
     f = np.ones(3)
     f[k] = 10.0**a
-    out = OutputError(oscillator(f), io, scale=OE_START / f).run(OE_START / f)
-    np.testing.assert_allclose(out.theta * f, ref.theta, rtol=RTOL)
-    assert (out.status, out.iterations) == (ref.status, ref.iterations)
+    same_oe(oe_run(oscillator(f), io, OE_START / f), ref, f)
 
 
-@pytest.mark.xfail(strict=True, reason="oe (symid/fit/timeseries/oe.py) scales θ by scale=1 unless given: a "
-                                       "parameter in other units is another problem for IPOPT (measured: ×1e6 on m "
-                                       "gives an estimate 4e6 × off); reported in the issue-14 IPOPT note")
-def test_oe_parameter_rescaled_by_default(records):
+def test_oe_every_parameter_rescaled_at_once_with_the_start_as_scale(records):
     io, ref = records
-    f = np.array([1e6, 1.0, 1.0])
-    out = OutputError(oscillator(f), io).run(OE_START / f)
-    np.testing.assert_allclose(out.theta * f, ref.theta, rtol=1e-6)
+    f = 10.0 ** np.array([-5, 4, 6])
+    same_oe(oe_run(oscillator(f), io, OE_START / f, scale=OE_START / f), ref, f)
 
 
-@pytest.mark.xfail(strict=True, reason="oe on a time axis or outputs rescaled by 1e±6 stops at IPOPT's iteration "
-                                       "limit (500) even with scale= the start (measured: estimates within 2e-8, "
-                                       "status Maximum_Iterations_Exceeded); reported in the issue-14 IPOPT note")
-@pytest.mark.parametrize("a", (-6, 6))
+@pytest.mark.parametrize("a", EXPONENTS)
 def test_oe_time_axis_and_outputs_rescaled(records, a):
     io, ref = records
     alpha = 10.0**a
     T = time_factor(alpha)[[0, 2, 4]]
-    out = OutputError(oscillator(), si.IOData(io.u, io.y, DT / alpha), scale=OE_START * T).run(OE_START * T)
-    assert out.status == ref.status
-    np.testing.assert_allclose(out.theta / T, ref.theta, rtol=RTOL)
-    out = OutputError(oscillator(), si.IOData(io.u, io.y * alpha, DT), scale=OE_START / alpha).run(OE_START / alpha)
-    assert out.status == ref.status
-    np.testing.assert_allclose(out.theta * alpha, ref.theta, rtol=RTOL)
+    same_oe(oe_run(oscillator(), si.IOData(io.u, io.y, DT / alpha), OE_START * T), ref, 1 / T)
+    same_oe(oe_run(oscillator(), si.IOData(io.u, io.y * alpha, DT), OE_START / alpha), ref, alpha)
+
+
+def test_oe_all_units_changed_together_with_estimated_initial_states():
+    """A record that starts away from rest (q = 0.3, q̇ = −1) with its initial state estimated: the state's units
+    change with the time axis (q̇) and the output (q and q̇), and the estimate follows."""
+    u = np.random.default_rng(0).standard_normal(200)
+    io = si.simulate_io(oscillator(), OE_TRUTH, u, DT, x0=[0.3, -1.0], noise=0.01, seed=2)
+    ref = oe_run(oscillator(), io, OE_START, initial_state="estimate")
+    assert ref[0].status == "Solve_Succeeded"
+    f = 10.0 ** np.array([3, -4, 2])
+    alpha, beta = 1e-3, 1e5
+    T = time_factor(alpha)[[0, 2, 4]] / beta / f
+    same_oe(oe_run(oscillator(f), si.IOData(io.u, io.y * beta, DT / alpha), OE_START * T, initial_state="estimate"),
+            ref, 1 / T)
+
+
+def test_the_unscaled_oe_set_up_was_not_invariant(records):
+    """What the start scaling is for: with θ as it is (scale 1), a mass declared in a unit 1e6 times larger is
+    another problem for IPOPT (measured: an estimate 4e6 × off, "Solve_Succeeded")."""
+    io, ref = records
+    f = np.array([1e6, 1.0, 1.0])
+    out = OutputError(oscillator(f), io, scale=np.ones(3)).run(OE_START / f)
+    assert np.max(np.abs(out.theta * f / ref[0].theta - 1)) > 1.0

@@ -311,14 +311,16 @@ class ScaledIpopt:
 
     One solver is built per (decade, μ₀ decade, iteration cap, time cap) on demand, all
     from one CasADi function of the objective (the second costs a fraction of the first).
+    An objective that depends on further numbers fixed per start (``parameters``, e.g.
+    the balancing of a matrix exponential) takes them as CasADi parameters too.
 
     Parameters
     ----------
     name : str
         CasADi name of the solver.
-    theta : casadi.MX
+    theta : casadi.MX or casadi.SX
         The parameter symbol (a column of ``l`` entries).
-    f : casadi.MX
+    f : casadi.MX or casadi.SX
         The objective in ``theta`` (normalised by the caller, e.g. by ‖data‖²).
     lower, upper : numpy.ndarray
         Bounds on θ (``-inf``/``inf`` for none).
@@ -331,6 +333,9 @@ class ScaledIpopt:
         value stops the start (status ``"User_Requested_Stop"``).
     ipopt_options : dict, optional
         Further IPOPT options, for studies of the set-up.
+    parameters : casadi.MX or casadi.SX, optional
+        A column of further symbols in ``f`` whose values every :meth:`solve` gives
+        (``values``); they are not optimised.
     start_scaling, objective_scaling, barrier_from_start : bool
         The three scalings above (default all True; False gives IPOPT's own set-up, for
         comparisons).
@@ -353,21 +358,24 @@ class ScaledIpopt:
                  tol: float, hessian: str, time_limit: float | None = None, scale: np.ndarray | None = None,
                  callback: Callable[[IpoptIteration], Any] | None = None,
                  ipopt_options: dict[str, Any] | None = None, start_scaling: bool = True,
-                 objective_scaling: bool = True, barrier_from_start: bool = True):
+                 objective_scaling: bool = True, barrier_from_start: bool = True, parameters: Any = None):
         self.name = name
         self.lower = np.asarray(lower, dtype=float)
         self.upper = np.asarray(upper, dtype=float)
         self.l = self.lower.size
         self.scale = None if scale is None else np.asarray(scale, dtype=float)
-        self.objective = ca.Function(f"{name}_f", [theta], [f])
-        self.gradient = ca.Function(f"{name}_g", [theta], [ca.gradient(f, theta)]) if barrier_from_start else None
+        self.n_values = 0 if parameters is None else int(parameters.numel())
+        q = (ca.MX if isinstance(theta, ca.MX) else ca.SX)(0, 1) if parameters is None else parameters
+        self.objective = ca.Function(f"{name}_f", [theta, q], [f])
+        self.gradient = ca.Function(f"{name}_g", [theta, q], [ca.gradient(f, theta)]) if barrier_from_start else None
         self.max_iter, self.tol, self.hessian, self.time_limit = int(max_iter), float(tol), hessian, time_limit
         self.ipopt_options = dict(ipopt_options or {})
         self.start_scaling, self.objective_scaling = bool(start_scaling), bool(objective_scaling)
         self.callback = callback
         self._iter_callback = None
         if callback is not None:
-            self._iter_callback = _IterationCallback(f"{name}_progress", self.l, self.l, self._report)
+            self._iter_callback = _IterationCallback(f"{name}_progress", self.l, self.l + self.n_values,
+                                                     self._report)
         self._context: dict[str, Any] = {}
         self._solvers: dict[tuple[int, int, int, float | None], Any] = {}
 
@@ -380,22 +388,28 @@ class ScaledIpopt:
             return np.ones(self.l)
         return start_scale(theta0, self.lower, self.upper)
 
-    def decade(self, theta0: np.ndarray) -> int:
+    def _values(self, values: Any) -> np.ndarray:
+        v = np.zeros(0) if values is None else np.asarray(values, dtype=float).reshape(-1)
+        if v.size != self.n_values:
+            raise ValueError(f"{self.name}: {self.n_values} parameter value(s) expected, got {v.size}")
+        return v
+
+    def decade(self, theta0: np.ndarray, values: Any = None) -> int:
         """⌊log₁₀ f(θ₀)⌋ clipped to [−4, 0] (0 without objective scaling or where f is not finite)."""
         if not self.objective_scaling:
             return 0
         try:
-            f0 = float(self.objective(theta0))
+            f0 = float(self.objective(theta0, self._values(values)))
         except RuntimeError:
             return 0
         return int(np.clip(np.floor(np.log10(f0)), -_DECADES, 0)) if np.isfinite(f0) and f0 > 0 else 0
 
-    def barrier_decade(self, theta0: np.ndarray, s: np.ndarray, decade: int) -> int:
+    def barrier_decade(self, theta0: np.ndarray, s: np.ndarray, decade: int, values: Any = None) -> int:
         """log₁₀ μ₀: ⌊log₁₀(0.1 ‖∇_z f(θ₀)‖∞ / c)⌋ clipped to [−10, −1] (−1, IPOPT's μ₀ = 0.1, without it)."""
         if self.gradient is None:
             return -1
         try:
-            g = np.asarray(self.gradient(theta0), dtype=float).reshape(-1) * s / 10.0**decade
+            g = np.asarray(self.gradient(theta0, self._values(values)), dtype=float).reshape(-1) * s / 10.0**decade
         except RuntimeError:
             return -1
         gmax = float(np.max(np.abs(g))) if g.size else 0.0
@@ -427,7 +441,8 @@ class ScaledIpopt:
         if key not in self._solvers:
             z = ca.MX.sym("z", self.l)
             s = ca.MX.sym("s", self.l)
-            nlp = {"x": z, "p": s, "f": self.objective(z * s) / 10.0**decade}
+            q = ca.MX.sym("q", self.n_values)
+            nlp = {"x": z, "p": ca.vertcat(s, q), "f": self.objective(z * s, q) / 10.0**decade}
             self._solvers[key] = ca.nlpsol(f"{self.name}_{len(self._solvers)}", "ipopt", nlp,
                                            self._options(decade, mu, max_iter, time_limit))
         return self._solvers[key]
@@ -439,25 +454,28 @@ class ScaledIpopt:
         ctx["iteration"] += 1
         return bool(self.callback(info)) if self.callback is not None else False
 
-    def solve(self, theta0: np.ndarray, *, max_iter: int | None = None, time_limit: float | None = None) -> IpoptRun:
+    def solve(self, theta0: np.ndarray, *, max_iter: int | None = None, time_limit: float | None = None,
+              scale: np.ndarray | None = None, values: Any = None) -> IpoptRun:
         """Run IPOPT from ``theta0`` (clipped to the bounds); ``IpoptRun.z`` is θ, within the bounds.
 
         ``max_iter`` and ``time_limit`` cap this solve below the solver's own (e.g. a trial
-        polish). Never raises on solver failure (as :meth:`IpoptSolver.solve`).
+        polish); ``scale`` replaces s for this solve; ``values`` are those of ``parameters``.
+        Never raises on solver failure (as :meth:`IpoptSolver.solve`).
         """
         theta0 = np.clip(np.asarray(theta0, dtype=float), self.lower, self.upper)
         iters = self.max_iter if max_iter is None else min(int(max_iter), self.max_iter)
         limit = self.time_limit
         if time_limit is not None:
             limit = float(time_limit) if limit is None else min(float(time_limit), limit)
-        s = self.scale_for(theta0)
-        decade = self.decade(theta0)
-        solver = self._solver(decade, self.barrier_decade(theta0, s, decade), iters, limit)
+        s = self.scale_for(theta0) if scale is None else np.asarray(scale, dtype=float)
+        q = self._values(values)
+        decade = self.decade(theta0, q)
+        solver = self._solver(decade, self.barrier_decade(theta0, s, decade, q), iters, limit)
         t0 = time.perf_counter()
         self._context = {"iteration": 0, "c": 10.0**decade, "s": s, "t0": t0}
         try:
             with native_interrupts(raise_now=True):
-                sol = solver(x0=theta0 / s, p=s, lbx=self.lower / s, ubx=self.upper / s)
+                sol = solver(x0=theta0 / s, p=np.concatenate([s, q]), lbx=self.lower / s, ubx=self.upper / s)
             stats = solver.stats()
             # IPOPT relaxes the bounds by 1e-8 (bound_relax_factor): the estimate returned lies within them
             theta = np.clip(np.asarray(sol["x"]).reshape(-1) * s, self.lower, self.upper)

@@ -14,6 +14,14 @@ a noise model K = 0 (Ljung, *System Identification*, 2nd ed., §4.2, §7.2); no 
 or persistent excitation is needed: a single bolus dose identifies a two-compartment
 model. The gradient and Hessian come from CasADi's automatic differentiation through the
 exact discretisation.
+
+Nothing in the set-up depends on units (issue 14): the cost is relative to each channel's
+energy; IPOPT works on θ / |θ₀| per start (and on every estimated initial state over the
+state's rms along the start's response), on the cost over its start's decade, with a barrier
+no stronger than the cost's pull at the start (:class:`symid.engine.ipopt.ScaledIpopt`); and
+the matrix exponential is balanced before its Taylor polynomial
+(:func:`symid.fit.timeseries.response.balancing`), so that a time axis or a state in other
+units does not change its rounding.
 """
 
 from __future__ import annotations
@@ -24,13 +32,13 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from symid.engine.ipopt import HESSIANS, IpoptSolver, positivity_bounds
+from symid.engine.ipopt import HESSIANS, IpoptIteration, ScaledIpopt, iteration_reporter, positivity_bounds, start_scale
 from symid.errors import DataError, OptionError
 from symid.fit.base import Estimator
-from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale
+from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.timeseries.records import as_records
-from symid.fit.timeseries.response import casadi_output, simulate_output, squarings, state_transitions
+from symid.fit.timeseries.response import balancing, casadi_output, simulate_output, squarings, state_transitions
 from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
 __all__ = ["OutputError"]
@@ -110,7 +118,9 @@ class OutputError(Estimator, FisherInformation):
         ``None`` (default): the model's. ``"estimate"``: one unknown initial state per
         record. Numbers (n,), or a list of them per record: known initial states.
     scale : array_like, optional
-        Typical magnitude of each parameter; IPOPT works on θ / scale. Default 1.
+        Typical magnitude of each parameter; IPOPT works on θ / scale. Default: each
+        start's own magnitudes |θ₀| (where θ₀ is 0: 1), so that the estimate does not
+        depend on the units of θ.
     positivity : bool, optional
         Bound parameters declared ``positive=True`` below by 0. Default True.
     hessian : {"exact", "limited-memory"}, optional
@@ -120,7 +130,18 @@ class OutputError(Estimator, FisherInformation):
     tol : float, optional
         IPOPT tolerance on the relative objective (default 1e-12: the two-compartment
         study fits noise-free samples to 2e-11 in θ; 1e-14 stops noisy fits with
-        "Search_Direction_Becomes_Too_Small" at the optimum).
+        "Search_Direction_Becomes_Too_Small" at the optimum); divided by the start's
+        decade of the objective as :class:`~symid.engine.ipopt.ScaledIpopt` does.
+    time_limit : float, optional
+        Wall-time budget of one start in seconds from its first IPOPT iteration (the
+        first start also builds the solver), checked after every iteration (status
+        ``"Maximum_WallTime_Exceeded"``). Default: none.
+    callback : callable, optional
+        Called after every IPOPT iteration with a
+        :class:`~symid.engine.ipopt.IpoptIteration` (iteration, relative misfit, elapsed
+        seconds, θ); a true return value stops the start (status ``"User_Requested_Stop"``).
+    verbose : bool, optional
+        Print one line per iteration (iteration, misfit, elapsed). Default False.
 
     Examples
     --------
@@ -142,20 +163,33 @@ class OutputError(Estimator, FisherInformation):
     cost_kind: ClassVar[str] = "relative output misfit to the measured samples (1/p) Σⱼ ‖yⱼ − ŷⱼ‖² / ‖yⱼ‖²"
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
-                 positivity: bool = True, hessian: str = "exact", max_iter: int = 500, tol: float = 1e-12):
+                 positivity: bool = True, hessian: str = "exact", max_iter: int = 500, tol: float = 1e-12,
+                 time_limit: float | None = None, callback: Any = None, verbose: bool = False):
         self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
         self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
         if self._x0_mode == "known":
             self._x0_known = _known_states(self._x0_known, model.n_states, len(self.records))
         self.model, self.data = model, data
         l = model.n_parameters
-        self.scale = np.ones(l) if scale is None else check_scale("scale", scale, l)
+        self.scale = None if scale is None else check_scale("scale", scale, l)
         self._positivity = check_bool("positivity", positivity)
         self._hessian = check_choice("hessian", hessian, HESSIANS)
         self._max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         self._tol = check_float("tol", tol, low=0, strict_low=True)
-        self.options = {"scale": self.scale.tolist(), "positivity": self._positivity, "hessian": self._hessian,
-                        "max_iter": self._max_iter, "tol": self._tol, "records": len(self.records),
+        self._time_limit = check_time_limit("time_limit", time_limit)
+        verbose = check_bool("verbose", verbose)
+        if callback is not None and not callable(callback):
+            raise OptionError(f"callback must be a function of one IpoptIteration (or None); got "
+                              f"{type(callback).__name__}")
+        self._report = iteration_reporter(callback, verbose)
+        self._iterations_before = 0  # of earlier rounds of the same start (run), for the callback's count
+        self._deadline: float | None = None  # of the start under way (time_limit), checked every iteration
+        self._timed_out = False
+        self.options = {"scale": "start" if self.scale is None else self.scale.tolist(),
+                        "positivity": self._positivity, "hessian": self._hessian,
+                        "max_iter": self._max_iter, "tol": self._tol, "time_limit": self._time_limit,
+                        "callback": None if callback is None else "given", "verbose": verbose,
+                        "records": len(self.records),
                         "initial_state": self._x0_mode if self._x0_mode != "model" else model.initial_state_kind}
         p = model.n_outputs
         energy = sum(np.sum(r.y**2, axis=0) for r in self.records)
@@ -172,7 +206,8 @@ class OutputError(Estimator, FisherInformation):
                                if self._estimate_x0 else ""))
         self._x0_scale = np.array([max(float(np.abs(r.y).max()), 1e-300) for r in self.records])
         self._h_max = max(float(np.diff(r.t).max()) for r in self.records)
-        self._solvers: dict[tuple[int, int], IpoptSolver] = {}
+        self._lower = positivity_bounds(model.positive, self._positivity, np.ones(l))[0]
+        self._solvers: dict[int, ScaledIpopt] = {}
         self._residual_fns: dict[int, Any] = {}
 
     # -- the data kind's part ------------------------------------------------------------------
@@ -237,88 +272,143 @@ class OutputError(Estimator, FisherInformation):
 
     # -- CasADi ----------------------------------------------------------------------------------
     def _symbolic(self, s_max: int) -> tuple[Any, Any, Any]:
-        """Unknowns z, the weighted residual vector r(z) (cost = ‖r‖²) and per-record outputs."""
-        l, n = self.model.n_parameters, self.model.n_states
+        """Unknowns v = (θ, estimated initial states) in their own units, the balancing q = (d, e) of the
+        exponential (:func:`~symid.fit.timeseries.response.balancing`) and the weighted residual vector
+        r(v, q) (cost = ‖r‖²)."""
+        l, n, m = self.model.n_parameters, self.model.n_states, self.model.n_inputs
         E = len(self.records)
-        nz = l + (n * E if self._estimate_x0 else 0)
-        z = ca.SX.sym("z", nz)
-        theta = z[:l] * ca.DM(self.scale)
+        v = ca.SX.sym("v", l + (n * E if self._estimate_x0 else 0))
+        q = ca.SX.sym("q", n + m)
+        theta = v[:l]
         A, B, C, D = _sx_state_space(self.model, theta)
         x0_map = self.model.initial_state_map if self._x0_mode == "model" else None
         res = []
         sw = ca.DM(np.sqrt(self._weights)).T
         for e, r in enumerate(self.records):
             if self._estimate_x0:
-                x0 = z[l + n * e: l + n * (e + 1)] * float(self._x0_scale[e])
+                x0 = v[l + n * e: l + n * (e + 1)]
             elif self._x0_mode == "known":
                 x0 = ca.SX(ca.DM(self._x0_known[e]))
             elif x0_map is None:
                 x0 = ca.SX.zeros(n, 1)
             else:
                 x0 = _sx_matrix(x0_map, theta)
-            Y = casadi_output(A, B, C, D, r.t, r.u, x0, s_max)
+            Y = casadi_output(A, B, C, D, r.t, r.u, x0, s_max, (q[:n], q[n:]))
             R = (ca.DM(r.y) - Y) * ca.repmat(sw, r.n_samples, 1)
             res.append(ca.vec(R))
-        return z, ca.vertcat(*res), theta
+        return v, q, ca.vertcat(*res)
 
     def _residual_function(self, s_max: int) -> Any:
-        """CasADi function z ↦ (r, ∂r/∂z) for ``s_max`` squarings (built once)."""
+        """CasADi function (v, q) ↦ (r, ∂r/∂v) for ``s_max`` squarings (built once)."""
         if s_max not in self._residual_fns:
-            z, r, _ = self._symbolic(s_max)
-            self._residual_fns[s_max] = (z, r, ca.Function("symid_oe_residual", [z], [r, ca.jacobian(r, z)]))
+            v, q, r = self._symbolic(s_max)
+            self._residual_fns[s_max] = ca.Function("symid_oe_residual", [v, q], [r, ca.jacobian(r, v)])
         return self._residual_fns[s_max]
 
-    def _solver(self, s_max: int, decade: int = 0) -> IpoptSolver:
-        """IPOPT on ‖r‖² / 10^decade: the objective near 1 at the start, so that the barrier of the bounds
-        (μ starts at 0.1) does not push a start near the optimum away from it; the tolerance is scaled alike
-        (the same stopping point in the relative misfit)."""
-        key = (s_max, decade)
-        if key not in self._solvers:
-            z, r, _ = self._residual_function(s_max)
-            f = ca.sumsqr(r) / 10.0**decade
-            lbt, ubt = positivity_bounds(self.model.positive, self._positivity, self.scale)
-            extra = z.numel() - lbt.size
-            lbz = np.concatenate([lbt, np.full(extra, -np.inf)])
-            ubz = np.concatenate([ubt, np.full(extra, np.inf)])
-            self._solvers[key] = IpoptSolver("symid_oe", z, f, lbz=lbz, ubz=ubz, max_iter=self._max_iter,
-                                             tol=min(self._tol / 10.0**decade, 1e-4), hessian=self._hessian)
-        return self._solvers[key]
+    def _solver(self, s_max: int) -> ScaledIpopt:
+        """IPOPT on ‖r‖² for ``s_max`` squarings, scaled per start (built once)."""
+        if s_max not in self._solvers:
+            v, q, r = self._symbolic(s_max)
+            extra = v.numel() - self._lower.size
+            lower = np.concatenate([self._lower, np.full(extra, -np.inf)])
+            self._solvers[s_max] = ScaledIpopt(f"symid_oe_{s_max}", v, ca.sumsqr(r), lower=lower,
+                                               upper=np.full(v.numel(), np.inf), max_iter=self._max_iter,
+                                               tol=self._tol, hessian=self._hessian, parameters=q,
+                                               callback=None if self._report is None and self._time_limit is None
+                                               else self._progress)
+        return self._solvers[s_max]
 
-    def _squarings(self, theta: np.ndarray) -> int:
+    def _progress(self, info: IpoptIteration) -> bool:
+        """Every IPOPT iteration: the user's callback (θ alone, iterations counted over the rounds of one start),
+        then the start's time budget (one for all rounds, so IPOPT's own per-solve limit is not used)."""
+        stop = False
+        if self._report is not None:
+            stop = bool(self._report(IpoptIteration(info.iteration + self._iterations_before, info.objective,
+                                                    info.elapsed, info.theta[: self.model.n_parameters].copy())))
+        if self._deadline is not None and time.perf_counter() > self._deadline:
+            self._timed_out = True
+            return True
+        return stop
+
+    def _balance(self, theta: np.ndarray) -> np.ndarray:
+        """q = (d, e): the balancing of the exponential at θ (ones where the model is not finite there)."""
+        try:
+            A, B, _, _ = self._matrices(theta)
+        except (np.linalg.LinAlgError, ValueError):
+            return np.ones(self.model.n_states + self.model.n_inputs)
+        return np.concatenate(balancing(A, B, self._h_max))
+
+    def _squarings(self, theta: np.ndarray, q: np.ndarray) -> int:
         A, B, _, _ = self._matrices(theta)
-        return squarings(A, B, self._h_max)
+        n = self.model.n_states
+        return squarings(A, B, self._h_max, (q[:n], q[n:]))
 
-    def _z_start(self, theta: np.ndarray) -> np.ndarray:
-        z = [theta / self.scale]
-        if self._estimate_x0:
-            try:
-                x0s = self.initial_states(theta)
-            except (np.linalg.LinAlgError, ValueError):
-                x0s = [np.zeros(self.model.n_states) for _ in self.records]
-            z += [np.nan_to_num(x0 / s) for x0, s in zip(x0s, self._x0_scale, strict=True)]
-        return np.concatenate(z)
+    def _unknowns(self, theta: np.ndarray) -> np.ndarray:
+        """v at θ: θ, then (``x0="estimate"``) the least-squares initial state of every record."""
+        if not self._estimate_x0:
+            return theta.copy()
+        try:
+            x0s = self.initial_states(theta)
+        except (np.linalg.LinAlgError, ValueError):
+            x0s = [np.zeros(self.model.n_states) for _ in self.records]
+        return np.concatenate([theta, *(np.nan_to_num(x0) for x0 in x0s)])
+
+    def _unknown_scale(self, v0: np.ndarray) -> np.ndarray:
+        """Typical magnitudes of v for a start: ``scale`` or |θ₀| (:func:`~symid.engine.ipopt.start_scale`);
+        for an estimated initial state, the rms of each state along the start's response of its record
+        (the largest |y| of the record where that is 0 or not finite)."""
+        l, n = self.model.n_parameters, self.model.n_states
+        theta = v0[:l]
+        out = [start_scale(theta, self._lower, np.full(l, np.inf)) if self.scale is None else self.scale]
+        if not self._estimate_x0:
+            return out[0]
+        try:
+            A, B, _, _ = self._matrices(theta)
+            eye, none = np.eye(n), np.zeros((n, self.model.n_inputs))
+            with np.errstate(over="ignore", invalid="ignore"):
+                rms = [np.sqrt(np.mean(simulate_output(A, B, eye, none, r.t, r.u, v0[l + n * e: l + n * (e + 1)])
+                                       ** 2, axis=0)) for e, r in enumerate(self.records)]
+        except (np.linalg.LinAlgError, ValueError):
+            rms = [np.zeros(n) for _ in self.records]
+        for x, fallback in zip(rms, self._x0_scale, strict=True):
+            out.append(np.where(np.isfinite(x) & (x > 0), x, fallback))
+        return np.concatenate(out)
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start ``x0`` (parameter vector); never raises on solver failure.
 
-        The exponential's squarings are set for the start; when the estimate needs more,
-        IPOPT runs again from it with the larger number (at most three rounds).
+        The exponential's balancing and squarings are set for the start; when the estimate
+        needs more squarings, IPOPT runs again from it with the larger number (at most
+        three rounds), with the start's scaling.
         """
         start = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
-        theta, z = start, self._z_start(start)
-        s = self._squarings(start)
-        iters, status, finished = 0, "not run", False
-        f0 = self.misfit(start) if np.all(np.isfinite(start)) else float("inf")
-        decade = int(np.clip(np.floor(np.log10(f0)), -12, 0)) if np.isfinite(f0) and f0 > 0 else 0
+        l = self.model.n_parameters
+        q = self._balance(start) if np.all(np.isfinite(start)) else np.ones(self.model.n_states
+                                                                            + self.model.n_inputs)
+        try:
+            s = self._squarings(start, q)
+        except (np.linalg.LinAlgError, ValueError):
+            s = 0
+        v = self._unknowns(start)
+        scale = self._unknown_scale(v)
+        theta, iters, status, finished = start, 0, "not run", False
+        self._deadline = None
+        self._timed_out = False
         for _ in range(3):
-            run = self._solver(s, decade).solve(z)
+            self._iterations_before = iters  # a new round starts where the last ended: the same iterate, number
+            solver = self._solver(s)
+            if self._deadline is None and self._time_limit is not None:  # from the first solve, once it is built
+                self._deadline = time.perf_counter() + self._time_limit
+            run = solver.solve(v, scale=scale, values=q)
             iters += run.iterations
             status, finished = run.status, run.finished
-            z = run.z
-            theta = z[: self.model.n_parameters] * self.scale
-            need = self._squarings(theta) if np.all(np.isfinite(theta)) else s
-            if need <= s:
+            if self._timed_out:
+                status, finished = "Maximum_WallTime_Exceeded", False
+            v = run.z
+            theta = v[:l]
+            need = self._squarings(theta, q) if np.all(np.isfinite(theta)) else s
+            if need <= s or self._timed_out or status == "User_Requested_Stop":
                 break
             s = need
         return self.outcome(start, theta, finished=finished, status=status, message=status, iterations=iters,
@@ -355,10 +445,6 @@ class OutputError(Estimator, FisherInformation):
         ``cost = ‖r‖²``; the columns are ∂r/∂θ (and ∂r/∂x0 per record for ``x0="estimate"``).
         """
         theta = self.model.theta_vector(theta)
-        s = self._squarings(theta)
-        _, _, fun = self._residual_function(s)
-        z = self._z_start(theta)
-        r, J = fun(z)
-        col_scale = np.concatenate([self.scale, np.repeat(self._x0_scale, self.model.n_states)
-                                    if self._estimate_x0 else np.zeros(0)])
-        return np.asarray(r).reshape(-1), np.asarray(J) / col_scale[None, :]
+        q = self._balance(theta)
+        r, J = self._residual_function(self._squarings(theta, q))(self._unknowns(theta), q)
+        return np.asarray(r).reshape(-1), np.asarray(J)
