@@ -84,3 +84,57 @@ def test_ls_outputs_in_other_units(records, ls_ref, a):
     beta = 10.0**a
     out = estimate(two_dof(), si.IOData(records.u, records.y * beta, DT), "ls", START / beta)
     np.testing.assert_allclose(out.theta * beta, ls_ref.theta, rtol=1e-7 if abs(a) == 6 else RTOL)
+
+
+# -- ALS, GB and IPOPT on the similarity misfit (thesis ch. 6, appendix C) ---------------------------------
+#
+# A state-space model A = [[0, 1], [a, b]], B = [0; c], C = [1, 0] (truth a = −2, b = −0.5, c = 1.5), its exact
+# black box in another basis. With T₀ from the start (aux_init="model", (C-7)) every method works on θ / |θ₀| and
+# T by its rows at the start: a parameter declared in other units gives the same iterations and the same estimate
+# (measured: 4e-15 at most). The default aux_init="random" draws T₀ seeded by the bytes of the start, so a start in
+# other units draws another T₀ (invariant in distribution only). The time axis and the outputs in other units are
+# not followed: see test_the_time_axis_is_not_followed_by_the_similarity_misfit.
+
+def state_space(factors=None):
+    factors = np.ones(3) if factors is None else factors
+    a, b, c = si.parameters("a b c")
+    return si.StateSpaceModel(A=[[0, 1], [a * factors[0], b * factors[1]]], B=[[0], [c * factors[2]]], C=[[1, 0]],
+                              parameters=[a, b, c])
+
+
+SS_TRUTH = np.array([-2.0, -0.5, 1.5])
+SS_START = SS_TRUTH * np.array([1.3, 0.6, 0.8])
+
+
+@pytest.fixture(scope="module")
+def black_box():
+    A, B, C, D = state_space().state_space(SS_TRUTH)
+    T = np.array([[1.0, 0.4], [-0.3, 0.8]])
+    return si.BlackBox(T @ A @ np.linalg.inv(T), T @ B, C @ np.linalg.inv(T), D)
+
+
+@pytest.mark.parametrize("method", ["als", "gb", "ipopt"])
+def test_similarity_methods_follow_a_parameter_in_other_units(black_box, method):
+    ref = estimate(state_space(), black_box, method, SS_START, aux_init="model")
+    assert np.max(np.abs(ref.theta / SS_TRUTH - 1)) < 1e-5  # ALS stops at its step tolerance 1e-6
+    for k in range(3):
+        for a in (-6, 6):
+            f = np.ones(3)
+            f[k] = 10.0**a
+            out = estimate(state_space(f), black_box, method, SS_START / f, aux_init="model")
+            np.testing.assert_allclose(out.theta * f, ref.theta, rtol=RTOL)
+            assert (out.status, out.iterations) == (ref.status, ref.iterations)
+
+
+@pytest.mark.xfail(strict=True, reason="the similarity misfit (C-1) sums ‖T𝔸 − A(θ)T‖², ‖T𝔹 − B(θ)‖² and "
+                                       "‖ℂ − C(θ)T‖², whose units differ: with 𝔸 × 1e6 (time in units of 1e-6) one "
+                                       "block outweighs the others by 1e12 (measured: ALS stops after 1 sweep, GB "
+                                       "after 4 iterations, IPOPT at its 3000-iteration limit; estimates 40 % off)")
+@pytest.mark.parametrize("method", ["als", "gb", "ipopt"])
+def test_the_time_axis_is_not_followed_by_the_similarity_misfit(black_box, method):
+    ref = estimate(state_space(), black_box, method, SS_START, aux_init="model")
+    c = 1e6  # t' = t / c: A' = c A, B' = c B; a' = c² a, b' = c b, c' = c² c
+    faster = si.BlackBox(black_box.A * c, black_box.B * c, black_box.C, black_box.D)
+    phys = np.array([c**2, c, c**2])
+    out = estimate(state_space(), faster, method, SS_START * phys, aux_init="model")
+    np.testing.assert_allclose(out.theta / phys, ref.theta, rtol=RTOL)

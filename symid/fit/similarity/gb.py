@@ -12,7 +12,7 @@ from symid.fit.options import check_choice, check_float, check_int, check_seed
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
 from symid.fit.similarity.objective import SimilarityMisfit
-from symid.fit.similarity.start import INITS, initial_point
+from symid.fit.similarity.start import INITS, initial_point, unknown_scale
 
 __all__ = ["GbSimilarity"]
 
@@ -25,6 +25,9 @@ class GbSimilarity(SimilarityEstimator):
     every black box) and :func:`scipy.optimize.minimize` (BFGS) stops when the largest
     gradient entry is ≤ ``tol`` (default 1e-10: the valleys of F are long and flat, and
     a looser stop leaves parameter errors above the study's 1e-3 even in the right basin).
+    BFGS works on z / s, s the start's magnitudes
+    (:func:`~symid.fit.similarity.start.unknown_scale`), so that a parameter declared in
+    other units is the same unknown (its first step and the gradient test alike).
 
     Parameters
     ----------
@@ -56,10 +59,17 @@ class GbSimilarity(SimilarityEstimator):
     def solve(self, x0: np.ndarray) -> scipy.optimize.OptimizeResult:
         """The raw :func:`scipy.optimize.minimize` result (``x`` = (θ, vec T)) from the start x₀."""
         theta, T, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
-        z0 = self.objective.join(theta, T)
+        s = unknown_scale(theta, T)
+
+        def scaled(y: np.ndarray) -> tuple[float, np.ndarray]:
+            f, g = self.objective.value_and_grad(y * s)
+            return f, g * s
+
         with np.errstate(over="ignore", invalid="ignore"):
-            return scipy.optimize.minimize(self.objective.value_and_grad, z0, jac=True, method="BFGS",
-                                           options={"gtol": self.gtol, "maxiter": self.max_iter})
+            res = scipy.optimize.minimize(scaled, self.objective.join(theta, T) / s, jac=True, method="BFGS",
+                                          options={"gtol": self.gtol, "maxiter": self.max_iter})
+        res.x = res.x * s
+        return res
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start x₀; never raises on solver failure."""

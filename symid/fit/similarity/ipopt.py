@@ -7,12 +7,12 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from symid.engine.ipopt import IpoptSolver, casadi_matrices, positivity_bounds
+from symid.engine.ipopt import ScaledIpopt, casadi_matrices, positivity_bounds
 from symid.fit.options import check_bool, check_choice, check_float, check_int, check_seed
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
 from symid.fit.similarity.objective import SimilarityMisfit
-from symid.fit.similarity.start import INITS, initial_point
+from symid.fit.similarity.start import INITS, initial_point, unknown_scale
 
 __all__ = ["IpoptSimilarity", "IpoptSimilarityFRF"]
 
@@ -22,7 +22,11 @@ class IpoptSimilarity(SimilarityEstimator):
 
     The objective is F(θ, T) / (‖𝔸‖² + ‖𝔹‖² + ‖ℂ‖²), the scaled misfit of
     :class:`~symid.fit.similarity.objective.SimilarityMisfit` (+ ‖𝔻 − D(θ)‖² when D holds parameters).
-    Like ALS and GB it does not keep T invertible.
+    Like ALS and GB it does not keep T invertible. IPOPT works on z / s, s the start's
+    magnitudes (:func:`~symid.fit.similarity.start.unknown_scale`), on the objective over
+    its start's decade and with a barrier no stronger than the start's gradient
+    (:class:`~symid.engine.ipopt.ScaledIpopt`), so that a parameter declared in other
+    units is the same unknown.
 
     Parameters
     ----------
@@ -64,16 +68,17 @@ class IpoptSimilarity(SimilarityEstimator):
         if self.misfit_F.with_d:
             f = f + ca.sumsqr(ca.DM(bb.D) - mats["D"])
         lb, ub = positivity_bounds(model.positive, positivity, np.ones(l))
-        self._solver = IpoptSolver("symid_ipopt_similarity", z, f / self.misfit_F.scale,
-                                   lbz=np.concatenate([lb, np.full(n * n, -np.inf)]),
-                                   ubz=np.concatenate([ub, np.full(n * n, np.inf)]), max_iter=max_iter, tol=tol,
+        self._lower = lb
+        self._solver = ScaledIpopt("symid_ipopt_similarity", z, f / self.misfit_F.scale,
+                                   lower=np.concatenate([lb, np.full(n * n, -np.inf)]),
+                                   upper=np.concatenate([ub, np.full(n * n, np.inf)]), max_iter=max_iter, tol=tol,
                                    hessian="exact")
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start x₀; never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
         theta0, T0, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
-        run = self._solver.solve(self.misfit_F.join(theta0, T0))
+        run = self._solver.solve(self.misfit_F.join(theta0, T0), scale=unknown_scale(theta0, T0, self._lower))
         theta, T = self.misfit_F.split(run.z)
         return self.transform_outcome(x0, theta, T, finished=run.finished, status=run.status,
                                       message=f"IPOPT: {run.status}", iterations=run.iterations,

@@ -29,7 +29,7 @@ import numpy as np
 from symid.errors import ModelError
 
 __all__ = ["INITS", "initial_point", "least_squares_theta", "least_squares_transform", "random_pair",
-           "transform_scale"]
+           "transform_scale", "unknown_scale"]
 
 INITS = ("random", "model", "zero", "identity")
 
@@ -55,9 +55,13 @@ def random_pair(n: int, x0: np.ndarray, seed: int) -> tuple[np.ndarray, np.ndarr
 
 
 def least_squares_theta(maps: dict[str, Any], bb: Any, T: np.ndarray) -> np.ndarray:
-    """θ minimising F(θ, T) for fixed T (thesis (C-8)); the minimum-norm solution when not unique."""
+    """θ minimising F(θ, T) for fixed T (thesis (C-8)); when not unique, the solution of least norm in
+    parameters scaled to unit columns (so that neither the rank decision nor the choice depends on the
+    parameters' units)."""
     J, r = theta_system(maps, bb, T)
-    return np.linalg.lstsq(J, r, rcond=None)[0]
+    cols = np.linalg.norm(J, axis=0)
+    cols = np.where((cols > 0) & np.isfinite(cols), cols, 1.0)
+    return np.linalg.lstsq(J / cols, r, rcond=None)[0] / cols
 
 
 def theta_system(maps: dict[str, Any], bb: Any, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -131,3 +135,30 @@ def initial_point(init: str, x0: np.ndarray, seed: int, maps: dict[str, Any], bb
     else:
         raise ModelError(f"init must be one of {', '.join(map(repr, INITS))}; got {init!r}")
     return least_squares_theta(maps, bb, T), T, S
+
+
+def unknown_scale(theta0: np.ndarray, T0: np.ndarray, lower: np.ndarray | None = None) -> np.ndarray:
+    """Typical magnitudes of z = (θ, vec T) (row-major) at a start, for methods that work on z / s.
+
+    θ: |θ₀| per parameter (:func:`symid.engine.ipopt.start_scale`: where θ₀ is 0, the
+    largest finite bound, else 1), so that a parameter declared in other units is the
+    same unknown. T: every entry of row i by ‖T₀ᵢ‖ (row i of T maps into the model's state
+    i, whose units it carries; rows of 0 take the largest row norm, a T₀ of 0 takes 1).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.similarity.start import unknown_scale
+    >>> unknown_scale(np.array([-2e3, 0.5]), np.array([[3.0, 4.0], [0.0, 0.0]])).tolist()
+    [2000.0, 0.5, 5.0, 5.0, 5.0, 5.0]
+    """
+    from symid.engine.ipopt import start_scale
+
+    theta0 = np.asarray(theta0, dtype=float)
+    lower = np.full(theta0.size, -np.inf) if lower is None else np.asarray(lower, dtype=float)
+    st = start_scale(theta0, lower, np.full(theta0.size, np.inf))
+    rows = np.linalg.norm(np.asarray(T0, dtype=float), axis=1)
+    rows = np.where(np.isfinite(rows), rows, 0.0)
+    top = float(rows.max(initial=0.0))
+    rows = np.where(rows > 0, rows, top if top > 0 else 1.0)
+    return np.concatenate([st, np.repeat(rows, rows.size)])
