@@ -29,6 +29,15 @@ over-relaxation α (Boyd et al. 2011, §3.4.3):
   fall, the steps settle instead of jittering at the residual's level;
 * ρ is rebalanced from the ratio of the normalised residuals (residual balancing, as in
   OSQP) when they differ by more than a factor 5; the KKT matrix is then refactorised.
+* optionally (``equilibrate``, off by default), 𝒜 is equilibrated before every sub-problem
+  by :func:`ruiz`: ŷ = D y with one factor per block (a scalar keeps a block's nuclear
+  norm, (w/d)‖Ŷ‖_*, and its PSD cone), ẑ = E⁻¹ z with one factor per variable, as SCS
+  and OSQP scale their data; the iteration on (ẑ, ŷ) is ADMM on the original problem
+  with one ρ per block, ρ d_b². The stopping rule is evaluated on the residuals of the
+  original problem (as both solvers do by default), ρ is balanced on the scaled ones (as
+  OSQP does), and the dual Λ = ρ D u is carried unchanged to the next sub-problem when
+  the factors change. Measured on the spectra of thesis §5-6 (``benchmarks/admm_scaling.py``):
+  see :class:`ADMMOptions`.
 
 No Python loop runs over blocks: only over the few groups of equal-shape blocks. The state
 (z, the scaled duals) is kept between SCR iterations (warm start); the inner-iteration
@@ -85,6 +94,11 @@ class ADMMOptions:
         (the dual one in proportion), so the sub-problems get more accurate as SCR
         converges instead of capping the reachable residual at the ADMM tolerance.
         ``None`` keeps the fixed tolerances.
+    equilibrate : bool
+        Ruiz equilibration of the stacked map 𝒜 before every sub-problem: one factor per
+        block (each bilinear term's matrix, each LMI, so that the nuclear norm and the PSD
+        cone of a block are kept) and one per variable, which is ADMM with one ρ per block
+        (see the module notes).
 
     Examples
     --------
@@ -104,6 +118,7 @@ class ADMMOptions:
     adaptive_rho: bool = True
     adapt_every: int = 25
     tighten: float | None = 1.0
+    equilibrate: bool = False
 
     def __post_init__(self) -> None:
         if self.rho is not None and not (np.isfinite(self.rho) and self.rho > 0):
@@ -190,6 +205,80 @@ def _block_rows(offset: int, idx: np.ndarray, coef: np.ndarray) -> tuple[np.ndar
     return rows[keep], cols[keep], coef[keep]
 
 
+def _segment_max(vals: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Largest value of each segment vals[starts[i]:starts[i+1]] (0 for an empty one)."""
+    out = np.zeros(starts.size - 1)
+    full = starts[:-1] < starts[1:]
+    if vals.size and full.any():
+        out[full] = np.maximum.reduceat(vals, starts[:-1][full])
+    return out
+
+
+_RUIZ_PASSES = 25  # as SCS (NUM_RUIZ_PASSES)
+_RUIZ_TOL = 0.1  # stop once every block and column maximum is within 10 % of 1
+_SCALE_RANGE = (1e-4, 1e4)  # bounds on the accumulated factors, as OSQP (MIN_SCALING, MAX_SCALING)
+
+
+def ruiz(A: sps.csr_matrix, block_starts: np.ndarray, H: sps.spmatrix | None = None,
+         passes: int = _RUIZ_PASSES) -> tuple[np.ndarray, np.ndarray]:
+    """Modified Ruiz equilibration of A (m × n) with one row factor per block of rows.
+
+    Rows ``block_starts[b]:block_starts[b+1]`` share one factor ``d[b]`` (SCS keeps a cone's
+    rows together the same way), columns get one factor each, ``e``; the largest entry of
+    every block and of every column of diag(d) A diag(e) — and of every column of
+    diag(e) H diag(e), if ``H`` is given — is driven to 1 by alternately dividing by the
+    square roots of the current maxima (Ruiz 2001). Blocks and columns without entries keep
+    factor 1. Returns (d, e).
+
+    Examples
+    --------
+    Two blocks, row 0 and rows 1–2, five decades apart:
+
+    >>> import numpy as np, scipy.sparse as sps
+    >>> A = sps.csr_matrix(np.array([[1e3, 2e3], [1e-2, 3e-2], [4e-2, 1e-2]]))
+    >>> d, e = ruiz(A, np.array([0, 1, 3]))
+    >>> B = abs(d[[0, 1, 1], None] * A.toarray() * e)
+    >>> maxima = [B[:1].max(), B[1:].max(), *B.max(axis=0)]  # of each block, of each column
+    >>> bool(np.allclose(maxima, 1.0, atol=0.1)), bool(d[1] / d[0] > 1e4)
+    (True, True)
+    """
+    A = sps.csr_matrix(A)
+    m, n = A.shape
+    nb = block_starts.size - 1
+    d, e = np.ones(nb), np.ones(n)
+    if A.nnz == 0 and (H is None or H.nnz == 0):
+        return d, e
+    absval = np.abs(A.data)
+    rows = np.repeat(np.arange(m), np.diff(A.indptr))
+    block_of_row = np.repeat(np.arange(nb), np.diff(block_starts))
+    blk = block_of_row[rows]
+    cols = A.indices
+    b_starts = A.indptr[block_starts]  # entries of a CSR matrix are ordered by row, hence by block
+    order = np.argsort(cols, kind="stable")
+    c_starts = np.concatenate([[0], np.cumsum(np.bincount(cols, minlength=n))])
+    if H is not None and H.nnz:
+        Hc = sps.coo_matrix(H)
+        h_abs, h_r, h_c = np.abs(Hc.data), Hc.row, Hc.col
+    else:
+        h_abs = None
+    lo, hi = _SCALE_RANGE
+    for _ in range(passes):
+        vals = absval * d[blk] * e[cols]
+        bmax = _segment_max(vals, b_starts)
+        cmax = _segment_max(vals[order], c_starts)
+        if h_abs is not None:
+            hv = h_abs * e[h_r] * e[h_c]
+            hmax = np.zeros(n)
+            np.maximum.at(hmax, h_c, hv)
+            cmax = np.maximum(cmax, hmax)
+        bm, cm = bmax[bmax > 0], cmax[cmax > 0]
+        if max(np.abs(bm - 1).max(initial=0.0), np.abs(cm - 1).max(initial=0.0)) <= _RUIZ_TOL:
+            break
+        d = np.clip(d / np.sqrt(np.where(bmax > 0, bmax, 1.0)), lo, hi)
+        e = np.clip(e / np.sqrt(np.where(cmax > 0, cmax, 1.0)), lo, hi)
+    return d, e
+
+
 class ADMMBackend:
     """Solve the SCR sub-problems by ADMM; see the module docstring."""
 
@@ -206,13 +295,26 @@ class ADMMBackend:
         sizes = [g.s * int(np.prod(g.pq)) for g in groups] + [g.E0.size for g in lmis]
         self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
         self.m = int(self.offsets[-1])
+        # one block per term and per LMI: the rows that share one equilibration factor
+        bsizes = [np.full(g.s, int(np.prod(g.pq))) for g in groups] + [np.full(g.s, g.E0[0].size) for g in lmis]
+        self.block_starts = np.concatenate([[0], np.cumsum(np.concatenate(bsizes) if bsizes else [])]).astype(int)
+        self._term_blocks = np.concatenate([[0], np.cumsum([g.s for g in groups])]).astype(int)
         trip = [_block_rows(int(self.offsets[len(groups) + k]), g.idx, g.G()) for k, g in enumerate(lmis)]
         self._lmi_rows = tuple(np.concatenate([t[i] for t in trip]) if trip else np.zeros(0) for i in range(3))
         self._lmi_c = np.concatenate([g.E0.reshape(-1) for g in lmis]) if lmis else np.zeros(0)
         self.z = np.zeros(red.nz)
-        self.u = np.zeros(self.m)
+        self.u = np.zeros(self.m)  # scaled dual of the equilibrated problem, u = D⁻¹Λ/ρ
         self.started = False
-        self.taus = [g.weight / self.rho for g in groups]
+        self.d_blocks = np.ones(self.block_starts.size - 1)  # row factor of each block
+        self.d_rows = np.ones(self.m)
+        self.e_cols = np.ones(red.nz)  # column factor of each variable
+        self.scalings: list[tuple[float, float]] = []  # (spread of d, spread of e) per sub-problem
+        self._set_taus()
+
+    def _set_taus(self) -> None:
+        """Thresholds of the SVT per group: w_t / (ρ d_t)."""
+        tb = self._term_blocks
+        self.taus = [g.weight / (self.rho * self.d_blocks[tb[k]:tb[k + 1]]) for k, g in enumerate(self.groups)]
 
     def on_stall(self) -> None:
         """Double the inner-iteration cap if the last sub-problem hit it."""
@@ -237,6 +339,20 @@ class ADMMBackend:
                            shape=(self.m, self.red.nz))
         return A, np.concatenate(cs)
 
+    def _equilibrate(self, A: sps.csr_matrix) -> None:
+        """New block and column factors for the map A; the scaled dual carried over (Λ unchanged)."""
+        d, e = ruiz(A, self.block_starts, self.red.H if self.red.H.nnz else None)
+        if not self.started and self.opt.rho is None and self.groups:  # ρ from the weights of the scaled problem
+            tb = self._term_blocks
+            self.rho = 2.0 * float(np.median(np.concatenate(
+                [g.weight / d[tb[k]:tb[k + 1]] for k, g in enumerate(self.groups)])))
+        d_rows = np.repeat(d, np.diff(self.block_starts))
+        self.u *= self.d_rows / d_rows  # Λ = ρ D u is kept
+        self.d_blocks, self.d_rows, self.e_cols = d, d_rows, e
+        self._set_taus()
+        spread = [float(v.max() / v.min()) if v.size else 1.0 for v in (d, e)]
+        self.scalings.append((spread[0], spread[1]))
+
     def _prox(self, x: np.ndarray, shifts: list[np.ndarray | None]) -> np.ndarray:
         """Y-update (SVT) and S-update (PSD projection) on the stacked vector x."""
         y = np.empty_like(x)
@@ -255,17 +371,17 @@ class ADMMBackend:
             sl = slice(off[ng + k], off[ng + k + 1])
             y[sl] = _psd(x[sl].reshape(g.s, e, e)).reshape(-1)
 
-    def _factor(self, AtA: sps.csr_matrix) -> tuple[_KKT, float]:
+    def _factor(self, AtA: sps.csr_matrix, H: sps.spmatrix, D: sps.spmatrix) -> tuple[_KKT, float]:
         """Factorise the KKT matrix of the z-update for the current ρ; returns it and δ."""
         nz = self.red.nz
-        N = sps.csr_matrix(2 * self.red.H + self.rho * AtA)
+        N = sps.csr_matrix(2 * H + self.rho * AtA)
         delta = 1e-10 * max(1.0, float(N.diagonal().max(initial=0.0)))
-        return _KKT(N + delta * sps.identity(nz, format="csr"), self.red.D), delta
+        return _KKT(N + delta * sps.identity(nz, format="csr"), D), delta
 
     def _set_rho(self, rho: float) -> None:
         self.u *= self.rho / rho  # the scaled dual u = Λ/ρ
         self.rho = rho
-        self.taus = [g.weight / rho for g in self.groups]
+        self._set_taus()
 
     def step(self, built: list[tuple[np.ndarray, np.ndarray]], W: list[np.ndarray] | None,
              z0: np.ndarray, residual: float = np.inf, deadline: float | None = None
@@ -277,29 +393,46 @@ class ADMMBackend:
 
         ``residual`` is the accuracy SCR asks for (the smaller of the last bilinear residual and a tenth
         of the last step); with ``tighten`` the tolerances shrink with it.
+
+        With ``equilibrate`` the iteration runs on ẑ = E⁻¹z and ŷ = D y, D and E from
+        :func:`ruiz`; the stopping rule is evaluated on the residuals of the original problem
+        (as SCS and OSQP do), ρ is balanced on those of the scaled one (as OSQP does).
         """
         red, opt = self.red, self.opt
         nz, m = red.nz, self.m
         tm = {"build": 0.0, "factor": 0.0, "solve": 0.0, "svd": 0.0, "projection": 0.0}
         t = time.perf_counter()
         A, c = self._assemble(built)
+        scaled = bool(opt.equilibrate)
+        a_rms = np.sqrt(float(A.data @ A.data) / max(nz, 1)) if scaled else 0.0  # RMS column norm of 𝒜
+        H, Dm, g = red.H, red.D, red.g
+        if scaled:
+            self._equilibrate(A)
+            dr, ec = self.d_rows, self.e_cols
+            A = sps.csr_matrix(sps.diags(dr) @ A @ sps.diags(ec))
+            c = dr * c
+            H = sps.csr_matrix(sps.diags(ec) @ H @ sps.diags(ec))
+            Dm = sps.csr_matrix(Dm @ sps.diags(ec))
+            g = ec * g
         AT = A.T.tocsr()
         AtA = AT @ A
         if m * nz <= _DENSE_OPERATOR:  # small problems: dense products have less overhead
             A, AT = A.toarray(), AT.toarray()
-        a_rms = np.sqrt(float(AtA.diagonal().sum()) / max(nz, 1))  # RMS column norm of 𝒜
+        a_rms_s = np.sqrt(float(AtA.diagonal().sum()) / max(nz, 1))  # (of the equilibrated 𝒜 if scaled)
+        if not scaled:
+            a_rms = a_rms_s
         tm["build"] += time.perf_counter() - t
         t = time.perf_counter()
         try:
-            kkt, delta = self._factor(AtA)
+            kkt, delta = self._factor(AtA, H, Dm)
         except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
             return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
         tm["factor"] += time.perf_counter() - t
         if not self.started:
             self.z = z0.copy()
-        z = self.z
+        z = self.z / self.e_cols if scaled else self.z
         y = A @ z + c
-        neq = red.D.shape[0]
+        neq = Dm.shape[0]
         rhs = np.zeros(nz + neq)
         rhs[nz:] = red.d
         alpha = opt.alpha
@@ -316,9 +449,9 @@ class ADMMBackend:
         for it in range(1, cap + 1):
             rho, u = self.rho, self.u
             if W is not None and it == last_change + 1:
-                shifts = [(g.weight / rho)[:, None, None] * w for g, w in zip(self.groups, W, strict=True)]
+                shifts = [tau[:, None, None] * w for tau, w in zip(self.taus, W, strict=True)]
             t = time.perf_counter()
-            rhs[:nz] = rho * (AT @ (y - u - c)) - red.g + delta * z
+            rhs[:nz] = rho * (AT @ (y - u - c)) - g + delta * z
             z = kkt.solve(rhs)
             az = A @ z + c
             ah = alpha * az + (1 - alpha) * y if alpha != 1 else az
@@ -333,12 +466,24 @@ class ADMMBackend:
             self.u = u = x - y_new
             if it % check == 0 or it == cap or m == 0:
                 t = time.perf_counter()
-                rp = float(np.linalg.norm(az - y_new))
-                rd = rho * float(np.linalg.norm(AT @ (y_new - y)))
-                scale_p = max(float(np.linalg.norm(az)), float(np.linalg.norm(y_new)))
-                # ||𝒜ᵀΛ|| of Boyd et al. vanishes at the optimum of a feasibility problem; ||Λ|| times the
-                # RMS column norm of 𝒜 is the scale of the terms whose difference the dual residual is
-                scale_d = rho * float(np.linalg.norm(u)) * a_rms
+                aty = AT @ (y_new - y)
+                if scaled:  # residuals of the original problem: D⁻¹ on rows, E⁻¹ on the dual
+                    dr = self.d_rows
+                    rp = float(np.linalg.norm((az - y_new) / dr))
+                    rd = rho * float(np.linalg.norm(aty / ec))
+                    scale_p = max(float(np.linalg.norm(az / dr)), float(np.linalg.norm(y_new / dr)))
+                    scale_d = rho * float(np.linalg.norm(u * dr)) * a_rms
+                    rps, rds = float(np.linalg.norm(az - y_new)), rho * float(np.linalg.norm(aty))
+                    scale_ps = max(float(np.linalg.norm(az)), float(np.linalg.norm(y_new)))
+                    scale_ds = rho * float(np.linalg.norm(u)) * a_rms_s
+                else:
+                    rp = float(np.linalg.norm(az - y_new))
+                    rd = rho * float(np.linalg.norm(aty))
+                    scale_p = max(float(np.linalg.norm(az)), float(np.linalg.norm(y_new)))
+                    # ||𝒜ᵀΛ|| of Boyd et al. vanishes at the optimum of a feasibility problem; ||Λ|| times the
+                    # RMS column norm of 𝒜 is the scale of the terms whose difference the dual residual is
+                    scale_d = rho * float(np.linalg.norm(u)) * a_rms
+                    rps, rds, scale_ps, scale_ds = rp, rd, scale_p, scale_d
                 tm["solve"] += time.perf_counter() - t
                 eps_p = sqm * opt.eps_abs + opt.eps_rel * scale_p
                 eps_d = sqn * opt.eps_abs + opt.eps_rel * scale_d
@@ -351,18 +496,20 @@ class ADMMBackend:
                     timed_out = True
                     y = y_new
                     break
-                if opt.adaptive_rho and it - last_change >= opt.adapt_every and rp > 0 and rd > 0:
-                    ratio = np.sqrt((rp / max(scale_p, 1e-300)) / (rd / max(scale_d, 1e-300)))
+                if opt.adaptive_rho and it - last_change >= opt.adapt_every and rps > 0 and rds > 0:
+                    ratio = np.sqrt((rps / max(scale_ps, 1e-300)) / (rds / max(scale_ds, 1e-300)))
                     if not 0.2 <= ratio <= 5.0:
                         t = time.perf_counter()
                         self._set_rho(float(np.clip(rho * ratio, 1e-6, 1e6)))
                         try:
-                            kkt, delta = self._factor(AtA)
+                            kkt, delta = self._factor(AtA, H, Dm)
                         except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
                             return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
                         tm["factor"] += time.perf_counter() - t
                         last_change = it
             y = y_new
+        if scaled:
+            z = z * self.e_cols
         self.started = True
         self.z = z
         self.hit_cap = not ok
