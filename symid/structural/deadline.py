@@ -22,6 +22,9 @@ A child is always killed and reaped (no zombie) on the way out, Ctrl-C in the pa
 included: the child ignores SIGINT (the parent, which receives it too from the
 terminal, stops the child), and a child whose parent has gone (killed with SIGKILL,
 say) exits by itself within ``_ORPHAN_POLL`` seconds, so no orphan keeps computing.
+On POSIX the child leads its own process group, and stopping it kills the whole group:
+a program it runs (msolve, :mod:`~symid.structural.msolve`) is stopped with it, at the
+deadline or when the parent has gone.
 """
 
 from __future__ import annotations
@@ -48,12 +51,31 @@ def _exit_when_orphaned(parent: int) -> None:  # pragma: no cover - runs in the 
     def watch() -> None:
         while os.getppid() == parent:
             time.sleep(_ORPHAN_POLL)
+        _kill_own_group()
         os._exit(70)
 
     threading.Thread(target=watch, name="symid-orphan-watch", daemon=True).start()
 
 
+def _lead_own_group() -> None:  # pragma: no cover - runs in the child process
+    if hasattr(os, "setpgid"):
+        try:
+            os.setpgid(0, 0)
+        except OSError:  # already done by the parent, or not allowed: the group kill falls back to the process
+            pass
+
+
+def _kill_own_group() -> None:  # pragma: no cover - runs in the child process
+    """Kill this child and the programs it started (its process group), when it leads one."""
+    if hasattr(os, "killpg") and os.getpgid(0) == os.getpid():
+        try:
+            os.killpg(os.getpid(), signal.SIGKILL)
+        except OSError:
+            pass
+
+
 def _child(conn, fn, kwargs, parent):  # pragma: no cover - runs in the child process
+    _lead_own_group()
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent decides, and stops this process
     _exit_when_orphaned(parent)
     try:
@@ -109,6 +131,11 @@ class Running:
         finally:
             send.close()  # only the child writes: its death closes the pipe (EOF here)
         self.pid = self._proc.pid
+        if hasattr(os, "setpgid"):  # also here, so that no stop() can come before the child's own setpgid
+            try:
+                os.setpgid(self.pid, self.pid)
+            except OSError:  # the child did it first, or has already exited
+                pass
 
     @property
     def connection(self):
@@ -138,8 +165,13 @@ class Running:
         return self._outcome
 
     def stop(self) -> None:
-        """Kill the child if it still runs, and reap it (idempotent)."""
+        """Kill the child and the programs it started (its process group) if it still runs; reap it (idempotent)."""
         if self._proc.exitcode is None:  # ``exitcode`` polls: a finished child is reaped here
+            if hasattr(os, "killpg"):
+                try:
+                    os.killpg(self.pid, signal.SIGKILL)
+                except OSError:  # not a group leader (setpgid refused) or gone already
+                    pass
             self._proc.kill()
         self._proc.join(5)
         self._recv.close()

@@ -27,10 +27,37 @@ Method
    case iff θ_k − θ_k* lies in the radical of the ideal (normal form, then the
    Rabinowitsch trick).
 5. :func:`generic_global` confirms what is claimed global at an independent point θ**,
-   modulo a random prime p ≈ 2³¹ (:func:`confirm_mod_p`: no coefficient growth).
+   modulo a random prime p ≈ 2³⁰ (:func:`confirm_mod_p`: no coefficient growth).
 
 The complex count is the generic (structural) count; the counts of *real* and
 *positive* solutions depend on the region of θ*.
+
+Two engines
+-----------
+Steps 2–4 (and the confirmation of step 5) are done by sympy, or, when an msolve program
+is given (``msolve=``; :mod:`~symid.structural.msolve`, found by
+:func:`~symid.structural.msolve.msolve_binary`) and the Jacobian has full rank (finitely
+many solutions expected), by msolve: F4 and a rational parametrization
+(w, w', v_j, c_j) of the solutions, over ℚ at θ* and over GF(p) at θ**. From it:
+
+* the count: w's degree, which must equal msolve's count with multiplicity and w must be
+  square-free (else a multiple solution: :class:`NonGenericPoint`, as in step 3);
+* per parameter: θ_j is single-valued on every complex solution iff
+  v_j + c_j·θ_j*·w' is the zero polynomial (x_j = −v_j/(c_j w') on the roots of w, and
+  that polynomial has degree < deg w); over GF(p), iff v_j is the constant −θ_j**;
+* the real solutions: msolve's isolating boxes (one per real root of w), and their signs
+  (a box on one side of 0; else msolve is run again at a higher precision);
+* θ* must be a root of the parametrization, checked exactly in rationals (an altered or
+  truncated output raises :class:`~symid.structural.msolve.MsolveError`).
+
+Where msolve finds a positive-dimensional set, a non-radical ideal modulo p at θ**, or
+anything else outside that case, the sympy computation is done instead, so the result is
+the same whichever engine ran (the float values of ``solutions`` agree to rounding: the
+two engines compute them differently). What differs is how the counts are established:
+sympy's over ℚ is exact; msolve's over ℚ is a multi-modular computation with a
+probabilistic stopping criterion (a Monte Carlo answer; see the module
+:mod:`~symid.structural.msolve`), as the confirmation modulo a random prime already is.
+The solutions are listed in a canonical order (by their values, θ* given exactly).
 """
 
 from __future__ import annotations
@@ -39,6 +66,7 @@ import random
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from fractions import Fraction
 
 import numpy as np
 import sympy as sp
@@ -50,6 +78,7 @@ from sympy.polys.rings import PolyElement, PolyRing, ring
 
 from symid.errors import ModelError, SolverError
 from symid.structural.local import rank_at
+from symid.structural.msolve import MsolveError, input_text, parse_output, run_msolve
 from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
     KIND_TF,
@@ -114,10 +143,20 @@ class GlobalResult:
     membership : tuple of bool
         For each extra candidate passed in: f(θ) − f(θ*) lies in the ideal.
     groebner_size : int
-        Number of polynomials in the reduced basis.
+        Number of polynomials in the reduced basis (0 when msolve ran: it does not return it).
     times : dict of str to float
         Wall time of the steps.
     notes : tuple of str
+    theta_confirm : dict of str to str
+        θ** of the confirmation, when a global claim was confirmed.
+    confirmed : bool
+        The confirmation at θ** agreed.
+    draws : int
+        Points θ* drawn until a generic one.
+    engine : str
+        ``"sympy"`` or ``"msolve"`` (:mod:`~symid.structural.msolve`): which computed the
+        solutions (the result is the same either way, up to the float rounding of
+        ``solutions``).
     """
 
     summary_kind: str
@@ -141,6 +180,7 @@ class GlobalResult:
     theta_confirm: dict = field(default_factory=dict)
     confirmed: bool = False
     draws: int = 1
+    engine: str = "sympy"
 
 
 STAR_NUMERATORS = (1, 100_000)
@@ -357,13 +397,8 @@ def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, lis
         eqs.append(tR * lamR - R.one)
         aux = 2
     else:
-        nonconst_den = [d for d in summ.denominators if not d.is_ground]
-        sat = None
-        if nonconst_den:
-            sat = nonconst_den[0]
-            for d in nonconst_den[1:]:
-                sat = sat.lcm(d)
-            sat = sat.sqf_part()
+        sat = _saturating(summ)
+        if sat is not None:
             R = ring([*params, tsym], dom, grevlex_memo)[0]
         else:
             R = ring(list(params), dom, grevlex_memo)[0]
@@ -378,23 +413,52 @@ def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, lis
     return R, eqs, aux
 
 
+def _saturating(summ) -> PolyElement | None:
+    """The square-free lcm of the non-constant denominators (saturated by t·sat − 1 = 0), or None."""
+    nonconst_den = [d for d in summ.denominators if not d.is_ground]
+    if not nonconst_den:
+        return None
+    sat = nonconst_den[0]
+    for d in nonconst_den[1:]:
+        sat = sat.lcm(d)
+    return sat.sqf_part()
+
+
+def _aux_values(summ, pt) -> list[Fraction]:
+    """The auxiliary variables of :func:`_system` at θ* itself (λ = t = 1, or t = 1/sat(θ*))."""
+    L = summ.normaliser
+    if L is not None and not L.is_ground:
+        return [Fraction(1), Fraction(1)]
+    sat = _saturating(summ)
+    if sat is None:
+        return []
+    v = sat(*pt)
+    return [Fraction(int(v.denominator), int(v.numerator))]
+
+
+MAX_PRIME = 1_518_500_213
+"""Primes of the confirmation are below this (msolve's FGLM refuses larger ones), and at least 2³⁰."""
+
+
 def _mod_p_modulus(rng: random.Random) -> int:
-    """A random prime in [2³⁰, 2³¹)."""
+    """A random prime in [2³⁰, :data:`MAX_PRIME`)."""
     while True:
-        p = rng.randrange(2**30, 2**31) | 1
+        p = rng.randrange(2**30, MAX_PRIME) | 1
         if sp.isprime(p):
             return p
 
 
 def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int = 0, draw: int = 500,
-                  rank: int | None = None) -> tuple[bool, int | None, dict, dict]:
+                  rank: int | None = None, msolve: str | None = None) -> tuple[bool, int | None, dict, dict]:
     """Solve summary(θ) = summary(θ**) modulo a random prime at an independent generic point θ**.
 
     Used to confirm global claims (:func:`generic_global`): the same algebra as
-    :func:`global_analysis` over GF(p), p a random prime in [2³⁰, 2³¹), so the
+    :func:`global_analysis` over GF(p), p a random prime in [2³⁰, 1.5·10⁹), so the
     coefficients never grow. For a prime that does not divide the finitely many
     denominators and leading coefficients of the computation (all but a negligible
     fraction), the quotient dimension and the per-parameter answers are those over ℚ.
+    With ``msolve`` (the program's path), msolve's parametrization modulo p gives them
+    when the ideal is radical there (the generic case); otherwise sympy's computation.
 
     Returns
     -------
@@ -415,6 +479,10 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
             continue
     else:  # pragma: no cover - ten random 31-bit primes dividing the denominators: practically impossible
         raise ExactStepLimit("no prime found that reduces the system at θ**")
+    if msolve is not None:
+        found = _confirm_msolve(msolve, R, eqs, star, names, modulus, rng.randrange(2**31))
+        if found is not None:
+            return (*found, theta2)
     G = groebner(eqs, R)
     nv = R.ngens
     if not _is_zero_dimensional(G, nv):
@@ -450,7 +518,7 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
 
 def global_analysis(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
                     seed: int = 0, extra_candidates: Sequence[sp.Expr] = (), expressions: bool = True,
-                    prepared: tuple | None = None) -> GlobalResult:
+                    prepared: tuple | None = None, msolve: str | None = None) -> GlobalResult:
     """Solve summary(θ) = summary(θ*) exactly at a random rational θ* and classify the solutions.
 
     Parameters
@@ -472,10 +540,25 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     prepared : tuple, optional
         The result of :func:`star_and_summary` for the same model, ``known`` and
         ``seed`` (saves recomputing it when the step is re-run; not modified).
+    msolve : str, optional
+        Path of an msolve program: solve with msolve (see the module docstring) when
+        there are no ``extra_candidates`` (membership needs sympy's basis); a
+        positive-dimensional solution set is then handed to sympy. The Gröbner-basis
+        ``candidates`` are empty when msolve ran.
 
     Returns
     -------
     GlobalResult
+
+    Raises
+    ------
+    NonGenericPoint
+        θ* has a multiple solution.
+    ExactStepLimit
+        More than :data:`MAX_QUOTIENT` complex solutions, or (msolve) the sign of a
+        coordinate of a real solution not decided at 8192 bits.
+    MsolveError
+        msolve failed or its output is malformed or inconsistent with the system.
 
     Examples
     --------
@@ -511,6 +594,14 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     t1 = time.perf_counter()
     pt = [QQ.from_sympy(v) for v in star]
     R, eqs, aux = _system(summ, params, pt)
+    if msolve is not None and not extra_candidates:
+        found = _global_msolve(msolve, R, eqs, _aux_values(summ, pt), star, names, positive, rng.randrange(2**31))
+        if found is not None:
+            times["groebner"] = time.perf_counter() - t1
+            n_c, n_r, n_a, sols, real_sols, glob_c, glob_r, glob_a = found
+            summary_exprs = tuple(summ.expressions()) if expressions else ()
+            return GlobalResult(summ.kind, summ.labels, summary_exprs, theta_star, True, n_c, n_r, n_a, sols,
+                                real_sols, glob_c, glob_r, glob_a, (), (), 0, times, tuple(notes), engine="msolve")
     G = groebner(eqs, R)
     times["groebner"] = time.perf_counter() - t1
     nv = R.ngens
@@ -588,6 +679,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
             for i, name in enumerate(names):
                 glob_r[name] = single(real_sols, name, i)
                 glob_a[name] = single(sols, name, i)
+            real_sols, sols = _canonical(real_sols, theta_star), _canonical(sols, theta_star)
     times["solutions"] = time.perf_counter() - t2
     summary_exprs = tuple(summ.expressions()) if expressions else ()
     return GlobalResult(summ.kind, summ.labels, summary_exprs, theta_star, zero_dim, n_c, n_r, n_a,
@@ -612,8 +704,7 @@ def _solve_numeric(mm: dict[int, DomainMatrix], theta_idx, rng: random.Random, x
         if cp.degree() == D and _square_free(cp, x):
             break
     else:  # three random forms (coefficients up to 1e6) fail to separate only at a multiple solution
-        raise NonGenericPoint(f"{D} solutions counted with multiplicity, and no linear form separates them: "
-                              "a multiple solution")
+        raise NonGenericPoint(_multiple_solution(D))
     Fl = sum(r[v] * F[v] for v in range(nv))
     w, vecs = np.linalg.eig(Fl.T)
     real = _certified_real(cp, w)
@@ -655,13 +746,136 @@ def _certified_real(cp: sp.Poly, w: np.ndarray) -> np.ndarray:
     return real
 
 
+def _multiple_solution(degree: int) -> str:
+    return f"{degree} solutions counted with multiplicity but fewer distinct ones: a multiple solution"
+
+
+def _canonical(solutions: list[dict], theta_star: Mapping[str, sp.Rational]) -> tuple[dict, ...]:
+    """Solutions in a canonical order (by their values to 6 digits), θ* itself given exactly.
+
+    The engines compute the other solutions differently (eigenvectors in float64, or the
+    midpoints of msolve's 128-bit boxes): their floats agree to rounding, not bit for bit.
+    """
+    exact = {n: float(v) for n, v in theta_star.items()}
+    out = []
+    for s in solutions:
+        if all(abs(s[n] - exact[n]) <= REAL_TOL * max(1.0, abs(exact[n])) for n in exact):
+            s = dict(exact)
+        out.append(s)
+    return tuple(sorted(out, key=lambda s: tuple(float(f"{s[n]:.6g}") for n in exact)))
+
+
+MSOLVE_PRECISIONS = (128, 1024, 8192)
+"""Bits of msolve's real-root boxes (``-p``): a box that straddles 0 in a coordinate whose sign matters is
+computed again at the next precision (a coordinate exactly 0 at an irrational solution never settles)."""
+
+
+def _square_free_int(coeffs: Sequence[int]) -> bool:
+    x = sp.Dummy("x")
+    return _square_free(sp.Poly(list(reversed(coeffs)), x, domain="QQ"), x)
+
+
+def _square_free_mod(coeffs: Sequence[int], p: int) -> bool:
+    """Whether a polynomial over GF(p) (coefficients by increasing degree) is square-free: gcd(f, f') = 1."""
+    def trim(f):
+        while f and f[-1] % p == 0:
+            f = f[:-1]
+        return f
+
+    def rem(a, b):
+        a = list(a)
+        inv = pow(b[-1], -1, p)
+        while len(a) >= len(b):
+            q = a[-1] * inv % p
+            shift = len(a) - len(b)
+            for i, c in enumerate(b):
+                a[shift + i] = (a[shift + i] - q * c) % p
+            a = trim(a)
+        return a
+
+    f = trim([c % p for c in coeffs])
+    g = trim([k * c % p for k, c in enumerate(f)][1:])
+    if not g:
+        return len(f) <= 1
+    while g:
+        f, g = g, rem(f, g)
+    return len(f) == 1
+
+
+def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star, names: Sequence[str],
+                   positive: Sequence[bool], seed: int):
+    """msolve's answer at θ* over ℚ: (n_complex, n_real, n_admissible, admissible, real, global per parameter over
+    complex / real / admissible solutions), or None for a positive-dimensional set (then sympy decides)."""
+    var = [f"x{i}" for i in range(R.ngens)]
+    text = input_text([dict(p.terms()) for p in eqs], R.ngens, 0)
+    exact = [Fraction(int(v.p), int(v.q)) for v in star]
+    point = dict(zip(var, [*exact, *aux], strict=True))
+    tol = [REAL_TOL * max(1.0, abs(float(v))) for v in exact]
+    for prec in MSOLVE_PRECISIONS:
+        out = parse_output(run_msolve(binary, text, options=("-P", "1", "-p", str(prec)), seed=seed), var, 0)
+        if out.status == "positive-dimensional":
+            return None
+        if out.status == "empty":
+            raise MsolveError("msolve found no solution of summary(θ) = summary(θ*), but θ* is one: its answer is "
+                              "wrong")
+        par = out.param
+        if par.degree > MAX_QUOTIENT:
+            raise ExactStepLimit(f"more than {MAX_QUOTIENT} complex solutions; not enumerated")
+        if par.n_distinct != par.degree or not _square_free_int(par.elim):
+            raise NonGenericPoint(_multiple_solution(par.degree))
+        par.check_point(point)
+        if par.real_points is None:
+            raise MsolveError("msolve did not list the real solutions")
+        boxes = [[box[var[i]] for i in range(len(names))] for box in par.real_points]
+        if not any(all(lo <= v <= hi for (lo, hi), v in zip(b, exact, strict=True)) for b in boxes):
+            raise MsolveError("θ* is not among msolve's real solutions: its answer is inconsistent with the system")
+        settled = all(lo > 0 or hi <= 0 for b in boxes for (lo, hi), pos in zip(b, positive, strict=True) if pos)
+        if settled:
+            break
+    else:
+        raise ExactStepLimit(f"the sign of a coordinate of a real solution was not decided at {MSOLVE_PRECISIONS[-1]} "
+                             "bits (it may be exactly 0)")
+    real, adm, moved_r, moved_a = [], [], set(), set()
+    for b in boxes:
+        vals = {n: float((lo + hi) / 2) for n, (lo, hi) in zip(names, b, strict=True)}
+        ok = all(lo > 0 for (lo, _), pos in zip(b, positive, strict=True) if pos)
+        moved = {n for n, (lo, hi), v, t in zip(names, b, exact, tol, strict=True) if hi < v - t or lo > v + t}
+        real.append(vals)
+        moved_r |= moved
+        if ok:
+            adm.append(vals)
+            moved_a |= moved
+    glob_c = {n: par.single_valued(var[i], exact[i]) for i, n in enumerate(names)}
+    theta_star = dict(zip(names, star, strict=True))
+    return (par.n_distinct, len(real), len(adm), _canonical(adm, theta_star), _canonical(real, theta_star), glob_c,
+            {n: n not in moved_r for n in names}, {n: n not in moved_a for n in names})
+
+
+def _confirm_msolve(binary: str, R: PolyRing, eqs, star, names: Sequence[str], modulus: int, seed: int):
+    """msolve's answer at θ** over GF(p): (True, count, single-valued per parameter), or None when the ideal is not
+    radical modulo p or not zero-dimensional there (then sympy decides)."""
+    var = [f"x{i}" for i in range(R.ngens)]
+    text = input_text([{m: int(c) % modulus for m, c in p.terms()} for p in eqs], R.ngens, modulus)
+    out = parse_output(run_msolve(binary, text, options=("-P", "2"), seed=seed), var, modulus)
+    if out.status != "finite":
+        return None
+    par = out.param
+    if par.degree > MAX_QUOTIENT:
+        return True, None, dict.fromkeys(names, False)
+    if par.n_distinct != par.degree or not _square_free_mod(par.elim, modulus):
+        return None
+    single = {n: par.single_valued(var[i], Fraction(int(v.p), int(v.q))) for i, (n, v) in
+              enumerate(zip(names, star, strict=True))}
+    return True, par.degree, single
+
+
 def _claims_global(res: GlobalResult) -> bool:
     return (res.zero_dimensional and res.n_complex == 1) or any(res.global_complex.values())
 
 
 def generic_global(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
                    seed: int = 0, rank: int | None = None, extra_candidates: Sequence[sp.Expr] = (),
-                   expressions: bool = True) -> GlobalResult:
+                   expressions: bool = True, msolve: str | None = None) -> GlobalResult:
     """:func:`global_analysis` at a θ* checked to be generic, and its global claims confirmed at a second point.
 
     1. θ* is drawn (:func:`draw_point`) until the Jacobian has the generic rank
@@ -673,6 +887,10 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
        repeated at an independent generic point θ** modulo a random prime
        (:func:`confirm_mod_p`), and a parameter is global only when it is at both
        points.
+
+    ``msolve``: path of an msolve program, used (at θ* and θ**) when the Jacobian has
+    full rank (``rank`` = the number of free parameters: finitely many solutions); the
+    result is the same as sympy's (module docstring), ``engine`` says which ran.
 
     Examples
     --------
@@ -687,9 +905,11 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     res = None
     for draw in range(MAX_DRAWS):
         prepared = star_and_summary(model, known, seed=seed, draw=draw, rank=rank)
+        if msolve is not None and rank != len(prepared[0]):
+            msolve = None  # infinitely many solutions: sympy (radical membership, basis candidates)
         try:
             res = global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
-                                  expressions=expressions, prepared=prepared)
+                                  expressions=expressions, prepared=prepared, msolve=msolve)
             break
         except NonGenericPoint as exc:
             star = ", ".join(str(v) for v in prepared[1])
@@ -699,7 +919,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     draws = draw + 1
     if not _claims_global(res):
         return replace(res, notes=(*res.notes, *notes), draws=draws)
-    zero2, count2, single2, theta2 = confirm_mod_p(model, known, seed=seed, draw=500, rank=rank)
+    zero2, count2, single2, theta2 = confirm_mod_p(model, known, seed=seed, draw=500, rank=rank,
+                                                   msolve=msolve if res.engine == "msolve" else None)
     glob_c = {k: v and single2.get(k, False) for k, v in res.global_complex.items()}
     agree = glob_c == res.global_complex and zero2 == res.zero_dimensional and count2 == res.n_complex
     if not agree:

@@ -139,6 +139,11 @@ class IdentifiabilityReport:
         The solution count in words: exact (complex, generic; real and admissible at
         θ*), a certified lower bound with the reason the exact count is missing, or why
         it was not computed.
+    engine : str
+        Which program solved summary(θ) = summary(θ*): ``"msolve"`` or ``"sympy"``
+        (empty when the exact step did not finish). Like ``timing``, a record of how the
+        report was made: the rest of the report is the same whichever ran (the floats of
+        ``solutions`` agree to rounding).
     """
 
     model: str
@@ -170,6 +175,7 @@ class IdentifiabilityReport:
     timing: dict[str, float] = field(default_factory=dict)
     theta_confirm: dict[str, str] = field(default_factory=dict)
     solution_count: str = ""
+    engine: str = ""
 
     @property
     def identifiable(self) -> tuple[str, ...]:
@@ -265,7 +271,8 @@ class IdentifiabilityReport:
                 L.append(f"  - {n}")
         if self.timing:
             L.append("")
-            L.append("time: " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timing.items()))
+            L.append("time: " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timing.items())
+                     + (f" (exact step: {self.engine})" if self.engine else ""))
         return "\n".join(L)
 
     def __str__(self) -> str:

@@ -45,10 +45,10 @@ _MODEL_ERRORS = ("ModelError", "NonAffineError", "PoleError", "DataError")
 _LIMITS = ("ExactStepLimit", "MemoryError")
 
 
-def _global_step(model, known, positive, seed, extra_candidates, expressions, rank):
+def _global_step(model, known, positive, seed, extra_candidates, expressions, rank, msolve=None):
     """A generic θ*, the summary and the Gröbner step (confirmed at θ**), in one child process."""
     return generic_global(model, known, positive=positive, seed=seed, rank=rank, extra_candidates=extra_candidates,
-                          expressions=expressions)
+                          expressions=expressions, msolve=msolve)
 
 
 def _witness_step(model, known, positive, seed, rank):
@@ -147,16 +147,18 @@ def _read_witnesses(out: GlobalOutcome, wit: WitnessResult, names: Sequence[str]
 
 def run_global(model, known: Mapping[str, sp.Rational], *, names: Sequence[str], positive: Sequence[bool],
                seed: int, extra_candidates: Sequence[sp.Expr], full_rank: bool, exact_count: bool,
-               left: Callable[[], float | None], rank: int | None = None) -> GlobalOutcome:
+               left: Callable[[], float | None], rank: int | None = None, msolve: str | None = None) -> GlobalOutcome:
     """Run the Gröbner step (and, for a full-rank Jacobian, the witness search beside it) within ``left()`` s.
 
     ``left()`` gives the seconds left of the budget (``None``: no limit, and the
-    Gröbner step runs in this process without a witness search).
+    Gröbner step runs in this process without a witness search). ``msolve``: the msolve
+    program for the exact step (:func:`~symid.structural.global_.generic_global`).
     """
     t1 = time.perf_counter()
     out = GlobalOutcome()
     g_kwargs = {"model": model, "known": known, "positive": list(positive), "seed": seed,
-                "extra_candidates": list(extra_candidates), "expressions": not full_rank, "rank": rank}
+                "extra_candidates": list(extra_candidates), "expressions": not full_rank, "rank": rank,
+                "msolve": msolve}
     if left() is None:  # no deadline: the exact answer, in this process
         status, value = run_with_deadline(_global_step, g_kwargs, None)
     else:
