@@ -248,7 +248,7 @@ def _pick_theta_star(model, mats, kind, output, params, rng: random.Random, *, k
 
 
 def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: int = 0, draw: int = 0,
-                     rank: int | None = None):
+                     rank: int | None = None, summary=None):
     """The random point θ* of the global step and the exhaustive summary built for it.
 
     Parameters
@@ -262,6 +262,10 @@ def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: 
         and the redraws after a non-generic θ* use others), 0 ≤ draw < 1000.
     rank : int, optional
         The generic rank of the Jacobian: θ* is redrawn until the Jacobian has it at θ*.
+    summary : ExhaustiveSummary, optional
+        The transfer-function summary built at another point of the same model: reused
+        when the realisation is minimal at this θ* too (the summary's polynomials do not
+        depend on the point; only whether they are exhaustive there does).
 
     Returns
     -------
@@ -276,6 +280,8 @@ def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: 
     params = free_parameters(model, known)
     rng = random.Random(10_007 + 1000 * seed + draw)
     star, minimal = _pick_theta_star(model, mats, kind, output, params, rng, known=known, rank=rank)
+    if summary is not None and minimal and summary.kind == KIND_TF:
+        return params, star, minimal, summary, rng
     summ = exhaustive_summary(model, known, check_point=star)
     return params, star, minimal, summ, rng
 
@@ -369,9 +375,33 @@ def _in_radical(G, R: PolyRing, f: PolyElement) -> bool:
     return groebner(Gy, Ry) == [Ry.one]
 
 
+def _evaluator(pt):
+    """p ↦ p(pt) for polynomials over ℚ, exactly, with the powers of the coordinates cached (sympy's recursive
+    ``p(*pt)`` builds a polynomial per variable and was most of the time of building a large system)."""
+    powers = [[QQ(1), v] for v in pt]
+
+    def power(i: int, e: int):
+        row = powers[i]
+        while len(row) <= e:
+            row.append(row[-1] * row[1])
+        return row[e]
+
+    def value(p: PolyElement):
+        total = QQ(0)
+        for mono, c in p.terms():
+            for i, e in enumerate(mono):
+                if e:
+                    c = c * power(i, e)
+            total += c
+        return total
+
+    return value
+
+
 def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, list[PolyElement], int]:
     """The polynomial system summary(θ) = summary(θ*) over ℚ (or GF(modulus)): ring, equations, auxiliary count."""
     dom = QQ if modulus is None else sp.GF(modulus)
+    at = _evaluator(pt)
 
     def lift(p: PolyElement, R: PolyRing) -> PolyElement:
         if modulus is None:
@@ -393,7 +423,7 @@ def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, lis
         lamR, tR = R.gens[-2], R.gens[-1]
         for num, den in [*zip(summ.numerators, summ.denominators, strict=True), (L, L)]:
             raw = num * L.exquo(den)
-            eqs.append(lift(raw, R) - lamR * const(raw(*pt)))
+            eqs.append(lift(raw, R) - lamR * const(at(raw)))
         eqs.append(tR * lamR - R.one)
         aux = 2
     else:
@@ -404,7 +434,7 @@ def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, lis
             R = ring(list(params), dom, grevlex_memo)[0]
         aux = 1 if sat is not None else 0
         for num, den in zip(summ.numerators, summ.denominators, strict=True):
-            e = num * den(*pt) - den * num(*pt)
+            e = num * at(den) - den * at(num)
             if e != R0.zero:
                 eqs.append(lift(e, R))
         if sat is not None:
@@ -432,7 +462,7 @@ def _aux_values(summ, pt) -> list[Fraction]:
     sat = _saturating(summ)
     if sat is None:
         return []
-    v = sat(*pt)
+    v = _evaluator(pt)(sat)
     return [Fraction(int(v.denominator), int(v.numerator))]
 
 
@@ -449,7 +479,8 @@ def _mod_p_modulus(rng: random.Random) -> int:
 
 
 def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int = 0, draw: int = 500,
-                  rank: int | None = None, msolve: str | None = None) -> tuple[bool, int | None, dict, dict]:
+                  rank: int | None = None, msolve: str | None = None,
+                  summary=None) -> tuple[bool, int | None, dict, dict]:
     """Solve summary(θ) = summary(θ**) modulo a random prime at an independent generic point θ**.
 
     Used to confirm global claims (:func:`generic_global`): the same algebra as
@@ -459,12 +490,14 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
     fraction), the quotient dimension and the per-parameter answers are those over ℚ.
     With ``msolve`` (the program's path), msolve's parametrization modulo p gives them
     when the ideal is radical there (the generic case); otherwise sympy's computation.
+    ``summary``: θ*'s summary, reused when it is exhaustive at θ** too
+    (:func:`star_and_summary`).
 
     Returns
     -------
     (zero_dimensional, quotient dimension or None, single-valued per parameter, θ** as strings)
     """
-    params, star, _, summ, rng = star_and_summary(model, known, seed=seed, draw=draw, rank=rank)
+    params, star, _, summ, rng = star_and_summary(model, known, seed=seed, draw=draw, rank=rank, summary=summary)
     names = [p.name for p in params]
     theta2 = {n: str(v) for n, v in zip(names, star, strict=True)}
     pt = [QQ.from_sympy(v) for v in star]
@@ -920,7 +953,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     if not _claims_global(res):
         return replace(res, notes=(*res.notes, *notes), draws=draws)
     zero2, count2, single2, theta2 = confirm_mod_p(model, known, seed=seed, draw=500, rank=rank,
-                                                   msolve=msolve if res.engine == "msolve" else None)
+                                                   msolve=msolve if res.engine == "msolve" else None,
+                                                   summary=prepared[3])
     glob_c = {k: v and single2.get(k, False) for k, v in res.global_complex.items()}
     agree = glob_c == res.global_complex and zero2 == res.zero_dimensional and count2 == res.n_complex
     if not agree:

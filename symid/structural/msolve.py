@@ -134,13 +134,13 @@ def input_text(polynomials: Sequence[Mapping[tuple[int, ...], object]], nvars: i
     names = [f"x{i}" for i in range(nvars)]
     lines = []
     for poly in polynomials:
-        terms = [(mono, Fraction(int(c.numerator), int(c.denominator)) if characteristic == 0 else int(c))
+        terms = [(mono, (int(c.numerator), int(c.denominator)) if characteristic == 0 else int(c))
                  for mono, c in poly.items() if c]
         if not terms:
             continue
         if characteristic == 0:
-            den = lcm(*(c.denominator for _, c in terms))
-            ints = [(m, int(c * den)) for m, c in terms]
+            den = lcm(*(d for _, (_, d) in terms))
+            ints = [(m, n * (den // d)) for m, (n, d) in terms]
             g = gcd(*(c for _, c in ints))
             ints = [(m, c // g) for m, c in ints]
         else:
