@@ -24,7 +24,10 @@ when nothing settled it. Column ``k``: admissible solutions of summary(θ) = sum
 the Krawczyk test (a proven lower bound; ``~>=j`` if only verified numerically). A model
 settled by witnesses is run a second time with ``exact_count=True`` (the Gröbner step
 gets the whole budget) to show what the exact count would cost. The load average is
-recorded: the machine is shared, and timings taken under load are inflated.
+recorded: the machine is shared, and timings taken under load are inflated; so is the
+number of cores the run was allowed (``cpus_usable``: ``taskset -c 1`` makes it 1, and then
+the exact step and the witness search share that core). Column ``engine`` of the JSON: which
+exact engine ran (``msolve`` when installed, for full-rank models).
 """
 
 from __future__ import annotations
@@ -67,7 +70,7 @@ print(json.dumps({{"import_s": t1 - t0, "load_s": t2 - t1, "report_s": t3 - t2, 
                   "n_solutions_at_least": rep.n_solutions_at_least,
                   "n_parameters": len(rep.parameters),
                   "combinations": [c["expression"] for c in rep.combinations],
-                  "timing": rep.timing}}))
+                  "engine": rep.engine, "timing": rep.timing}}))
 """
 
 
@@ -128,6 +131,7 @@ def main(argv: list[str] | None = None) -> int:
           f"niceness {os.nice(0)}")
     out = {"benchmark": "identifiability", "target_s": TARGET_S, "timeout_s": args.timeout,
            "python": sys.version.split()[0], "machine": platform.machine(), "cores": os.cpu_count(),
+           "cpus_usable": _cpus_usable(),
            "load_average_before": load_before, "load_average_after": load_after, "niceness": os.nice(0),
            "rows": rows}
     path = Path(__file__).resolve().parent / "results" / "identifiability.json"
@@ -135,6 +139,11 @@ def main(argv: list[str] | None = None) -> int:
     write_json_atomic(path, out, indent=2)
     print(f"wrote {path}")
     return 0
+
+
+def _cpus_usable() -> int | None:
+    """How many cores this process may run on (``taskset``), where the OS says."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None
 
 
 def _complete(row: dict) -> bool:
@@ -168,6 +177,7 @@ def _families(args, parser) -> int:
           f"{load_before:.2f}/{load_after:.2f} on {os.cpu_count()} cores")
     out = {"benchmark": "identifiability_families", "target_s": TARGET_S, "timeout_s": timeout,
            "python": sys.version.split()[0], "machine": platform.machine(), "cores": os.cpu_count(),
+           "cpus_usable": _cpus_usable(),
            "load_average_before": load_before, "load_average_after": load_after, "niceness": os.nice(0),
            "complete": True, "rows": rows}
     path = Path(__file__).resolve().parent / "results" / "identifiability_families.json"
