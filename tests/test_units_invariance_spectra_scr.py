@@ -31,3 +31,63 @@ def test_scr_on_spectra_with_the_mass_in_other_units(unit):
         other = si.identify(model(unit), spec, method="scr", x0=[2.0 / unit, 1.0, 2.0]).theta
     np.testing.assert_allclose([other["m"] * unit, other["c"], other["k"]], [base["m"], base["c"], base["k"]],
                                rtol=1e-7)
+
+
+# -- the frequency axis and the spectra in other units (Clarabel, the start's own Yᵢ) ---------------------
+#
+# With aux_init="model" the iteration depends on the start alone, so the whole path can be compared. With a scale
+# given in the same units as θ (here the start's magnitudes), the engine works on θ / scale, and a parameter in
+# other units or frequencies in other units (ω' = a ω: m' = m / a², c' = c / a) give the same iterations and the
+# same estimate (measured: 7e-16 at most). Asserted to 1e-9 (rounding only). The default (no scale) is not
+# invariant; ScrPSD's module notes say why the start's |θ₀| is not the default.
+
+def scr_psd(mdl, spec, x0, scaled=True):
+    from symid.fit.spectra.scr import ScrPSD
+
+    x0 = np.asarray(x0, dtype=float)
+    return ScrPSD(mdl, spec, aux_init="model", scale=np.abs(x0) if scaled else None).run(x0)
+
+
+@pytest.fixture(scope="module")
+def spectra_ref():
+    spec = si.simulate_spectra(model(), [1.0, 0.5, 4.0], np.linspace(0.5, 3, 8), Phi_uu=1.0)
+    ref = scr_psd(model(), spec, [2.0, 1.0, 2.0])
+    assert ref.status == "converged" and np.allclose(ref.theta, [1.0, 0.5, 4.0], rtol=1e-6)
+    return spec, ref
+
+
+@pytest.mark.parametrize("a", [-6, -3, 3, 6])
+def test_scr_on_spectra_follows_the_mass_unit_and_the_frequency_axis(spectra_ref, a):
+    spec, ref = spectra_ref
+    unit = 10.0**a
+    out = scr_psd(model(unit), spec, [2.0 / unit, 1.0, 2.0])
+    np.testing.assert_allclose(out.theta * [unit, 1, 1], ref.theta, rtol=1e-9)
+    assert (out.status, out.iterations) == (ref.status, ref.iterations)
+    phys = np.array([unit**-2, 1 / unit, 1.0])  # ω' = unit · ω
+    out = scr_psd(model(), si.SpectralData(spec.w * unit, spec.Phi_yy, spec.Phi_uu), np.array([2.0, 1.0, 2.0]) * phys)
+    np.testing.assert_allclose(out.theta / phys, ref.theta, rtol=1e-9)
+    assert (out.status, out.iterations) == (ref.status, ref.iterations)
+
+
+def test_without_a_scale_the_frequency_axis_changes_the_estimate(spectra_ref):
+    """What the scale is for: θ as it is, with ω × 1e-6 (m' = 1e12 m) Clarabel's sub-problems go wrong (measured:
+    100 % off after the 40-iteration limit)."""
+    spec, ref = spectra_ref
+    phys = np.array([1e12, 1e6, 1.0])
+    out = scr_psd(model(), si.SpectralData(spec.w * 1e-6, spec.Phi_yy, spec.Phi_uu), np.array([2.0, 1.0, 2.0]) * phys,
+                  scaled=False)
+    assert np.max(np.abs(out.theta / phys / ref.theta - 1)) > 0.01
+
+
+@pytest.mark.xfail(strict=True, reason="the relaxation matrix of a term X P Xᴴ = Q, [[Q + XPRᴴ + … , (X + R)P], "
+                                       "[P(Xᴴ + Rᴴ), P]], is not homogeneous under X → X/β, P → β²P (outputs in "
+                                       "units β times smaller), so the spectra's units change the relaxation itself "
+                                       "(measured: Φyy × 1e6 ends 2e-5 off, 'stationary' after 10 iterations "
+                                       "instead of 'converged' after 6; × 1e12: solver error at iteration 0)")
+@pytest.mark.parametrize("a", [3, 6])
+def test_scr_on_spectra_does_not_follow_the_output_unit(spectra_ref, a):
+    spec, ref = spectra_ref
+    beta = 10.0**a
+    louder = si.SpectralData(spec.w, spec.Phi_yy * beta**2, spec.Phi_uu)
+    out = scr_psd(model(), louder, np.array([2.0, 1.0, 2.0]) / beta)
+    np.testing.assert_allclose(out.theta * beta, ref.theta, rtol=1e-9)
