@@ -200,6 +200,15 @@ def population_table(doc: dict) -> str:
                      for r in doc.get("runs", []))
     code = f"runs at {runs}" if runs else f"code {doc['commit']}"
     lines.append(f"\n{doc['problems']} problems (sizes: {sizes}); {code}.")
+    skipped = doc.get("unresolved") or {}
+    if skipped:
+        cells: dict[tuple[str, int], list[float]] = {}
+        for name, value in skipped.items():
+            cls, size, _ = name.rsplit("-", 2)
+            cells.setdefault((cls, int(size.removeprefix("n"))), []).append(float(value))
+        parts = [f"{cls} n = {n}: {len(v)} (resolution {max(v):.0e} at most)" for (cls, n), v in sorted(cells.items())]
+        lines.append(f"Skipped, the grid does not resolve a 1e-3 error (resolution ≤ 1e-20; `unresolved` in the JSON): "
+                     f"{'; '.join(parts)}.")
     return "\n".join(lines) + "\n"
 
 
