@@ -148,6 +148,26 @@ def test_many_real_solutions_and_their_signs():
         assert sorted(s[p] for p in ("k1_5", "k3_2", "k4_3", "k5_4")) == star
 
 
+@needs_msolve
+def test_a_coordinate_exactly_zero_at_irrational_solutions_is_not_positive():
+    # x0(x0 − 3) = 0, (x1 − 1)(x1² − 2) = 0 at θ* = (3, 1), x0 declared positive: 6 real solutions, x0 = 0 exactly at
+    # three of them (two irrational, where msolve's boxes of x0 straddle 0 at any precision): decided exactly from
+    # gcd(w, v_0), so 3 admissible (x0 = 3), and x0 single-valued over them (by hand)
+    from sympy import QQ
+    from sympy.polys.rings import ring
+
+    from symid.structural.global_ import _global_msolve
+
+    R, x0, x1 = ring("x0,x1", QQ)
+    eqs = [x0**2 - 3 * x0, (x1 - 1) * (x1**2 - 2)]
+    n_c, n_r, n_a, adm, real, glob_c, glob_r, glob_a = _global_msolve(
+        MSOLVE, R, eqs, [], [sp.Integer(3), sp.Integer(1)], ["x0", "x1"], [True, False], seed=1)
+    assert (n_c, n_r, n_a) == (6, 6, 3)
+    assert sorted(s["x0"] for s in real) == [0.0, 0.0, 0.0, 3.0, 3.0, 3.0]
+    np.testing.assert_allclose(sorted(s["x1"] for s in adm), [-2**0.5, 1.0, 2**0.5], rtol=1e-15)
+    assert glob_a == {"x0": True, "x1": False} and glob_c == glob_r == {"x0": False, "x1": False}
+
+
 # -- msolve's output, read strictly ----------------------------------------------------------
 
 TWO = ("[0, [0, \n3, \n2, \n['x0', 'x1', 'x2'],\n[0, 0, 1],\n[1,\n[[2, [2560343871, -15008291, 21450]],\n"

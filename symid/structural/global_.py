@@ -46,7 +46,8 @@ many solutions expected), by msolve: F4 and a rational parametrization
   v_j + c_j·θ_j*·w' is the zero polynomial (x_j = −v_j/(c_j w') on the roots of w, and
   that polynomial has degree < deg w); over GF(p), iff v_j is the constant −θ_j**;
 * the real solutions: msolve's isolating boxes (one per real root of w), and their signs
-  (a box on one side of 0; else msolve is run again at a higher precision);
+  (a box on one side of 0, or an exact zero: as many boxes containing 0 as real roots of
+  gcd(w, v_j); else msolve is run again at a higher precision);
 * θ* must be a root of the parametrization, checked exactly in rationals (an altered or
   truncated output raises :class:`~symid.structural.msolve.MsolveError`).
 
@@ -799,8 +800,8 @@ def _canonical(solutions: list[dict], theta_star: Mapping[str, sp.Rational]) -> 
 
 
 MSOLVE_PRECISIONS = (128, 1024, 8192)
-"""Bits of msolve's real-root boxes (``-p``): a box that straddles 0 in a coordinate whose sign matters is
-computed again at the next precision (a coordinate exactly 0 at an irrational solution never settles)."""
+"""Bits of msolve's real-root boxes (``-p``): a box that straddles 0 in a coordinate whose sign matters, and is not
+shown to be an exact zero (:func:`_exact_zeros`), is computed again at the next precision."""
 
 
 def _square_free_int(coeffs: Sequence[int]) -> bool:
@@ -862,16 +863,20 @@ def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star,
         boxes = [[box[var[i]] for i in range(len(names))] for box in par.real_points]
         if not any(all(lo <= v <= hi for (lo, hi), v in zip(b, exact, strict=True)) for b in boxes):
             raise MsolveError("θ* is not among msolve's real solutions: its answer is inconsistent with the system")
-        settled = all(lo > 0 or hi <= 0 for b in boxes for (lo, hi), pos in zip(b, positive, strict=True) if pos)
+        zero = _exact_zeros(par, var, boxes, positive)
+        settled = all(lo > 0 or hi <= 0 or (k, j) in zero for k, b in enumerate(boxes)
+                      for j, ((lo, hi), pos) in enumerate(zip(b, positive, strict=True)) if pos)
         if settled:
             break
     else:
         raise ExactStepLimit(f"the sign of a coordinate of a real solution was not decided at {MSOLVE_PRECISIONS[-1]} "
                              "bits (it may be exactly 0)")
     real, adm, moved_r, moved_a = [], [], set(), set()
-    for b in boxes:
-        vals = {n: float((lo + hi) / 2) for n, (lo, hi) in zip(names, b, strict=True)}
-        ok = all(lo > 0 for (lo, _), pos in zip(b, positive, strict=True) if pos)
+    for k, b in enumerate(boxes):
+        vals = {n: 0.0 if (k, j) in zero else float((lo + hi) / 2) for j, (n, (lo, hi)) in enumerate(zip(names, b,
+                                                                                                      strict=True))}
+        ok = all(lo > 0 and (k, j) not in zero for j, ((lo, _), pos) in enumerate(zip(b, positive, strict=True))
+                 if pos)
         moved = {n for n, (lo, hi), v, t in zip(names, b, exact, tol, strict=True) if hi < v - t or lo > v + t}
         real.append(vals)
         moved_r |= moved
@@ -882,6 +887,33 @@ def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star,
     theta_star = dict(zip(names, star, strict=True))
     return (par.n_distinct, len(real), len(adm), _canonical(adm, theta_star), _canonical(real, theta_star), glob_c,
             {n: n not in moved_r for n in names}, {n: n not in moved_a for n in names})
+
+
+def _exact_zeros(par, var: Sequence[str], boxes, positive: Sequence[bool]) -> set[tuple[int, int]]:
+    """(solution, coordinate) pairs whose box contains 0 and whose coordinate is exactly 0, for positive coordinates.
+
+    x_j = −v_j(ϑ)/(c_j w'(ϑ)) vanishes exactly on the roots of g = gcd(w, v_j) (ϑ itself: on ϑ = 0). When g has as
+    many real roots as there are boxes of x_j that contain 0, those boxes are the exact zeros (each real root of g
+    is a real solution with x_j = 0, whose box contains 0); otherwise none is settled here (a finer box will be).
+    """
+    out: set[tuple[int, int]] = set()
+    x = sp.Dummy("x")
+    w = sp.Poly(list(reversed(par.elim)), x, domain="ZZ")
+    for j, pos in enumerate(positive):
+        if not pos:
+            continue
+        near = [k for k, b in enumerate(boxes) if b[j][0] <= 0 <= b[j][1]]
+        if not near or all(boxes[k][j][1] <= 0 for k in near):
+            continue
+        if var[j] == par.parameter:
+            n_zero = 1 if par.elim[0] == 0 else 0
+        else:
+            v = par.coords[var[j]][0]
+            g = w if not v else w.gcd(sp.Poly(list(reversed(v)), x, domain="ZZ"))
+            n_zero = g.count_roots() if g.degree() > 0 else 0
+        if n_zero == len(near):
+            out.update((k, j) for k in near)
+    return out
 
 
 def _confirm_msolve(binary: str, R: PolyRing, eqs, star, names: Sequence[str], modulus: int, seed: int):
