@@ -713,7 +713,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
             for i, name in enumerate(names):
                 glob_r[name] = single(real_sols, name, i)
                 glob_a[name] = single(sols, name, i)
-            real_sols, sols = _canonical(real_sols, theta_star), _canonical(sols, theta_star)
+            real_sols, sols = _canonical(real_sols, theta_star, glob_c), _canonical(sols, theta_star, glob_c)
     times["solutions"] = time.perf_counter() - t2
     summary_exprs = tuple(summ.expressions()) if expressions else ()
     return GlobalResult(summ.kind, summ.labels, summary_exprs, theta_star, zero_dim, n_c, n_r, n_a,
@@ -784,10 +784,12 @@ def _multiple_solution(degree: int) -> str:
     return f"{degree} solutions counted with multiplicity but fewer distinct ones: a multiple solution"
 
 
-def _canonical(solutions: list[dict], theta_star: Mapping[str, sp.Rational]) -> tuple[dict, ...]:
-    """Solutions in a canonical order (by their values to 6 digits), θ* itself given exactly.
+def _canonical(solutions: list[dict], theta_star: Mapping[str, sp.Rational],
+               single: Mapping[str, bool]) -> tuple[dict, ...]:
+    """Solutions in a canonical order (by their values to 6 digits), θ* itself and the parameters single-valued over
+    every complex solution (``single``) given exactly.
 
-    The engines compute the other solutions differently (eigenvectors in float64, or the
+    The engines compute the other values differently (eigenvectors in float64, or the
     midpoints of msolve's 128-bit boxes): their floats agree to rounding, not bit for bit.
     """
     exact = {n: float(v) for n, v in theta_star.items()}
@@ -795,6 +797,8 @@ def _canonical(solutions: list[dict], theta_star: Mapping[str, sp.Rational]) -> 
     for s in solutions:
         if all(abs(s[n] - exact[n]) <= REAL_TOL * max(1.0, abs(exact[n])) for n in exact):
             s = dict(exact)
+        else:
+            s = {n: exact[n] if single.get(n) else v for n, v in s.items()}
         out.append(s)
     return tuple(sorted(out, key=lambda s: tuple(float(f"{s[n]:.6g}") for n in exact)))
 
@@ -885,8 +889,9 @@ def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star,
             moved_a |= moved
     glob_c = {n: par.single_valued(var[i], exact[i]) for i, n in enumerate(names)}
     theta_star = dict(zip(names, star, strict=True))
-    return (par.n_distinct, len(real), len(adm), _canonical(adm, theta_star), _canonical(real, theta_star), glob_c,
-            {n: n not in moved_r for n in names}, {n: n not in moved_a for n in names})
+    return (par.n_distinct, len(real), len(adm), _canonical(adm, theta_star, glob_c),
+            _canonical(real, theta_star, glob_c), glob_c, {n: n not in moved_r for n in names},
+            {n: n not in moved_a for n in names})
 
 
 def _exact_zeros(par, var: Sequence[str], boxes, positive: Sequence[bool]) -> set[tuple[int, int]]:
