@@ -1,8 +1,8 @@
 """The two-stage route of issue 14 item 5, measured: frequency response → black box → structure by SCR.
 
 Stage 1 fits a black box of the model's order to the exact frequency response by vector
-fitting (:func:`symid.signal.vectfit.vector_fit`, relative weights; the output matrix of
-the real modal realisation solved by linear least squares), stage 2 runs the similarity
+fitting (:func:`symid.signal.vectfit.vector_fit`, relative weights; its real modal
+realisation of the poles, the output matrix solved by linear least squares), stage 2 runs the similarity
 formulation of thesis chapter 7 ((7-10), Algorithm 7.1: ``si.identify(model, BlackBox,
 method="scr")``) from the benchmark's uninformed start, and stage 3 polishes on the
 frequency response with IPOPT. Problems: ``benchmarks/population_models.py`` (chains and
@@ -32,7 +32,7 @@ import population_models as pm  # noqa: E402  (benchmarks/ on the path)
 import symid as si  # noqa: E402
 from symid.errors import ModelError  # noqa: E402
 from symid.runlog import write_json_atomic  # noqa: E402
-from symid.signal.vectfit import vector_fit  # noqa: E402
+from symid.signal.vectfit import _realisation, vector_fit  # noqa: E402
 
 PROBLEMS = (("chain", 3, 0), ("chain", 3, 2), ("chain_sensors", 3, 0), ("chain_sensors", 3, 1), ("gains", 3, 0))
 
@@ -40,17 +40,8 @@ PROBLEMS = (("chain", 3, 0), ("chain", 3, 2), ("chain_sensors", 3, 0), ("chain_s
 def black_box(model, frf) -> tuple[si.BlackBox, float]:
     """Vector fit of the model's order as a real modal realisation, and its relative error on the data."""
     vf = vector_fit(frf.w, frf.H, model.n_states, weight="relative")
+    A, b = _realisation(vf.poles)  # the real modal form vector fitting itself uses
     n = vf.poles.size
-    A, b, i = np.zeros((n, n)), np.zeros(n), 0
-    while i < n:  # real modal form: a real pole, or a pair [[σ, ω], [−ω, σ]]
-        a = vf.poles[i]
-        if a.imag == 0:
-            A[i, i], b[i] = a.real, 1.0
-            i += 1
-        else:
-            A[i:i + 2, i:i + 2] = [[a.real, a.imag], [-a.imag, a.real]]
-            b[i] = 1.0
-            i += 2
     G = np.array([np.linalg.solve(1j * w * np.eye(n) - A, b) for w in frf.w])
     H = np.asarray(frf.H)[:, :, 0]
     D = vf.D.real
