@@ -5,15 +5,21 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Mapping
+from fractions import Fraction
 
 import sympy as sp
+from sympy import QQ
 
 from symid.errors import IdentifiabilityWarning, ModelError
 from symid.structural.arguments import checked_arguments, checked_known, checked_seed
 from symid.structural.combinations import (
+    _rank,
+    linear_expression,
+    linear_space,
     monomial_candidates,
     parameters_to_fix,
     poly_gradients,
+    rref_rows,
     select_combinations,
 )
 from symid.structural.deadline import run_with_deadline, start
@@ -41,13 +47,16 @@ def _verdicts_from_groebner(glob, names, loc, full_rank: bool, *, admissible: bo
     """
     single = glob.global_admissible if admissible else glob.global_real
     count = glob.n_admissible if admissible else glob.n_real
+    # the solutions compared: all of them (finitely many), or those of the generic slice of a positive-dimensional
+    # set (symid.structural.slicing: admissible points of the set, so two that differ prove "local" too)
+    finite = (glob.zero_dimensional and full_rank) or bool(glob.slice_values)
     verdicts = {}
     for nm in names:
         if not loc[nm]:
             verdicts[nm] = "none"
         elif glob.global_complex.get(nm, False):
             verdicts[nm] = "global"
-        elif glob.zero_dimensional and full_rank and not single.get(nm, True):
+        elif finite and not single.get(nm, True):
             verdicts[nm] = LOCAL
         else:
             verdicts[nm] = UNDETERMINED
@@ -90,11 +99,6 @@ def _positive_flags(model, positive: bool | None, known) -> list[bool]:
     if positive is None:
         return [bool(q.is_positive) for q in free]
     return [bool(positive)] * len(free)
-
-
-def _complexity(expr: sp.Expr) -> tuple[int, int]:
-    terms = len(sp.Add.make_args(sp.expand(sp.numer(sp.together(expr)))))
-    return terms, sp.count_ops(expr)
 
 
 def identifiability(model, *, known: Mapping[str, float] | None = None, positive: bool | None = None,
@@ -186,7 +190,8 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         faster on 9–18 parameters; install with ``pip install "symid[msolve]"``, or set
         ``$SYMID_MSOLVE`` to the program; ``SYMID_MSOLVE=off`` turns it off), ``"sympy"``
         (Buchberger over ℚ, pure Python), or ``"auto"`` (default: msolve when found, else
-        sympy). A model that is not locally identifiable is always solved by sympy.
+        sympy). A model that is not locally identifiable is solved on a generic slice
+        of its solution set (:mod:`~symid.structural.slicing`), by the same engine.
         The report is the same either way (``engine`` in it says which ran; the floats of
         ``solutions`` agree to rounding). sympy's count over ℚ is exact; msolve's over ℚ
         is multi-modular with a probabilistic stopping criterion (Monte Carlo, as the
@@ -261,8 +266,8 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     # search would use, so that the combinations never depend on the basis finishing
     summary_job = None
     if not full_rank and timeout is not None:
-        summary_job = start(_summary_combinations, {"model": model, "known": known_exact, "local": local,
-                                                    "monos": monos, "limit": 4 * len(free)})
+        summary_job = start(_summary_candidates, {"model": model, "known": known_exact, "local": local,
+                                                  "limit": 4 * len(free)})
     try:
         return _finish(model, args, local, monos, full_rank, free, names, pos, necessary, notes, t0, t_local, left,
                        summary_job)
@@ -275,9 +280,17 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
             summary_job) -> IdentifiabilityReport:
     """The global step, the verdicts, the combinations and the report (see :func:`identifiability`)."""
     timeout, seed, known_exact = args.timeout, args.seed, args.known
+    fix = () if full_rank else tuple(q.name for q in parameters_to_fix(local))
+    # locally identifiable linear functions: with the identifiable parameters they span every one; the global
+    # step says which of their combinations are globally identifiable
+    linear = [] if full_rank else linear_space(local, model, known_exact, seed=seed)
+    forms = [*({nm: 1} for nm, ok in zip(names, local.identifiable, strict=True) if ok),
+             *({nm: Fraction(int(v.numerator), int(v.denominator)) for nm, v in zip(names, vec, strict=True) if v}
+               for vec in linear)]
     out = run_global(model, known_exact, names=names, positive=pos, seed=seed, extra_candidates=monos,
                      full_rank=full_rank, exact_count=args.exact_count, left=left, rank=local.rank,
-                     msolve=args.msolve)
+                     msolve=args.msolve, fix=fix, linear_forms=forms,
+                     identifiable=[nm for nm, ok in zip(names, local.identifiable, strict=True) if ok])
     glob = out.result
     notes.extend(out.notes)
     determined = glob is not None
@@ -369,35 +382,29 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
             notes.append("global verdicts confirmed at a second independent random point θ** (same result)")
 
     # -- combinations and reparameterisation -------------------------------------
-    combos, reparam, fix = [], {}, ()
+    combos, reparam = [], {}
     if local.rank < len(free):
-        candidates = [(e, "scaling", (glob.membership[i] if determined else None)) for i, e in enumerate(monos)]
-        if determined:
-            gb = sorted(glob.candidates, key=_complexity)
-            candidates += [(e, "groebner", True) for e in gb]
-            sm = sorted(glob.summary_expressions, key=_complexity)
-            candidates += [(e, "summary", True) for e in sm]
-        else:  # the summary entries are identifiable functions: no Gröbner basis needed (chosen in the child)
-            s_kwargs = {"model": model, "known": known_exact, "local": local, "monos": monos, "limit": 4 * len(free)}
-            status_s, chosen_s = run_with_deadline(_summary_combinations, s_kwargs, left()) \
-                if summary_job is None else summary_job.wait(left())
-            stopped = limit_reason("combinations step", status_s, chosen_s)
-            if status_s == "ok":
-                candidates = []
-                combos = chosen_s
-            elif stopped is not None:
-                notes.append(f"no combinations from the summary entries: {stopped}")
-            elif status_s == "timeout":
-                notes.append("the summary entries were not computed within the budget: no combinations from them")
-            else:
-                raise_on_error("combinations", status_s, chosen_s)
-        if candidates:
-            chosen = select_combinations(local, candidates)
-            combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global}
-                      for c in chosen]
+        # the scaling monomials (global when single-valued on the slice: symid.structural.slicing), then the
+        # summary entries, identifiable functions by definition (computed in a child beside the global step)
+        member = glob.membership if determined and len(glob.membership) == len(monos) else (None,) * len(monos)
+        candidates = [(e, "scaling", member[i]) for i, e in enumerate(monos)]
+        candidates += _linear_candidates(free, linear, forms, glob.linear_global if determined else None)
+        s_kwargs = {"model": model, "known": known_exact, "local": local, "limit": 4 * len(free)}
+        status_s, found_s = run_with_deadline(_summary_candidates, s_kwargs, left()) \
+            if summary_job is None else summary_job.wait(left())
+        stopped = limit_reason("combinations step", status_s, found_s)
+        if status_s == "ok":
+            candidates += found_s
+        elif stopped is not None:
+            notes.append(f"no combinations from the summary entries: {stopped}")
+        elif status_s == "timeout":
+            notes.append("the summary entries were not computed within the budget: no combinations from them")
+        else:
+            raise_on_error("combinations", status_s, found_s)
+        chosen = select_combinations(local, candidates)
+        combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global}
+                  for c in chosen]
         reparam = {f"phi{i + 1}": c["expression"] for i, c in enumerate(combos)}
-        fix_syms = parameters_to_fix(local)
-        fix = tuple(q.name for q in fix_syms)
         if len(local.identifiable) - sum(local.identifiable) > 0 and \
                 sum(local.identifiable) + len(combos) < local.rank:
             notes.append("the combinations found do not reach the Jacobian rank "
@@ -426,21 +433,52 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
         engine=glob.engine if determined else "")
 
 
-def _summary_combinations(model, known, local, monos, limit: int) -> list[dict]:
-    """Combinations from the scaling monomials and the ``limit`` simplest summary entries (fewest terms).
+def _linear_candidates(free, linear, forms, lam) -> list[tuple]:
+    """Linear combinations, the globally identifiable ones first (a basis of the combinations of ``forms`` with
+    coefficients ``lam``, in reduced row echelon form), then the basis ``linear`` of the locally identifiable ones
+    (global when in that span; unknown when ``lam`` is None: the global step did not finish)."""
+    n = len(free)
+    index = {q.name: i for i, q in enumerate(free)}
 
-    Run in a child process beside the Gröbner step of a model that is not locally
-    identifiable: the summary entries are identifiable functions, so the combinations
-    do not depend on the Gröbner basis finishing.
+    def vec(form) -> list:
+        out = [QQ(0)] * n
+        for nm, a in form.items():
+            out[index[nm]] = QQ(Fraction(a).numerator, Fraction(a).denominator)
+        return out
+
+    out = []
+    glob_rows = []
+    if lam is not None:
+        combos = []
+        for coeffs in lam:
+            acc = [QQ(0)] * n
+            for c, form in zip(coeffs, forms, strict=True):
+                if c:
+                    acc = [x + QQ(c.numerator, c.denominator) * y for x, y in zip(acc, vec(form), strict=True)]
+            combos.append(acc)
+        glob_rows = rref_rows(combos, n)
+        out += [(linear_expression(row, free), "linear", True) for row in glob_rows]
+    for row in linear:
+        is_global = None if lam is None else _rank([*glob_rows, row]) == len(glob_rows)
+        out.append((linear_expression(row, free), "linear", is_global))
+    return out
+
+
+def _summary_candidates(model, known, local, limit: int) -> list[tuple]:
+    """The ``limit`` simplest summary entries (fewest terms) as combination candidates, with their gradients.
+
+    Run in a child process beside the global step of a model that is not locally
+    identifiable: the summary entries are identifiable functions (global by definition),
+    so the combinations do not depend on the global step finishing.
     """
     summ = exhaustive_summary(model, known)
     order = sorted(range(len(summ)), key=lambda i: (len(summ.numerators[i]) + len(summ.denominators[i]), i))
-    candidates = [(e, "scaling", None) for e in monos]
+    out = []
     for i in order[:limit]:
         num, den = summ.numerators[i], summ.denominators[i]
-        candidates.append((num.as_expr() / den.as_expr(), "summary", True, poly_gradients(num, den, local.points)))
-    return [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global}
-            for c in select_combinations(local, candidates)]
+        expr = sp.factor_terms(num.as_expr() / den.as_expr())  # the same function, common factors pulled out
+        out.append((expr, "summary", True, poly_gradients(num, den, local.points)))
+    return out
 
 
 def _check_fix(model, known_exact, fix: tuple[str, ...], seed: int, budget: float | None) -> str:

@@ -10,32 +10,38 @@ exactly at both points of the local test). Candidates, tried simplest first:
    so θ^a is identifiable iff ``a`` is orthogonal to every null vector divided
    elementwise by θ. When that space is the same at both random points (a scaling
    symmetry such as b → λb, c → c/λ), its integer kernel gives the exponents.
-2. **Gröbner-basis elements** at θ*: an element ``f(θ) − c`` of the reduced basis of
-   summary(θ) = summary(θ*) whose non-constant part ``f`` passes the gradient test at
-   the independent points is an identifiable function (e.g. ``θ1 + θ4 − θ5``, a trace).
+2. **Linear functions** ``a·θ`` whose gradient ``a`` is orthogonal to the Jacobian's
+   null space at generic points (e.g. ``θ1 + θ4 − θ5``, a trace; :func:`linear_space`):
+   first a basis of the globally identifiable ones (those single-valued on the global
+   step's slice), then the rest.
 3. **Summary entries** themselves (always identifiable, they generate the field of
-   identifiable functions), as a fall-back.
+   identifiable functions), the simplest first.
 
 Candidates are kept greedily while they raise the rank, together with the identifiable
 parameters, up to the rank of the Jacobian: the result is a set of algebraically
 independent identifiable functions, so every identifiable function is algebraic over
 them (a *local* generating set; it need not generate the field of globally identifiable
 functions, whose exact computation — as in StructuralIdentifiability.jl — is out of
-scope). Each combination is also marked global when f(θ) − f(θ*) lies in the ideal.
+scope). Each monomial and linear combination is also marked global when it is
+single-valued on every solution of the global step's generic slice
+(:mod:`~symid.structural.slicing`); summary entries are global by definition.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+import random
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import sympy as sp
 from sympy import QQ
 from sympy.polys.matrices import DomainMatrix
 
-from symid.structural.local import LocalResult
+from symid.structural.local import LocalResult, PoleError, jacobian_at, random_point
 
-__all__ = ["Combination", "monomial_candidates", "parameters_to_fix", "poly_gradients", "select_combinations"]
+__all__ = ["Combination", "linear_expression", "linear_space", "monomial_candidates", "parameters_to_fix",
+           "poly_gradients", "rref_rows", "select_combinations"]
 
 
 @dataclass(frozen=True)
@@ -107,6 +113,94 @@ def monomial_candidates(local: LocalResult) -> list[sp.Expr]:
         expr = sp.Mul(*[params[k] ** e for k, e in zip(nonid, ints, strict=True)])
         out.append(expr)
     return out
+
+
+def linear_space(local: LocalResult, model=None, known: Mapping[str, object] | None = None, *,
+                 seed: int = 0, max_points: int = 12) -> list[list]:
+    """A basis of the locally identifiable linear functions Σ a_i θ_i that involve non-identifiable parameters.
+
+    Σ a_i θ_i is locally identifiable iff ``a`` is orthogonal to the Jacobian's null space
+    at generic θ. The identifiable parameters are identifiable functions on their own (and
+    their null-vector entries vanish), so only the coordinates of the non-identifiable
+    ones are kept: each returned vector (QQ entries, one per parameter, zero on the
+    identifiable ones) is a row of the reduced row echelon form of that space. The space
+    is the intersection over points: it starts from the points of ``local`` and, given the
+    ``model``, more random points are added (the exact Jacobian at each) until one more
+    point leaves it unchanged (a spurious direction survives a random point with
+    probability zero), at most ``max_points``. Without ``model`` only the points of
+    ``local`` are used.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.local import local_analysis
+    >>> from symid.structural.combinations import linear_space
+    >>> a, b, c = si.parameters("a b c")
+    >>> model = si.StateSpaceModel(A=[[-a - b]], B=[[c]], C=[[1]])
+    >>> [[str(v) for v in row] for row in linear_space(local_analysis(model), model)]
+    [['1', '1', '0']]
+    """
+    params = local.parameters
+    nonid = [k for k, ok in enumerate(local.identifiable) if not ok]
+    rows = [[vec[k] for k in nonid] for ns in local.nullspaces for vec in ns]
+    if not nonid or not rows:
+        return []
+
+    def kernel_of(rows_: list) -> DomainMatrix:
+        return DomainMatrix(rows_, (len(rows_), len(nonid)), QQ).nullspace()
+
+    kernel = kernel_of(rows)
+    rng = random.Random(20_011 + seed)
+    for _ in range(max_points if model is not None else 0):
+        if kernel.shape[0] == 0:
+            break
+        try:
+            J = jacobian_at(model, random_point(rng, len(params)), known)
+        except PoleError:
+            continue
+        new_rows = [[vec[k] for k in nonid] for vec in J.nullspace().to_list()]
+        smaller = kernel_of(rows + new_rows)
+        rows += new_rows
+        if smaller.shape[0] == kernel.shape[0]:
+            break
+        kernel = smaller
+    if kernel.shape[0] == 0:
+        return []
+    out = []
+    for vec in kernel.rref()[0].to_list():
+        full = [QQ(0)] * len(params)
+        for k, v in zip(nonid, vec, strict=True):
+            full[k] = v
+        out.append(full)
+    return out
+
+
+def linear_expression(vec: Sequence, params: Sequence[sp.Symbol]) -> sp.Expr:
+    """Σ a_i θ_i scaled to coprime integers with a positive first coefficient.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> from sympy import QQ
+    >>> from symid.structural.combinations import linear_expression
+    >>> a, b = sp.symbols("a b")
+    >>> linear_expression([QQ(-1, 2), QQ(3, 4)], [a, b])
+    2*a - 3*b
+    """
+    rats = [QQ.to_sympy(QQ.convert(v)) for v in vec]
+    den = sp.ilcm(*[r.q for r in rats])
+    ints = [int(r * den) for r in rats]
+    g = math.gcd(*ints) or 1
+    sign = 1 if next((i for i in ints if i), 1) > 0 else -1
+    return sp.Add(*[sign * (i // g) * q for q, i in zip(params, ints, strict=True)])
+
+
+def rref_rows(vectors: Sequence[Sequence], n: int) -> list[list]:
+    """The non-zero rows of the reduced row echelon form of ``vectors`` (QQ entries, length ``n``)."""
+    if not vectors:
+        return []
+    rref = DomainMatrix([list(map(QQ.convert, v)) for v in vectors], (len(vectors), n), QQ).rref()[0].to_list()
+    return [row for row in rref if any(row)]
 
 
 def select_combinations(local: LocalResult, candidates: Sequence[tuple[sp.Expr, str, bool | None]]

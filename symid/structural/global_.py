@@ -158,6 +158,16 @@ class GlobalResult:
         ``"sympy"`` or ``"msolve"`` (:mod:`~symid.structural.msolve`): which computed the
         solutions (the result is the same either way, up to the float rounding of
         ``solutions``).
+    slice_values : dict of str to sympy.Rational
+        For a model that is not locally identifiable, solved on a slice
+        (:mod:`~symid.structural.slicing`): the random values given to the parameters
+        that cut the solution set; empty otherwise.
+    slice_result : GlobalResult or None
+        The sliced system's own result (counts and solutions on the slice).
+    linear_global : tuple of tuple of Fraction
+        A basis of the coefficient vectors λ for which Σ λ_k ℓ_k is single-valued on every
+        complex solution, ℓ_k the ``linear_forms`` passed in (empty when none were, or the
+        solution set is positive-dimensional).
     """
 
     summary_kind: str
@@ -182,6 +192,9 @@ class GlobalResult:
     confirmed: bool = False
     draws: int = 1
     engine: str = "sympy"
+    slice_values: dict = field(default_factory=dict)
+    slice_result: GlobalResult | None = None
+    linear_global: tuple = ()
 
 
 STAR_NUMERATORS = (1, 100_000)
@@ -552,7 +565,8 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
 
 def global_analysis(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
                     seed: int = 0, extra_candidates: Sequence[sp.Expr] = (), expressions: bool = True,
-                    prepared: tuple | None = None, msolve: str | None = None) -> GlobalResult:
+                    prepared: tuple | None = None, msolve: str | None = None,
+                    linear_forms: Sequence[Mapping[str, Fraction]] = ()) -> GlobalResult:
     """Solve summary(θ) = summary(θ*) exactly at a random rational θ* and classify the solutions.
 
     Parameters
@@ -579,6 +593,9 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
         there are no ``extra_candidates`` (membership needs sympy's basis); a
         positive-dimensional solution set is then handed to sympy. The Gröbner-basis
         ``candidates`` are empty when msolve ran.
+    linear_forms : sequence of dict of str to Fraction
+        Linear forms Σ a_j θ_j (parameter name → coefficient): which of their
+        combinations are single-valued is returned in ``linear_global``.
 
     Returns
     -------
@@ -628,14 +645,18 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     t1 = time.perf_counter()
     pt = [QQ.from_sympy(v) for v in star]
     R, eqs, aux = _system(summ, params, pt)
-    if msolve is not None and not extra_candidates:
-        found = _global_msolve(msolve, R, eqs, _aux_values(summ, pt), star, names, positive, rng.randrange(2**31))
+    exact_star = [Fraction(int(v.p), int(v.q)) for v in star]
+    crossed = [_cross_terms(e, params, exact_star) for e in extra_candidates]
+    if msolve is not None and all(c is not None for c in crossed):
+        found = _global_msolve(msolve, R, eqs, _aux_values(summ, pt), star, names, positive, rng.randrange(2**31),
+                               candidates=crossed, forms=linear_forms)
         if found is not None:
             times["groebner"] = time.perf_counter() - t1
-            n_c, n_r, n_a, sols, real_sols, glob_c, glob_r, glob_a = found
+            n_c, n_r, n_a, sols, real_sols, glob_c, glob_r, glob_a, member_m, lin = found
             summary_exprs = tuple(summ.expressions()) if expressions else ()
             return GlobalResult(summ.kind, summ.labels, summary_exprs, theta_star, True, n_c, n_r, n_a, sols,
-                                real_sols, glob_c, glob_r, glob_a, (), (), 0, times, tuple(notes), engine="msolve")
+                                real_sols, glob_c, glob_r, glob_a, (), member_m, 0, times, tuple(notes),
+                                engine="msolve", linear_global=lin)
     G = groebner(eqs, R)
     times["groebner"] = time.perf_counter() - t1
     nv = R.ngens
@@ -668,6 +689,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     glob_c, glob_r, glob_a = {}, {}, {}
     sols, real_sols = [], []
     n_c = n_r = n_a = None
+    lin: tuple = ()
     if not zero_dim:
         for i, name in enumerate(names):
             f = R.gens[i] - pt[i]
@@ -688,8 +710,11 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
             glob_c = {n: True for n in names}
             glob_r = dict(glob_c)
             glob_a = dict(glob_c)
+            k_forms = range(len(linear_forms))
+            lin = tuple(tuple(Fraction(int(i == k)) for i in k_forms) for k in k_forms)
         else:
             mm = _mult_matrices(G, R, basis, range(nv))
+            lin = _constant_forms(mm, linear_forms, names, pt)
             x = sp.Dummy("x")
             # a separating linear form with a square-free characteristic polynomial proves the ideal radical:
             # len(basis) distinct solutions, each simple (else θ* is where solutions merge: NonGenericPoint)
@@ -718,7 +743,27 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     summary_exprs = tuple(summ.expressions()) if expressions else ()
     return GlobalResult(summ.kind, summ.labels, summary_exprs, theta_star, zero_dim, n_c, n_r, n_a,
                         tuple(sols), tuple(real_sols), glob_c, glob_r, glob_a, tuple(cands), membership, len(G),
-                        times, tuple(notes))
+                        times, tuple(notes), linear_global=lin)
+
+
+def _constant_forms(mm: dict[int, DomainMatrix], forms: Sequence[Mapping[str, Fraction]], names: Sequence[str],
+                    pt) -> tuple:
+    """A basis of the λ with Σ λ_k ℓ_k single-valued: Σ_k λ_k Σ_j a_kj (M_j − θ_j* I) = 0 (a radical ideal)."""
+    if not forms:
+        return ()
+    D = mm[0].shape[0]
+    eye = DomainMatrix.eye(D, QQ)
+    cols = []
+    for form in forms:
+        acc = DomainMatrix.zeros((D, D), QQ)
+        for name, a in form.items():
+            if a:
+                j = names.index(name)
+                acc = acc + (mm[j] - eye * pt[j]) * QQ(Fraction(a).numerator, Fraction(a).denominator)
+        cols.append([v for row in acc.to_list() for v in row])
+    rows = [[c[i] for c in cols] for i in range(D * D)]
+    kernel = DomainMatrix(rows, (D * D, len(forms)), QQ).nullspace().to_list()
+    return tuple(tuple(Fraction(int(v.numerator), int(v.denominator)) for v in row) for row in kernel)
 
 
 def _solve_numeric(mm: dict[int, DomainMatrix], theta_idx, rng: random.Random, x: sp.Symbol):
@@ -840,10 +885,39 @@ def _square_free_mod(coeffs: Sequence[int], p: int) -> bool:
     return len(f) == 1
 
 
+def _cross_terms(expr, params, point) -> list[tuple[dict[str, int], Fraction]] | None:
+    """Terms of P·Q(θ*) − Q·P(θ*) for a rational function f = P/Q of ``params`` (None when f is not one).
+
+    f(θ) − f(θ*) vanishes on a solution where Q ≠ 0 iff this polynomial does (the membership of
+    the sympy path, cross-multiplied the same way).
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> from fractions import Fraction
+    >>> from symid.structural.global_ import _cross_terms
+    >>> a, b = sp.symbols("a b")
+    >>> _cross_terms(a / b, [a, b], [Fraction(2), Fraction(3)])
+    [({'a': 1}, Fraction(3, 1)), ({'b': 1}, Fraction(-2, 1))]
+    """
+    num, den = sp.fraction(sp.together(sp.sympify(expr)))
+    try:
+        P, Q = sp.Poly(num, *params, domain="QQ"), sp.Poly(den, *params, domain="QQ")
+    except (sp.PolynomialError, sp.CoercionFailed, sp.GeneratorsNeeded):
+        return None
+    vals = [sp.Rational(v.numerator, v.denominator) for v in point]
+    g = P * Q.eval(dict(zip(params, vals, strict=True))) - Q * P.eval(dict(zip(params, vals, strict=True)))
+    names = [q.name for q in params]
+    return [({n: e for n, e in zip(names, mono, strict=True) if e}, Fraction(int(c.p), int(c.q)))
+            for mono, c in g.terms() if c != 0]
+
+
 def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star, names: Sequence[str],
-                   positive: Sequence[bool], seed: int):
+                   positive: Sequence[bool], seed: int, candidates: Sequence[Sequence[tuple]] = (),
+                   forms: Sequence[Mapping[str, Fraction]] = ()):
     """msolve's answer at θ* over ℚ: (n_complex, n_real, n_admissible, admissible, real, global per parameter over
-    complex / real / admissible solutions), or None for a positive-dimensional set (then sympy decides)."""
+    complex / real / admissible solutions, per candidate whether its cross-multiplied form (:func:`_cross_terms`)
+    vanishes on every complex solution), or None for a positive-dimensional set (then sympy decides)."""
     var = [f"x{i}" for i in range(R.ngens)]
     text = input_text([dict(p.terms()) for p in eqs], R.ngens, 0)
     exact = [Fraction(int(v.p), int(v.q)) for v in star]
@@ -889,9 +963,15 @@ def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star,
             moved_a |= moved
     glob_c = {n: par.single_valued(var[i], exact[i]) for i, n in enumerate(names)}
     theta_star = dict(zip(names, star, strict=True))
+    index = {n: i for i, n in enumerate(names)}
+    member = tuple(par.vanishes([({var[index[n]]: e for n, e in expo.items()}, c) for expo, c in terms])
+                   for terms in candidates)
+    lin = tuple(tuple(row) for row in par.constant_forms(
+        [{var[index[n]]: a for n, a in form.items()} for form in forms],
+        {var[index[n]]: v for n, v in zip(names, exact, strict=True)})) if forms else ()
     return (par.n_distinct, len(real), len(adm), _canonical(adm, theta_star, glob_c),
             _canonical(real, theta_star, glob_c), glob_c, {n: n not in moved_r for n in names},
-            {n: n not in moved_a for n in names})
+            {n: n not in moved_a for n in names}, member, lin)
 
 
 def _exact_zeros(par, var: Sequence[str], boxes, positive: Sequence[bool]) -> set[tuple[int, int]]:
@@ -945,7 +1025,9 @@ def _claims_global(res: GlobalResult) -> bool:
 
 def generic_global(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
                    seed: int = 0, rank: int | None = None, extra_candidates: Sequence[sp.Expr] = (),
-                   expressions: bool = True, msolve: str | None = None) -> GlobalResult:
+                   expressions: bool = True, msolve: str | None = None,
+                   confirm_known: Mapping[str, object] | None = None,
+                   linear_forms: Sequence[Mapping[str, Fraction]] = ()) -> GlobalResult:
     """:func:`global_analysis` at a θ* checked to be generic, and its global claims confirmed at a second point.
 
     1. θ* is drawn (:func:`draw_point`) until the Jacobian has the generic rank
@@ -961,6 +1043,9 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     ``msolve``: path of an msolve program, used (at θ* and θ**) when the Jacobian has
     full rank (``rank`` = the number of free parameters: finitely many solutions); the
     result is the same as sympy's (module docstring), ``engine`` says which ran.
+    ``confirm_known``: the known values at θ** (default ``known``; the slices of
+    :mod:`~symid.structural.slicing` give their cut parameters other values there).
+    ``linear_forms``: as for :func:`global_analysis` (decided at θ* only).
 
     Examples
     --------
@@ -979,7 +1064,7 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
             msolve = None  # infinitely many solutions: sympy (radical membership, basis candidates)
         try:
             res = global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
-                                  expressions=expressions, prepared=prepared, msolve=msolve)
+                                  expressions=expressions, prepared=prepared, msolve=msolve, linear_forms=linear_forms)
             break
         except NonGenericPoint as exc:
             star = ", ".join(str(v) for v in prepared[1])
@@ -989,9 +1074,10 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     draws = draw + 1
     if not _claims_global(res):
         return replace(res, notes=(*res.notes, *notes), draws=draws)
-    zero2, count2, single2, theta2 = confirm_mod_p(model, known, seed=seed, draw=500, rank=rank,
+    zero2, count2, single2, theta2 = confirm_mod_p(model, known if confirm_known is None else confirm_known,
+                                                   seed=seed, draw=500, rank=rank,
                                                    msolve=msolve if res.engine == "msolve" else None,
-                                                   summary=prepared[3])
+                                                   summary=prepared[3] if confirm_known is None else None)
     glob_c = {k: v and single2.get(k, False) for k, v in res.global_complex.items()}
     agree = glob_c == res.global_complex and zero2 == res.zero_dimensional and count2 == res.n_complex
     if not agree:

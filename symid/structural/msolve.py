@@ -324,6 +324,137 @@ class Parametrization:
         vv = list(v) + [0] * (len(wp) - len(v))
         return all(a + c * value * b == 0 for a, b in zip(vv, wp, strict=True))
 
+    def vanishes(self, terms: Sequence[tuple[Mapping[str, int], Fraction | int]]) -> bool:
+        """Whether the polynomial Σ a_k Π x_j^{e_kj} (``terms``: (exponents, a_k) pairs) is 0 on every solution.
+
+        With x_j·w' = −v_j/c_j on the roots of w (over GF(p): x_j = −v_j) and ϑ for the
+        parameter variable, f·w'^D (D the total degree of f) is a polynomial in ϑ; f
+        vanishes on every solution iff it is 0 modulo w (w' has no common root with the
+        square-free w). Exact, in integers or rationals (modulo p over GF(p)).
+
+        Examples
+        --------
+        >>> from symid.structural.msolve import parse_output
+        >>> # x0² = 4: solutions ±2 (msolve's form for the parametrization of x0 itself)
+        >>> par = parse_output("[0, [0, 1, 2, ['x0'], [], [1, [[2, [-4, 0, 1]], [1, [0, 2]], []]]]]:",
+        ...                    ["x0"], 0).param
+        >>> par.vanishes([({"x0": 2}, 1), ({}, -4)]), par.vanishes([({"x0": 1}, 1), ({}, -2)])
+        (True, False)
+        """
+        p = self.characteristic
+        w = list(self.elim)
+
+        def reduce(a: list) -> list:
+            a = list(a)
+            lead = w[-1]
+            while len(a) >= len(w):
+                c = a[-1]
+                if c:
+                    f = c * pow(lead, -1, p) % p if p else Fraction(c) / lead
+                    shift = len(a) - len(w)
+                    for i, wi in enumerate(w):
+                        a[shift + i] = (a[shift + i] - f * wi) % p if p else a[shift + i] - f * wi
+                a.pop()
+            while a and a[-1] == 0:
+                a.pop()
+            return a
+
+        def mul(a: list, b: list) -> list:
+            if not a or not b:
+                return []
+            out = [0] * (len(a) + len(b) - 1)
+            for i, x in enumerate(a):
+                if x:
+                    for j, y in enumerate(b):
+                        out[i + j] += x * y
+            return reduce([c % p for c in out] if p else out)
+
+        wp = [1] if p else list(self.denom)
+        scaled = {}  # x_j·w' as a polynomial in ϑ
+        for name in {n for expo, _ in terms for n, e in expo.items() if e}:
+            if name == self.parameter:
+                scaled[name] = mul([0, 1], wp)
+            else:
+                v, c = self.coords[name]
+                scaled[name] = [(-x) % p for x in v] if p else [Fraction(-x, c) for x in v]
+        if any(e < 0 for expo, _ in terms for e in expo.values()):
+            raise ValueError("vanishes: exponents must be non-negative")
+        top = max((sum(expo.values()) for expo, _ in terms), default=0)
+        acc: list = []
+        for expo, coef in terms:
+            coef = Fraction(coef)
+            part = [coef.numerator * pow(coef.denominator, -1, p) % p] if p else [coef]
+            for name, e in expo.items():
+                for _ in range(e):
+                    part = mul(part, scaled[name])
+            for _ in range(top - sum(expo.values())):
+                part = mul(part, wp)
+            acc = [x + y for x, y in zip(acc + [0] * len(part), part + [0] * len(acc), strict=True)]
+        return not reduce([x % p for x in acc] if p else acc)
+
+    def constant_forms(self, forms: Sequence[Mapping[str, Fraction]], point: Mapping[str, Fraction]) -> list[list]:
+        """A basis of the coefficient vectors λ for which Σ_k λ_k ℓ_k(x) is constant on every solution (over ℚ).
+
+        ``forms``: linear forms ℓ_k = Σ_j a_kj x_j (variable name → coefficient);
+        ``point``: a known solution (the constant is ℓ(point)). With x_j·w' = −v_j/c_j,
+        ℓ_k(x)·w' − ℓ_k(point)·w' reduced modulo w is linear in the coefficients, so
+        the combinations that vanish identically are the null space of the matrix whose
+        columns are these polynomials (exact rational arithmetic).
+
+        Examples
+        --------
+        >>> from fractions import Fraction
+        >>> from symid.structural.msolve import parse_output
+        >>> # x1 = ϑ with ϑ² = 4, x0 = (12 − 2ϑ)/(2ϑ): solutions (2, 2) and (−4, −2); x0 − 3/2·x1 = −1 on both
+        >>> text = ("[0, [0, 2, 2, ['x0', 'x1'], [], [1, [[2, [-4, 0, 1]], [1, [0, 2]], "
+        ...         "[[[1, [-12, 2]], 1]]]]]]:")
+        >>> par = parse_output(text, ["x0", "x1"], 0).param
+        >>> [[str(v) for v in row] for row in par.constant_forms([{"x0": 1}, {"x1": 1}], {"x0": 2, "x1": 2})]
+        [['-2/3', '1']]
+        """
+        from sympy import QQ
+        from sympy.polys.matrices import DomainMatrix
+
+        if self.characteristic:
+            raise ValueError("constant_forms is for parametrizations over ℚ")
+        w = list(self.elim)
+        n = len(w) - 1
+
+        def reduce(a: list) -> list:
+            a = list(a) + [Fraction(0)] * max(0, n - len(a))
+            while len(a) > n:
+                c = a.pop()
+                if c:
+                    f = Fraction(c) / w[-1]
+                    shift = len(a) - n
+                    for i, wi in enumerate(w[:-1]):
+                        a[shift + i] -= f * wi
+            return a
+
+        wp = [Fraction(x) for x in self.denom]
+        cols = []
+        for form in forms:
+            acc = [Fraction(0)] * max(n, len(wp) + 1)
+            for name, a in form.items():
+                a = Fraction(a)
+                if not a:
+                    continue
+                if name == self.parameter:
+                    xw = [Fraction(0), *wp]  # ϑ·w'
+                else:
+                    v, c = self.coords[name]
+                    xw = [Fraction(-x, c) for x in v]
+                shifted = [x - Fraction(point[name]) * y for x, y in
+                           zip(xw + [Fraction(0)] * len(wp), wp + [Fraction(0)] * len(xw), strict=True)]
+                acc = [x + a * y for x, y in zip(acc + [Fraction(0)] * len(shifted),
+                                                 shifted + [Fraction(0)] * len(acc), strict=True)]
+            cols.append(reduce(acc))
+        rows = [[QQ(c[i].numerator, c[i].denominator) for c in cols] for i in range(n)]
+        if not rows:
+            return [[1 if i == k else 0 for i in range(len(forms))] for k in range(len(forms))]
+        kernel = DomainMatrix(rows, (n, len(forms)), QQ).nullspace()
+        return [[Fraction(int(v.numerator), int(v.denominator)) for v in row] for row in kernel.to_list()]
+
     def check_point(self, point: Mapping[str, Fraction]) -> None:
         """Check exactly that a known solution (every variable of the input) is one of the parametrization's.
 

@@ -33,6 +33,7 @@ import sympy as sp
 from symid.errors import ModelError, SolverError
 from symid.structural.deadline import Running, run_with_deadline, start, wait_any
 from symid.structural.global_ import GlobalResult, generic_global, star_and_summary
+from symid.structural.slicing import sliced_global
 from symid.structural.witness import WitnessResult, find_witnesses
 
 __all__ = ["GlobalOutcome", "limit_reason", "raise_on_error", "run_global"]
@@ -45,8 +46,17 @@ _MODEL_ERRORS = ("ModelError", "NonAffineError", "PoleError", "DataError")
 _LIMITS = ("ExactStepLimit", "MemoryError")
 
 
-def _global_step(model, known, positive, seed, extra_candidates, expressions, rank, msolve=None):
-    """A generic θ*, the summary and the Gröbner step (confirmed at θ**), in one child process."""
+def _global_step(model, known, positive, seed, extra_candidates, expressions, rank, msolve=None, fix=(),
+                 linear_forms=(), identifiable=None):
+    """A generic θ*, the summary and the Gröbner step (confirmed at θ**), in one child process.
+
+    ``fix``: for a model that is not locally identifiable, the parameters that cut its solution set
+    (:mod:`~symid.structural.slicing`), and ``linear_forms`` the linear functions whose single-valued
+    combinations are asked.
+    """
+    if fix:
+        return sliced_global(model, known, fix=fix, positive=positive, seed=seed, extra_candidates=extra_candidates,
+                             msolve=msolve, linear_forms=linear_forms, identifiable=identifiable)
     return generic_global(model, known, positive=positive, seed=seed, rank=rank, extra_candidates=extra_candidates,
                           expressions=expressions, msolve=msolve)
 
@@ -147,18 +157,25 @@ def _read_witnesses(out: GlobalOutcome, wit: WitnessResult, names: Sequence[str]
 
 def run_global(model, known: Mapping[str, sp.Rational], *, names: Sequence[str], positive: Sequence[bool],
                seed: int, extra_candidates: Sequence[sp.Expr], full_rank: bool, exact_count: bool,
-               left: Callable[[], float | None], rank: int | None = None, msolve: str | None = None) -> GlobalOutcome:
+               left: Callable[[], float | None], rank: int | None = None, msolve: str | None = None,
+               fix: Sequence[str] = (), linear_forms: Sequence[Mapping[str, object]] = (),
+               identifiable: Sequence[str] | None = None) -> GlobalOutcome:
     """Run the Gröbner step (and, for a full-rank Jacobian, the witness search beside it) within ``left()`` s.
 
     ``left()`` gives the seconds left of the budget (``None``: no limit, and the
     Gröbner step runs in this process without a witness search). ``msolve``: the msolve
     program for the exact step (:func:`~symid.structural.global_.generic_global`).
+    ``fix``: for a rank-deficient Jacobian, the parameters whose random values cut the
+    solution set to finitely many points (:mod:`~symid.structural.slicing`);
+    ``linear_forms``: linear functions of θ whose single-valued combinations are asked;
+    ``identifiable``: the locally identifiable parameters.
     """
     t1 = time.perf_counter()
     out = GlobalOutcome()
     g_kwargs = {"model": model, "known": known, "positive": list(positive), "seed": seed,
                 "extra_candidates": list(extra_candidates), "expressions": not full_rank, "rank": rank,
-                "msolve": msolve}
+                "msolve": msolve, "fix": tuple(fix), "linear_forms": list(linear_forms),
+                "identifiable": None if identifiable is None else list(identifiable)}
     if left() is None:  # no deadline: the exact answer, in this process
         status, value = run_with_deadline(_global_step, g_kwargs, None)
     else:
