@@ -56,7 +56,7 @@ def _verdicts_from_groebner(glob, names, loc, full_rank: bool, *, admissible: bo
             verdicts[nm] = "none"
         elif glob.global_complex.get(nm, False):
             verdicts[nm] = "global"
-        elif finite and not single.get(nm, True):
+        elif finite and (not single.get(nm, True) or nm in glob.local_elsewhere):
             verdicts[nm] = LOCAL
         else:
             verdicts[nm] = UNDETERMINED
@@ -66,7 +66,7 @@ def _verdicts_from_groebner(glob, names, loc, full_rank: bool, *, admissible: bo
         verdict = UNDETERMINED
     elif glob.n_complex == 1:
         verdict = "global"
-    elif count is not None and count >= 2:
+    elif (count is not None and count >= 2) or glob.local_elsewhere:
         verdict = LOCAL
     else:
         verdict = UNDETERMINED

@@ -164,6 +164,10 @@ class GlobalResult:
         that cut the solution set; empty otherwise.
     slice_result : GlobalResult or None
         The sliced system's own result (counts and solutions on the slice).
+    local_elsewhere : dict of str to dict
+        Parameters that are single-valued on the admissible solutions at θ* but not on the
+        complex ones, for which another random point (given, as strings) has two admissible
+        solutions that differ in them (:func:`generic_global`): proven not global.
     linear_global : tuple of tuple of Fraction
         A basis of the coefficient vectors λ for which Σ λ_k ℓ_k is single-valued on every
         complex solution, ℓ_k the ``linear_forms`` passed in (empty when none were, or the
@@ -195,6 +199,7 @@ class GlobalResult:
     slice_values: dict = field(default_factory=dict)
     slice_result: GlobalResult | None = None
     linear_global: tuple = ()
+    local_elsewhere: dict = field(default_factory=dict)
 
 
 STAR_NUMERATORS = (1, 100_000)
@@ -1019,6 +1024,49 @@ def _confirm_msolve(binary: str, R: PolyRing, eqs, star, names: Sequence[str], m
     return True, par.degree, single
 
 
+EXTRA_POINTS = 6
+"""Further random points tried for a parameter whose other complex values are not admissible at θ*."""
+
+
+def _admissible_elsewhere(res: GlobalResult, model, known, positive, seed: int, rank, msolve, summary,
+                          extra_known=None, only=None) -> GlobalResult:
+    """Try :data:`EXTRA_POINTS` more random points for the parameters that are not single-valued over the complex
+    solutions but are over the admissible ones at θ*: two admissible solutions that differ in such a parameter at
+    another point prove it not globally identifiable (they are simple, so they persist near that point)."""
+    if not res.zero_dimensional or res.n_complex is None:
+        return res
+    open_ = [n for n, single in res.global_complex.items() if not single and res.global_admissible.get(n, False)
+             and (only is None or n in only)]
+    found: dict[str, dict] = {}
+    for k in range(EXTRA_POINTS if open_ else 0):
+        known_k = known if extra_known is None else extra_known[k]
+        try:
+            prepared = star_and_summary(model, known_k, seed=seed, draw=100 + k, rank=rank,
+                                        summary=summary if extra_known is None else None)
+            other = global_analysis(model, known_k, positive=positive, seed=seed, expressions=False,
+                                    prepared=prepared, msolve=msolve)
+        except NonGenericPoint:
+            continue
+        for n in list(open_):
+            if not other.global_admissible.get(n, True):
+                fixed = {} if extra_known is None else {q: str(v) for q, v in extra_known[k].items()
+                                                         if (known or {}).get(q) != v}
+                found[n] = {**fixed, **{q: str(v) for q, v in other.theta_star.items()}}
+                open_.remove(n)
+        if not open_:
+            break
+    if not found:
+        return res
+    points: dict[str, list[str]] = {}
+    for n, pt in found.items():
+        points.setdefault(", ".join(f"{q} = {v}" for q, v in pt.items()), []).append(n)
+    where = "; ".join(f"{', '.join(ns)} at θ = ({pt})" for pt, ns in points.items())
+    note = (f"{', '.join(found)}: a single value on the admissible solutions at θ* but not on the complex ones; at "
+            f"another random point two admissible solutions differ in {'it' if len(found) == 1 else 'each'} "
+            f"(proven not global): {where}")
+    return replace(res, local_elsewhere=found, notes=(*res.notes, note))
+
+
 def _claims_global(res: GlobalResult) -> bool:
     return (res.zero_dimensional and res.n_complex == 1) or any(res.global_complex.values())
 
@@ -1027,7 +1075,9 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
                    seed: int = 0, rank: int | None = None, extra_candidates: Sequence[sp.Expr] = (),
                    expressions: bool = True, msolve: str | None = None,
                    confirm_known: Mapping[str, object] | None = None,
-                   linear_forms: Sequence[Mapping[str, Fraction]] = ()) -> GlobalResult:
+                   linear_forms: Sequence[Mapping[str, Fraction]] = (),
+                   extra_known: Sequence[Mapping[str, object]] | None = None,
+                   local_only: Sequence[str] | None = None) -> GlobalResult:
     """:func:`global_analysis` at a θ* checked to be generic, and its global claims confirmed at a second point.
 
     1. θ* is drawn (:func:`draw_point`) until the Jacobian has the generic rank
@@ -1046,6 +1096,11 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     ``confirm_known``: the known values at θ** (default ``known``; the slices of
     :mod:`~symid.structural.slicing` give their cut parameters other values there).
     ``linear_forms``: as for :func:`global_analysis` (decided at θ* only).
+    A parameter single-valued on the admissible solutions at θ* but not on the complex
+    ones is looked at in :data:`EXTRA_POINTS` more random points (``extra_known``: the
+    known values at each; default ``known``): two admissible solutions that differ in it
+    there prove it not global (``local_elsewhere``; only the parameters named in
+    ``local_only``, when given).
 
     Examples
     --------
@@ -1072,6 +1127,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     if res is None:
         raise ExactStepLimit(f"no generic point θ* in {MAX_DRAWS} random draws")
     draws = draw + 1
+    res = _admissible_elsewhere(res, model, known, positive, seed, rank, msolve, prepared[3], extra_known,
+                                local_only)
     if not _claims_global(res):
         return replace(res, notes=(*res.notes, *notes), draws=draws)
     zero2, count2, single2, theta2 = confirm_mod_p(model, known if confirm_known is None else confirm_known,

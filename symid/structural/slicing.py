@@ -41,7 +41,7 @@ from dataclasses import replace
 
 import sympy as sp
 
-from symid.structural.global_ import GlobalResult, draw_point, generic_global
+from symid.structural.global_ import EXTRA_POINTS, GlobalResult, draw_point, generic_global
 from symid.structural.local import local_analysis
 from symid.structural.summary import exhaustive_summary, free_parameters
 
@@ -136,6 +136,8 @@ def sliced_global(model, known: Mapping[str, object] | None = None, *, fix: Sequ
     res = generic_global(model, {**known, **values}, positive=rest_positive, seed=seed, rank=len(rest),
                          extra_candidates=cands, expressions=False, msolve=msolve,
                          confirm_known={**known, **confirm_values},
+                         extra_known=[{**known, **_slice_values(fix, seed, 2 + k)} for k in range(EXTRA_POINTS)],
+                         local_only=sorted(identifiable),
                          linear_forms=[{n: a for n, a in form.items() if n not in values} for form in linear_forms])
 
     def whole(part: Mapping[str, bool]) -> dict[str, bool]:
