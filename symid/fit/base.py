@@ -35,7 +35,15 @@ from typing import Any, ClassVar
 import numpy as np
 
 from symid.errors import OptionError
-from symid.fit.options import check_bool, check_choice, check_float, check_int, check_known_names, check_time_limit
+from symid.fit.options import (
+    check_bool,
+    check_callback,
+    check_choice,
+    check_float,
+    check_int,
+    check_known_names,
+    check_time_limit,
+)
 from symid.fit.result import ScrIteration, StartOutcome
 from symid.fit.success import fit_test, physical_check
 
@@ -128,6 +136,33 @@ class Estimator(abc.ABC):
         from symid.fit.polish import polish_outcome
 
         return polish_outcome(polisher, self.run(x0))
+
+    def _progress_options(self, callback: Any, verbose: Any) -> None:
+        """Validate and keep ``callback`` (a function of one :class:`symid.engine.scr.ScrProgress`) and
+        ``verbose`` (print one line per iteration), for :meth:`progress_reporter`."""
+        self._callback = check_callback("callback", callback, "ScrProgress")
+        self._verbose = check_bool("verbose", verbose)
+
+    def progress_reporter(self, t0: float, label: str | None = None) -> Callable[[int, float, Any], bool] | None:
+        """``report(k, residual, θ)`` after iteration k: a :class:`symid.engine.scr.ScrProgress` (θ's data
+        misfit, seconds since ``t0``) to ``callback`` and, with ``verbose``, a printed line headed by
+        ``label`` (default: the method); it returns True when the callback asks to stop. ``None`` when
+        neither is asked for (nothing is computed then)."""
+        from symid.engine.scr.result import ScrProgress, print_progress
+
+        callback, verbose = getattr(self, "_callback", None), getattr(self, "_verbose", False)
+        if callback is None and not verbose:
+            return None
+        label = self.method if label is None else label
+
+        def report(k: int, residual: float, theta: Any) -> bool:
+            theta = np.asarray(theta, dtype=float).reshape(-1)
+            info = ScrProgress(int(k), float(residual), self.misfit(theta), time.perf_counter() - t0, theta)
+            if verbose:
+                print_progress(info, label)
+            return bool(callback(info)) if callback is not None else False
+
+        return report
 
     def outcome(self, x0: np.ndarray, theta: np.ndarray, *, finished: bool, status: str, message: str,
                 iterations: int, wall_time: float, history: tuple[ScrIteration, ...] = ()) -> StartOutcome:
@@ -231,30 +266,16 @@ class ScrEstimator(Estimator):
             opts["admm"] = admm
         return opts
 
-    def _progress_options(self, callback: Any, verbose: Any) -> None:
-        """Validate and keep ``callback`` (a function of one :class:`symid.engine.scr.ScrProgress`) and
-        ``verbose`` (print one line per iteration)."""
-        if callback is not None and not callable(callback):
-            raise OptionError(f"callback must be a function of one ScrProgress (or None); got "
-                              f"{type(callback).__name__}")
-        self._callback, self._verbose = callback, check_bool("verbose", verbose)
-
     def engine_monitor(self, theta_of: Callable[[Mapping[str, Any]], Any], t0: float) -> Any:
         """The engine's ``monitor`` reporting each iteration to ``callback``/``verbose`` as a
         :class:`symid.engine.scr.ScrProgress` (θ from the iterate by ``theta_of``, its data misfit,
         seconds since ``t0``); ``None`` when neither is asked for (nothing is computed then)."""
-        from symid.engine.scr.result import ScrProgress, print_progress
-
-        callback, verbose = getattr(self, "_callback", None), getattr(self, "_verbose", False)
-        if callback is None and not verbose:
+        report = self.progress_reporter(t0)
+        if report is None:
             return None
 
         def monitor(k: int, x: Mapping[str, Any], it: Any, elapsed: float) -> bool:
-            theta = np.asarray(theta_of(x), dtype=float).reshape(-1)
-            info = ScrProgress(k, float(it.residual), self.misfit(theta), time.perf_counter() - t0, theta)
-            if verbose:
-                print_progress(info)
-            return bool(callback(info)) if callback is not None else False
+            return report(k, float(it.residual), theta_of(x))
 
         return monitor
 

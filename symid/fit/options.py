@@ -22,6 +22,7 @@ __all__ = [
     "MAX_STARTS",
     "check_bool",
     "check_bounds",
+    "check_callback",
     "check_choice",
     "check_float",
     "check_int",
@@ -225,6 +226,24 @@ def check_time_limit(name: str, value: Any) -> float | None:
     (30.0, None)
     """
     return None if value is None else check_float(name, value, low=0, strict_low=True)
+
+
+def check_callback(name: str, value: Any, record: str) -> Any:
+    """A progress callback: ``None`` or a function of one ``record`` (the name of the type it receives).
+
+    Examples
+    --------
+    >>> from symid.fit.options import check_callback
+    >>> check_callback("callback", print, "ScrProgress") is print
+    True
+    >>> check_callback("callback", 3, "ScrProgress")
+    Traceback (most recent call last):
+    ...
+    symid.errors.OptionError: callback must be a function of one ScrProgress (or None); got int
+    """
+    if value is not None and not callable(value):
+        raise OptionError(f"{name} must be a function of one {record} (or None); got {type(value).__name__}")
+    return value
 
 
 def check_known_names(owner: str, given: Mapping[str, Any], valid: Iterable[str]) -> None:

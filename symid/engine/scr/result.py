@@ -52,6 +52,11 @@ class Iteration:
 class ScrProgress:
     """One SCR iteration of an estimator's start, as its ``callback`` receives it.
 
+    The similarity methods that are not SCR but iterate on the same equations (ALS and
+    GB sweeps, the reweighting rounds of ``ls``; :mod:`symid.fit.similarity`) report
+    their iterations in this record too, each with its own ``residual`` (their docstrings
+    say which).
+
     Attributes
     ----------
     iteration : int
@@ -60,7 +65,8 @@ class ScrProgress:
         Largest normalised bilinear residual after the iteration (SCR's stopping measure).
     misfit : float
         The estimator's data misfit at the iterate's θ (its ``cost``; ``inf`` where the
-        model cannot be evaluated).
+        model cannot be evaluated). On the N4SID route of I/O records, the misfit to the
+        estimated black box (:mod:`symid.fit.timeseries.blackbox`).
     elapsed : float
         Seconds since the start began.
     theta : numpy.ndarray
@@ -74,8 +80,11 @@ class ScrProgress:
     theta: np.ndarray = field(repr=False)
 
 
-def print_progress(info: ScrProgress) -> None:
+def print_progress(info: ScrProgress, label: str = "scr") -> None:
     """One line per SCR iteration (iteration, residual, misfit, elapsed seconds): what ``verbose=True`` prints.
+
+    ``label`` names the method at the start of the line (``"als"``, ``"gb"``, … for the
+    similarity methods that report in this record).
 
     Examples
     --------
@@ -84,7 +93,7 @@ def print_progress(info: ScrProgress) -> None:
     >>> print_progress(ScrProgress(12, 3.1e-4, 2.5e-6, 1.25, np.zeros(3)))
     scr    iteration    12  residual 3.100e-04  misfit 2.500000e-06       1.25 s
     """
-    print(f"scr    iteration {info.iteration:5d}  residual {info.residual:.3e}  misfit {info.misfit:.6e}  "
+    print(f"{label:<6} iteration {info.iteration:5d}  residual {info.residual:.3e}  misfit {info.misfit:.6e}  "
           f"{info.elapsed:9.2f} s", flush=True)
 
 
