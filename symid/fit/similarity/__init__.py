@@ -19,7 +19,10 @@ SecondOrderModel   ``ipopt``   nonlinear least squares on the black box's freque
 Every method is ranked by the same basis-free misfit
 (:meth:`~symid.fit.similarity.data.SimilarityData.misfit`). The options ``horizon``
 (N4SID), ``allow_unstable`` and ``balance`` configure the black box and are taken by
-every method.
+every method. Every method also takes ``time_limit`` (seconds per start), ``callback``
+and ``verbose`` (per-iteration progress: a :class:`symid.engine.scr.ScrProgress` for
+SCR, ALS, GB and ``ls``, a :class:`symid.engine.ipopt.IpoptIteration` for IPOPT); when
+``"scr"`` runs the linear case instead, these three pass to it.
 """
 
 from __future__ import annotations
@@ -32,10 +35,11 @@ from symid.fit.options import check_bool, check_known_names
 from symid.fit.similarity.data import similarity_data
 from symid.model.secondorder import SecondOrderModel
 
-__all__ = ["DATA_OPTIONS", "METHODS", "prepare"]
+__all__ = ["DATA_OPTIONS", "METHODS", "PROGRESS_OPTIONS", "prepare"]
 
 METHODS = ("scr", "als", "gb", "ipopt", "ls")
 DATA_OPTIONS = ("horizon", "allow_unstable", "balance")
+PROGRESS_OPTIONS = ("time_limit", "callback", "verbose")
 
 
 def _estimator_class(model: Any, method: str) -> type[Estimator]:
@@ -81,10 +85,11 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
 
         case = second_order_case(model)
         if case is not None:
+            shared = {k: opts.pop(k) for k in PROGRESS_OPTIONS if k in opts}  # ls takes these too
             if opts:
                 raise OptionError(f"options {', '.join(sorted(opts))} are SCR options, but the linear special case "
                                   "of §7-5-2 applies and runs instead; pass force_scr=True to run SCR")
-            est = LinearSimilarity2nd.create(model, sd, {}, noise_floor=noise_floor)
+            est = LinearSimilarity2nd.create(model, sd, shared, noise_floor=noise_floor)
             est.options["chosen_because"] = f"scr → ls: linear special case of §7-5-2 ({case})"
             return est
     return cls.create(model, sd, opts, noise_floor=noise_floor, owner=owner)

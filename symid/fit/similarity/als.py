@@ -7,9 +7,10 @@ from typing import Any
 
 import numpy as np
 
-from symid.fit.options import check_choice, check_float, check_int, check_seed
+from symid.fit.options import check_choice, check_float, check_int, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
-from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
+from symid.fit.similarity.data import SimilarityData, SimilarityEstimator, budget_message
+from symid.fit.similarity.objective import SimilarityMisfit
 from symid.fit.similarity.start import (
     INITS,
     initial_point,
@@ -46,22 +47,41 @@ class AlsSimilarity(SimilarityEstimator):
         Sweeps at most (default 10 000, the limit quoted in §6-7-2).
     tol : float
         Stop when the relative step ‖z⁺ − z‖/‖z‖ is at most this (default 1e-6, thesis (6-31)).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds, the start's (θ₀, T₀) included, checked
+        after every sweep (status ``"time_limit"``; the last sweep's estimate is kept).
+        Default: none.
+    callback : callable, optional
+        Called after every sweep with a :class:`symid.engine.scr.ScrProgress` (sweep,
+        residual √(F/(‖𝔸‖² + ‖𝔹‖² + ‖ℂ‖²)) of the similarity equations, black-box misfit,
+        elapsed seconds, θ); a true return value stops the start (status ``"stopped"``).
+    verbose : bool
+        Print one line per sweep (sweep, residual, misfit, elapsed). Default False.
     """
 
     method = "als"
 
     def __init__(self, model: Any, data: SimilarityData, *, aux_init: str = "random", seed: int = 0,
-                 max_iter: int = 10000, tol: float = 1e-6):
+                 max_iter: int = 10000, tol: float = 1e-6, time_limit: float | None = None, callback: Any = None,
+                 verbose: bool = False):
         self.init = check_choice("aux_init", aux_init, INITS)
         self.seed = check_seed("seed", seed)
         self.max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         self.tol = check_float("tol", tol, low=0, strict_low=True)
+        self.time_limit = check_time_limit("time_limit", time_limit)
+        self._progress_options(callback, verbose)
         self.model, self.data, self.frf = model, data, data.frf
+        self.objective = SimilarityMisfit(model.maps, data.blackbox)
         self.options = {"aux_init": aux_init, "seed": seed, "max_iter": max_iter, "tol": tol,
-                        "black_box": data.source}
+                        "time_limit": self.time_limit, "callback": None if callback is None else "given",
+                        "verbose": self._verbose, "black_box": data.source}
 
-    def solve(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, bool]:
-        """(θ, T, sweeps, converged) from the start x₀."""
+    def solve(self, x0: np.ndarray, t0: float | None = None) -> tuple[np.ndarray, np.ndarray, int, str]:
+        """(θ, T, sweeps, status) from the start x₀; status ``"converged"``, ``"max_iter"``, ``"time_limit"``
+        (``time_limit`` seconds after ``t0``, default now) or ``"stopped"`` (by the callback)."""
+        t0 = time.perf_counter() if t0 is None else t0
+        deadline = None if self.time_limit is None else t0 + self.time_limit
+        report = self.progress_reporter(t0)
         maps, bb = self.model.maps, self.data.blackbox
         theta, T, _ = initial_point(self.init, x0, self.seed, maps, bb)
         s = unknown_scale(theta, T)
@@ -73,16 +93,25 @@ class AlsSimilarity(SimilarityEstimator):
             step = np.linalg.norm(z_new - z) / max(np.linalg.norm(z), 1e-300)
             z = z_new
             if not np.all(np.isfinite(z)):
-                return theta, T, k, False
+                return theta, T, k, "max_iter"
+            asked = report is not None and report(k, self.objective.relative_residual(theta, T), theta)
             if step <= self.tol:
-                return theta, T, k, True
-        return theta, T, self.max_iter, False
+                return theta, T, k, "converged"
+            if asked:
+                return theta, T, k, "stopped"
+            if deadline is not None and time.perf_counter() >= deadline and k < self.max_iter:
+                return theta, T, k, "time_limit"
+        return theta, T, self.max_iter, "max_iter"
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start x₀; never raises on solver failure."""
         t0 = time.perf_counter()
-        theta, T, k, ok = self.solve(np.asarray(x0, dtype=float))
-        msg = (f"relative step ≤ {self.tol:g} after {k} sweeps" if ok
-               else f"no convergence in {k} sweeps (relative step > {self.tol:g})")
-        return self.transform_outcome(x0, theta, T, finished=ok, status="converged" if ok else "max_iter",
+        theta, T, k, status = self.solve(np.asarray(x0, dtype=float), t0)
+        if status == "time_limit":
+            msg = budget_message(self.time_limit, k, "sweep")
+        else:
+            msg = {"converged": f"relative step ≤ {self.tol:g} after {k} sweeps",
+                   "max_iter": f"no convergence in {k} sweeps (relative step > {self.tol:g})",
+                   "stopped": f"stopped by the callback after {k} sweeps"}[status]
+        return self.transform_outcome(x0, theta, T, finished=status == "converged", status=status,
                                       message=msg, iterations=k, wall_time=time.perf_counter() - t0)

@@ -32,7 +32,7 @@ from symid.fit.options import check_bool, check_int
 from symid.fit.result import ScrIteration, StartOutcome
 from symid.signal.realisation import balanced_realisation, not_minimal
 
-__all__ = ["SimilarityData", "SimilarityEstimator", "similarity_data"]
+__all__ = ["SimilarityData", "SimilarityEstimator", "budget_message", "similarity_data"]
 
 _GRID_POINTS = 200
 
@@ -177,6 +177,19 @@ def similarity_data(model: Any, data: Any, *, horizon: int | None = None, allow_
         basis = "balanced"
     return SimilarityData(blackbox=bb, frf=FrequencyData(w, H), subspace=dss, source=source, basis=basis,
                           to_basis=P)
+
+
+def budget_message(limit: float, iterations: int, unit: str = "iteration") -> str:
+    """What a start stopped by its ``time_limit`` reports (as the SCR engine words it).
+
+    Examples
+    --------
+    >>> from symid.fit.similarity.data import budget_message
+    >>> budget_message(0.5, 3, "sweep")
+    'time limit of 0.5 s reached after 3 sweeps; the last estimate is kept'
+    """
+    plural = "" if iterations == 1 else "s"
+    return f"time limit of {limit:g} s reached after {iterations} {unit}{plural}; the last estimate is kept"
 
 
 class SimilarityEstimator(Estimator):

@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 import scipy.optimize
 
-from symid.fit.options import check_choice, check_float, check_int, check_seed
+from symid.fit.options import check_choice, check_float, check_int, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
-from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
+from symid.fit.similarity.data import SimilarityData, SimilarityEstimator, budget_message
 from symid.fit.similarity.objective import SimilarityMisfit
 from symid.fit.similarity.start import INITS, initial_point, unknown_scale
 
@@ -41,42 +41,86 @@ class GbSimilarity(SimilarityEstimator):
         BFGS iteration limit (default 10 000).
     tol : float
         Gradient tolerance (scipy's ``gtol``).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds, the start's (θ₀, T₀) included, checked
+        after every BFGS iteration (status ``"time_limit"``; the last iterate is kept).
+        Default: none.
+    callback : callable, optional
+        Called after every BFGS iteration with a :class:`symid.engine.scr.ScrProgress`
+        (iteration, residual √(F/(‖𝔸‖² + ‖𝔹‖² + ‖ℂ‖²)) of the similarity equations,
+        black-box misfit, elapsed seconds, θ); a true return value stops the start
+        (status ``"stopped"``).
+    verbose : bool
+        Print one line per iteration (iteration, residual, misfit, elapsed). Default False.
     """
 
     method = "gb"
 
     def __init__(self, model: Any, data: SimilarityData, *, aux_init: str = "random", seed: int = 0,
-                 max_iter: int = 10000, tol: float = 1e-10):
+                 max_iter: int = 10000, tol: float = 1e-10, time_limit: float | None = None, callback: Any = None,
+                 verbose: bool = False):
         self.init = check_choice("aux_init", aux_init, INITS)
         self.seed = check_seed("seed", seed)
         self.max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         self.gtol = check_float("tol", tol, low=0, strict_low=True)
+        self.time_limit = check_time_limit("time_limit", time_limit)
+        self._progress_options(callback, verbose)
         self.model, self.data, self.frf = model, data, data.frf
         self.objective = SimilarityMisfit(model.maps, data.blackbox)
         self.options = {"aux_init": aux_init, "seed": seed, "max_iter": max_iter, "tol": tol,
-                        "black_box": data.source}
+                        "time_limit": self.time_limit, "callback": None if callback is None else "given",
+                        "verbose": self._verbose, "black_box": data.source}
 
-    def solve(self, x0: np.ndarray) -> scipy.optimize.OptimizeResult:
-        """The raw :func:`scipy.optimize.minimize` result (``x`` = (θ, vec T)) from the start x₀."""
+    def solve(self, x0: np.ndarray, t0: float | None = None) -> scipy.optimize.OptimizeResult:
+        """The raw :func:`scipy.optimize.minimize` result (``x`` = (θ, vec T)) from the start x₀; ``cut`` is
+        ``"time_limit"`` (``time_limit`` seconds after ``t0``, default now) or ``"stopped"`` (by the callback)
+        when BFGS was cut short before its own stopping rule (``x`` is then the last iterate), else ``None``."""
+        t0 = time.perf_counter() if t0 is None else t0
+        deadline = None if self.time_limit is None else t0 + self.time_limit
+        report = self.progress_reporter(t0)
         theta, T, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
         s = unknown_scale(theta, T)
+        l = theta.size
+        state = {"k": 0, "cut": None}
 
         def scaled(y: np.ndarray) -> tuple[float, np.ndarray]:
             f, g = self.objective.value_and_grad(y * s)
             return f, g * s
 
+        def each(intermediate_result: scipy.optimize.OptimizeResult) -> None:
+            """After every BFGS iteration: report it; stop at the deadline or when the callback asks, unless the
+            iterate meets BFGS's own stopping rule (the gradient test it runs next)."""
+            state["k"] += 1
+            y = intermediate_result.x
+            asked = report is not None and report(state["k"], np.sqrt(max(float(intermediate_result.fun), 0.0)),
+                                                  (y * s)[:l])
+            late = deadline is not None and time.perf_counter() >= deadline and state["k"] < self.max_iter
+            if (asked or late) and not np.max(np.abs(scaled(y)[1]), initial=0.0) <= self.gtol:
+                state["cut"] = "stopped" if asked else "time_limit"
+                raise StopIteration
+
         with np.errstate(over="ignore", invalid="ignore"):
             res = scipy.optimize.minimize(scaled, self.objective.join(theta, T) / s, jac=True, method="BFGS",
+                                          callback=each if report is not None or deadline is not None else None,
                                           options={"gtol": self.gtol, "maxiter": self.max_iter})
         res.x = res.x * s
+        res.cut = state["cut"]
         return res
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start x₀; never raises on solver failure."""
         t0 = time.perf_counter()
-        res = self.solve(np.asarray(x0, dtype=float))
+        res = self.solve(np.asarray(x0, dtype=float), t0)
         theta, T = self.objective.split(res.x)
-        return self.transform_outcome(x0, theta, T, finished=bool(res.success),
-                                      status="converged" if res.success else "stopped",
-                                      message=f"BFGS: {res.message} (F/scale = {res.fun:.3e})", iterations=int(res.nit),
+        k = int(res.nit)
+        if res.cut == "time_limit":
+            status, message, finished = "time_limit", budget_message(self.time_limit, k), False
+        elif res.cut == "stopped":
+            status, message, finished = "stopped", f"stopped by the callback after {k} iterations", False
+        else:
+            finished = bool(res.success)  # BFGS's own rule; "stopped" is the callback's, as in SCR
+            status = "converged" if finished else ("max_iter" if res.status == 1 else "not_converged")
+            message = f"BFGS: {res.message}"
+        return self.transform_outcome(x0, theta, T, finished=finished, status=status,
+                                      message=f"{message} (F/scale = {res.fun:.3e})", iterations=k,
                                       wall_time=time.perf_counter() - t0)

@@ -2,15 +2,25 @@
 
 from __future__ import annotations
 
+import dataclasses
+import time
 from typing import Any
 
 import casadi as ca
 import numpy as np
 
-from symid.engine.ipopt import ScaledIpopt, casadi_matrices, positivity_bounds
-from symid.fit.options import check_bool, check_choice, check_float, check_int, check_seed
+from symid.engine.ipopt import ScaledIpopt, casadi_matrices, iteration_reporter, positivity_bounds
+from symid.fit.options import (
+    check_bool,
+    check_callback,
+    check_choice,
+    check_float,
+    check_int,
+    check_seed,
+    check_time_limit,
+)
 from symid.fit.result import StartOutcome
-from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
+from symid.fit.similarity.data import SimilarityData, SimilarityEstimator, budget_message
 from symid.fit.similarity.objective import SimilarityMisfit
 from symid.fit.similarity.start import INITS, initial_point, unknown_scale
 
@@ -42,21 +52,37 @@ class IpoptSimilarity(SimilarityEstimator):
         IPOPT iteration limit (default 3000).
     tol : float
         IPOPT tolerance (default 1e-12).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds (IPOPT's ``max_wall_time``; status
+        ``"Maximum_WallTime_Exceeded"``, the last iterate kept). Default: none.
+    callback : callable, optional
+        Called after every IPOPT iteration with a
+        :class:`~symid.engine.ipopt.IpoptIteration` (iteration, objective F/(‖𝔸‖² + ‖𝔹‖²
+        + ‖ℂ‖²), elapsed seconds, θ); a true return value stops the start (status
+        ``"User_Requested_Stop"``).
+    verbose : bool
+        Print one line per iteration (iteration, objective, elapsed). Default False.
     """
 
     method = "ipopt"
 
     def __init__(self, model: Any, data: SimilarityData, *, aux_init: str = "random", seed: int = 0,
-                 positivity: bool = True, max_iter: int = 3000, tol: float = 1e-12):
+                 positivity: bool = True, max_iter: int = 3000, tol: float = 1e-12, time_limit: float | None = None,
+                 callback: Any = None, verbose: bool = False):
         self.init = check_choice("aux_init", aux_init, INITS)
         self.seed = check_seed("seed", seed)
         positivity = check_bool("positivity", positivity)
         max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         tol = check_float("tol", tol, low=0, strict_low=True)
+        time_limit = check_time_limit("time_limit", time_limit)
+        callback = check_callback("callback", callback, "IpoptIteration")
+        verbose = check_bool("verbose", verbose)
         self.model, self.data, self.frf = model, data, data.frf
         self.misfit_F = SimilarityMisfit(model.maps, data.blackbox)
         self.options = {"aux_init": aux_init, "seed": seed, "positivity": positivity, "max_iter": max_iter,
-                        "tol": tol, "black_box": data.source}
+                        "tol": tol, "time_limit": time_limit, "callback": None if callback is None else "given",
+                        "verbose": verbose, "black_box": data.source}
+        report = iteration_reporter(callback, verbose)
         bb = data.blackbox
         l, n = model.n_parameters, bb.n_states
         z = ca.MX.sym("z", l + n * n)
@@ -69,20 +95,29 @@ class IpoptSimilarity(SimilarityEstimator):
             f = f + ca.sumsqr(ca.DM(bb.D) - mats["D"])
         lb, ub = positivity_bounds(model.positive, positivity, np.ones(l))
         self._lower = lb
+
+        def on_iteration(info: Any) -> bool:  # the user sees θ, not z = (θ, vec T)
+            return report(dataclasses.replace(info, theta=info.theta[:l].copy()))
+
         self._solver = ScaledIpopt("symid_ipopt_similarity", z, f / self.misfit_F.scale,
                                    lower=np.concatenate([lb, np.full(n * n, -np.inf)]),
                                    upper=np.concatenate([ub, np.full(n * n, np.inf)]), max_iter=max_iter, tol=tol,
-                                   hessian="exact")
+                                   hessian="exact", time_limit=time_limit,
+                                   callback=None if report is None else on_iteration)
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start x₀; never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
+        t0 = time.perf_counter()
         theta0, T0, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
         run = self._solver.solve(self.misfit_F.join(theta0, T0), scale=unknown_scale(theta0, T0, self._lower))
         theta, T = self.misfit_F.split(run.z)
+        message = f"IPOPT: {run.status}"
+        if run.status == "Maximum_WallTime_Exceeded":
+            message += "; " + budget_message(self.options["time_limit"], run.iterations)
         return self.transform_outcome(x0, theta, T, finished=run.finished, status=run.status,
-                                      message=f"IPOPT: {run.status}", iterations=run.iterations,
-                                      wall_time=run.seconds)
+                                      message=message, iterations=run.iterations,
+                                      wall_time=time.perf_counter() - t0)
 
 
 class IpoptSimilarityFRF(SimilarityEstimator):
@@ -106,21 +141,35 @@ class IpoptSimilarityFRF(SimilarityEstimator):
         IPOPT iteration limit (default 3000).
     tol : float
         IPOPT tolerance (default 1e-12).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds (IPOPT's ``max_wall_time``; status
+        ``"Maximum_WallTime_Exceeded"``). Default: none.
+    callback : callable, optional
+        Called after every IPOPT iteration with a
+        :class:`~symid.engine.ipopt.IpoptIteration` (iteration, relative misfit to the
+        black box's response, elapsed seconds, θ); a true return value stops the start
+        (status ``"User_Requested_Stop"``).
+    verbose : bool
+        Print one line per iteration (iteration, misfit, elapsed). Default False.
     """
 
     method = "ipopt"
 
     def __init__(self, model: Any, data: SimilarityData, *, scale: Any = None, positivity: bool = True,
-                 hessian: str = "exact", max_iter: int = 3000, tol: float = 1e-12):
+                 hessian: str = "exact", max_iter: int = 3000, tol: float = 1e-12, time_limit: float | None = None,
+                 callback: Any = None, verbose: bool = False):
         from symid.fit.frf.ipopt import IpoptFRF
 
         self.model, self.data, self.frf = model, data, data.frf
         self.inner = IpoptFRF(model, data.frf, scale=scale, positivity=positivity, hessian=hessian,
-                              max_iter=max_iter, tol=tol)
+                              max_iter=max_iter, tol=tol, time_limit=time_limit, callback=callback, verbose=verbose)
         self.options = {**self.inner.options, "black_box": data.source, "data": "black-box frequency response"}
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """IPOPT from x₀ on the black box's response; the outcome judged by the black-box misfit."""
         out = self.inner.run(x0)
-        return self.outcome(x0, out.theta, finished=out.finished, status=out.status, message=out.message,
+        message = out.message
+        if out.status == "Maximum_WallTime_Exceeded":
+            message += "; " + budget_message(self.inner.options["time_limit"], out.iterations)
+        return self.outcome(x0, out.theta, finished=out.finished, status=out.status, message=message,
                             iterations=out.iterations, wall_time=out.wall_time)

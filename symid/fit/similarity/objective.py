@@ -70,6 +70,11 @@ class SimilarityMisfit:
         """F(θ, T) (unscaled)."""
         return float(sum(np.sum(R**2) for R in self.residuals(theta, T)))
 
+    def relative_residual(self, theta: np.ndarray, T: np.ndarray) -> float:
+        """√(F(θ, T) / scale): the residual of the similarity equations relative to the black box's size
+        (what ALS, GB and IPOPT report per iteration)."""
+        return float(np.sqrt(self.value(theta, T) / self.scale))
+
     def value_and_grad(self, z: np.ndarray) -> tuple[float, np.ndarray]:
         """F/scale and its gradient in z, from (C-12) and (C-15)."""
         theta, T = self.split(z)

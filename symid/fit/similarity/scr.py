@@ -136,24 +136,37 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         Engine back end (default ``"admm"``).
     max_iter, tol, heuristic, truncate_after, admm
         Passed to :func:`symid.engine.scr.solve` (defaults 1000, 1e-8, ``"nuclear"``, 0, None).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds (status ``"time_limit"``; the iteration
+        under way is cut short: ADMM checks the clock, Clarabel gets the time left, see
+        :func:`symid.engine.scr.solve`). ``polish=True`` gives the IPOPT polish the same
+        budget again. Default: none.
+    callback : callable, optional
+        Called after every SCR iteration with a :class:`symid.engine.scr.ScrProgress`
+        (iteration, bilinear residual, black-box misfit, elapsed seconds, θ); a true
+        return value stops the start (status ``"stopped"``).
+    verbose : bool
+        Print one line per SCR iteration (iteration, residual, misfit, elapsed). Default False.
     """
 
     def __init__(self, model: Any, data: SimilarityData, *, weights: float = 1.0, aux_init: str = "random",
                  seed: int = 0, positivity: bool = True, implied: bool = True, backend: str = "admm",
                  max_iter: int = 1000, tol: float = 1e-8, heuristic: str = "nuclear", truncate_after: int = 0,
-                 admm: Any = None):
+                 admm: Any = None, time_limit: float | None = None, callback: Any = None, verbose: bool = False):
         self.init = check_choice("aux_init", aux_init, INITS)
         weights = check_float("weights", weights, low=0, strict_low=True)
         self.seed = check_seed("seed", seed)
         positivity, implied = check_bool("positivity", positivity), check_bool("implied", implied)
         solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, heuristic=heuristic,
-                                          truncate_after=truncate_after, admm=admm)
+                                          truncate_after=truncate_after, admm=admm, time_limit=time_limit)
+        self._progress_options(callback, verbose)
         self.model, self.data = model, data
         self.frf = data.frf
         self.options = {"weights": weights, "aux_init": aux_init, "seed": seed, "positivity": positivity,
                         "implied": implied, "backend": backend, "max_iter": max_iter, "tol": tol,
-                        "heuristic": heuristic, "truncate_after": truncate_after, "black_box": data.source,
-                        "basis": data.basis}
+                        "heuristic": heuristic, "truncate_after": truncate_after,
+                        "time_limit": solve_opts["time_limit"], "callback": None if callback is None else "given",
+                        "verbose": self._verbose, "black_box": data.source, "basis": data.basis}
         self._setup_engine(self._build(weights, positivity, implied), solve_opts)
         if implied and not consistent(self.compiled):
             self._setup_engine(self._build(weights, positivity, False), solve_opts)
@@ -163,7 +176,8 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         """IPOPT on (6-9), T₀ from the SCR estimate by (C-7) (:class:`~symid.fit.similarity.ipopt.IpoptSimilarity`)."""
         from symid.fit.similarity.ipopt import IpoptSimilarity
 
-        return IpoptSimilarity(self.model, self.data, aux_init="model", positivity=self.options["positivity"])
+        return IpoptSimilarity(self.model, self.data, aux_init="model", positivity=self.options["positivity"],
+                               time_limit=self.options["time_limit"])
 
     def _build(self, lam: float, positivity: bool, implied: bool) -> scr.BilinearProblem:
         maps = self.model.maps
@@ -201,9 +215,10 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         theta0, T0, S0 = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
         return {"theta": theta0, "T": T0 / self.alpha, "S": S0 * self.alpha}
 
-    def solve(self, x0: np.ndarray) -> scr.SCRSolution:
-        """The raw engine solution from the start x₀; its T and S are in the scaled basis (T/α, αS)."""
-        return self.engine_solve(self.start(np.asarray(x0, dtype=float)))
+    def solve(self, x0: np.ndarray, monitor: Any = None) -> scr.SCRSolution:
+        """The raw engine solution from the start x₀; its T and S are in the scaled basis (T/α, αS).
+        ``monitor`` as :func:`symid.engine.scr.solve`."""
+        return self.engine_solve(self.start(np.asarray(x0, dtype=float)), monitor=monitor)
 
     def transform(self, sol: scr.SCRSolution, original: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """(T, S) of an engine solution for ``data.blackbox`` (the balanced one when stable), or with
@@ -218,7 +233,7 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         """Solve from the start θ₀; never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
-        sol = self.solve(x0)
+        sol = self.solve(x0, self.engine_monitor(lambda x: x["theta"], t0))
         theta = np.asarray(sol.x["theta"], dtype=float).reshape(-1)
         T, S = self.transform(sol)
         n = T.shape[0]

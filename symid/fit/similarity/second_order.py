@@ -44,9 +44,9 @@ import numpy as np
 from symid import scr
 from symid.errors import ModelError
 from symid.fit.base import ScrEstimator, symmetric_map
-from symid.fit.options import check_bool, check_choice, check_float, check_seed
+from symid.fit.options import check_bool, check_choice, check_float, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
-from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
+from symid.fit.similarity.data import SimilarityData, SimilarityEstimator, budget_message
 from symid.fit.similarity.scr import consistent, implied_equalities, left_times, right_times
 from symid.fit.similarity.start import random_pair
 
@@ -138,12 +138,26 @@ class LinearSimilarity2nd(SimilarityEstimator):
     data : SimilarityData
     case : {"sensors", "actuators"}, optional
         Default: :func:`second_order_case`.
+    time_limit : float, optional
+        Wall-time budget of one run in seconds, checked after every reweighting round
+        (status ``"time_limit"``; the last round's estimate is kept). Default: none (the
+        rounds are few and cheap: 3–5 measured, at most 50).
+    callback : callable, optional
+        Called after every reweighting round with a :class:`symid.engine.scr.ScrProgress`
+        (round, residual of the weighted equations relative to the size of their terms,
+        black-box misfit, elapsed seconds, θ); a true return value stops (status
+        ``"stopped"``).
+    verbose : bool
+        Print one line per round (round, residual, misfit, elapsed). Default False.
     """
 
     method = "ls"
 
-    def __init__(self, model: Any, data: SimilarityData, *, case: str | None = None):
+    def __init__(self, model: Any, data: SimilarityData, *, case: str | None = None, time_limit: float | None = None,
+                 callback: Any = None, verbose: bool = False):
         check_second_order(model)
+        self.time_limit = check_time_limit("time_limit", time_limit)
+        self._progress_options(callback, verbose)
         case = second_order_case(model) if case is None else case
         if case is None:
             raise ModelError("the linear special cases of thesis §7-5-2 need a full set of sensors (C known, rank n) "
@@ -152,7 +166,8 @@ class LinearSimilarity2nd(SimilarityEstimator):
         if not _applies(model, case):
             raise ModelError(f"case={case!r} does not apply: {_why_not(model)}")
         self.model, self.data, self.frf, self.case = model, data, data.frf, case
-        self.options = {"case": case, "black_box": data.source}
+        self.options = {"case": case, "time_limit": self.time_limit, "callback": None if callback is None else "given",
+                        "verbose": self._verbose, "black_box": data.source}
         J, r0, self._block = self._sensors() if case == "sensors" else self._actuators()
         l = model.n_parameters
         # on unit-norm columns: a parameter in other units scales its column, which must not change the rank
@@ -205,9 +220,14 @@ class LinearSimilarity2nd(SimilarityEstimator):
         sizes = np.sqrt(np.bincount(self._block, weights=terms**2))
         return np.where(sizes > 0, sizes, 1.0)
 
-    def solve(self) -> tuple[np.ndarray, int]:
-        """θ and the rounds of reweighting: weighted least squares, every block by the size of its terms at
-        the previous estimate (the first unweighted), until the estimate stops changing (to 1e-13 relative)."""
+    def solve(self, t0: float | None = None) -> tuple[np.ndarray, int, str]:
+        """θ, the rounds of reweighting and the status: weighted least squares, every block by the size of its
+        terms at the previous estimate (the first unweighted), until the estimate stops changing (to 1e-13
+        relative; ``"solved"``), or ``"time_limit"`` (``time_limit`` seconds after ``t0``, default now) or
+        ``"stopped"`` (by the callback) after a round."""
+        t0 = time.perf_counter() if t0 is None else t0
+        deadline = None if self.time_limit is None else t0 + self.time_limit
+        report = self.progress_reporter(t0)
         theta = np.linalg.lstsq(self._J / self._columns, -self._r0, rcond=None)[0] / self._columns
         for k in range(1, _REWEIGHT_MAX + 1):
             w = 1.0 / self.block_sizes(theta)[self._block]
@@ -217,19 +237,35 @@ class LinearSimilarity2nd(SimilarityEstimator):
             new = np.linalg.lstsq(Jw / cols, -self._r0 * w, rcond=None)[0] / cols
             done = bool(np.all(np.abs(new - theta) <= 1e-13 * np.abs(new).max()))
             theta = new
+            asked = report is not None and report(k, self.relative_residual(theta, w), theta)
             if done:
-                return theta, k
-        return theta, _REWEIGHT_MAX
+                return theta, k, "solved"
+            if asked:
+                return theta, k, "stopped"
+            if deadline is not None and time.perf_counter() >= deadline and k < _REWEIGHT_MAX:
+                return theta, k, "time_limit"
+        return theta, _REWEIGHT_MAX, "solved"
+
+    def relative_residual(self, theta: np.ndarray, w: np.ndarray) -> float:
+        """‖w (Jθ + r₀)‖ / ‖w (|r₀| + |J| |θ|)‖: the residual of the equations weighted by ``w`` (one weight per
+        row), relative to the size of their terms at θ."""
+        top = np.linalg.norm(w * (self._J @ theta + self._r0))
+        size = np.linalg.norm(w * (np.abs(self._r0) + np.abs(self._J) @ np.abs(theta)))
+        return float(top / size) if size > 0 else 0.0
 
     def run(self, x0: np.ndarray | None = None) -> StartOutcome:
         """Solve the least squares (the start is irrelevant; kept for a uniform signature)."""
         t0 = time.perf_counter()
-        theta, rounds = self.solve()
+        theta, rounds, status = self.solve(t0)
         start = np.zeros(self.model.n_parameters) if x0 is None else np.asarray(x0, dtype=float)
-        return self.outcome(start, theta, finished=True, status="solved", iterations=1,
-                            wall_time=time.perf_counter() - t0,
-                            message=f"linear least squares (full set of {self.case}, thesis §7-5-2), every block "
-                                    f"of equations weighed by its size ({rounds} rounds)")
+        message = (f"linear least squares (full set of {self.case}, thesis §7-5-2), every block of equations "
+                   f"weighed by its size ({rounds} round{'s' * (rounds != 1)})")
+        if status == "time_limit":
+            message += "; " + budget_message(self.time_limit, rounds, "round") + " (not reweighted to its fixed point)"
+        elif status == "stopped":
+            message += f"; stopped by the callback after {rounds} rounds (not reweighted to its fixed point)"
+        return self.outcome(start, theta, finished=status == "solved", status=status, iterations=rounds,
+                            wall_time=time.perf_counter() - t0, message=message)
 
 
 def _minv_structure(mmap: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -285,13 +321,24 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
         The α of the scaled unknowns T/α, αS; default ‖ℂ‖/‖C₀‖ (the known output map).
     backend, max_iter, tol, admm
         Passed to :func:`symid.engine.scr.solve` (defaults ``"admm"``, 2000, 1e-8).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds (status ``"time_limit"``; the iteration
+        under way is cut short, see :func:`symid.engine.scr.solve`). ``polish=True`` gives
+        the IPOPT polish the same budget again. Default: none.
+    callback : callable, optional
+        Called after every SCR iteration with a :class:`symid.engine.scr.ScrProgress`
+        (iteration, bilinear residual, black-box misfit, elapsed seconds, θ fitted to the
+        iterate's M, V, K, H); a true return value stops the start (status ``"stopped"``).
+    verbose : bool
+        Print one line per SCR iteration (iteration, residual, misfit, elapsed). Default False.
     """
 
     method = "scr"
 
     def __init__(self, model: Any, data: SimilarityData, *, weights: float = 1.0, aux_init: str = "random",
                  seed: int = 0, lmis: bool = True, implied: bool = True, transform_scale: float | None = None,
-                 backend: str = "admm", max_iter: int = 2000, tol: float = 1e-8, admm: Any = None):
+                 backend: str = "admm", max_iter: int = 2000, tol: float = 1e-8, admm: Any = None,
+                 time_limit: float | None = None, callback: Any = None, verbose: bool = False):
         check_second_order(model)
         self.init = check_choice("aux_init", aux_init, ("random", "zero", "identity"))
         weights = check_float("weights", weights, low=0, strict_low=True)
@@ -299,13 +346,17 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
         lmis, implied = check_bool("lmis", lmis), check_bool("implied", implied)
         if transform_scale is not None:
             transform_scale = check_float("transform_scale", transform_scale, low=0, strict_low=True)
-        solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, admm=admm)
+        solve_opts = self._engine_options(backend=backend, max_iter=max_iter, tol=tol, admm=admm,
+                                          time_limit=time_limit)
+        self._progress_options(callback, verbose)
         if not model.maps["B"].is_constant:
             raise ModelError("the second-order similarity formulation (7-10) needs the input matrix B known (thesis "
                              "§7-2: F known); B holds parameters. Use method='ipopt'")
         self.model, self.data, self.frf = model, data, data.frf
         self.options = {"weights": weights, "aux_init": aux_init, "seed": seed, "lmis": lmis, "implied": implied,
-                        "backend": backend, "max_iter": max_iter, "tol": tol, "black_box": data.source}
+                        "backend": backend, "max_iter": max_iter, "tol": tol, "time_limit": solve_opts["time_limit"],
+                        "callback": None if callback is None else "given", "verbose": self._verbose,
+                        "black_box": data.source}
         self.scale = transform_scale
         self._setup_engine(self._build(weights, lmis, implied), solve_opts)
         if implied and not consistent(self.compiled):
@@ -316,7 +367,7 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
         """IPOPT on the black box's frequency response (:class:`~symid.fit.similarity.ipopt.IpoptSimilarityFRF`)."""
         from symid.fit.similarity.ipopt import IpoptSimilarityFRF
 
-        return IpoptSimilarityFRF(self.model, self.data)
+        return IpoptSimilarityFRF(self.model, self.data, time_limit=self.options["time_limit"])
 
     def _build(self, lam: float, lmis: bool, implied: bool) -> scr.BilinearProblem:
         model, bb = self.model, self.data.blackbox
@@ -427,15 +478,18 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
             out["tau"] = np.linalg.lstsq(B, (Minv - self.minv0).ravel(), rcond=None)[0]
         return out
 
-    def solve(self, x0: np.ndarray) -> scr.SCRSolution:
-        """The raw engine solution (θ, τ and the scaled T, S in ``sol.x``) from the start x₀."""
-        return self.engine_solve(self.start(x0))
+    def solve(self, x0: np.ndarray, monitor: Any = None) -> scr.SCRSolution:
+        """The raw engine solution (θ, τ and the scaled T, S in ``sol.x``) from the start x₀; ``monitor`` as
+        :func:`symid.engine.scr.solve`."""
+        return self.engine_solve(self.start(x0), monitor=monitor)
 
-    def estimate(self, sol: scr.SCRSolution) -> dict[str, np.ndarray]:
-        """M = (M⁻¹(τ))⁻¹, V, K, H and the θ fitted to them, from an engine solution."""
+    def estimate(self, sol: scr.SCRSolution | Any) -> dict[str, np.ndarray]:
+        """M = (M⁻¹(τ))⁻¹, V, K, H and the θ fitted to them, from an engine solution (or one iterate of it,
+        a dict by variable name)."""
+        x = sol.x if isinstance(sol, scr.SCRSolution) else sol
         maps, l = self.model.maps, self.model.n_parameters
-        th = np.asarray(sol.x.get("theta", np.zeros(0)), dtype=float).reshape(-1)
-        Minv = self.minv(sol.x["tau"]) if "tau" in sol.x else self.minv0
+        th = np.asarray(x.get("theta", np.zeros(0)), dtype=float).reshape(-1)
+        Minv = self.minv(x["tau"]) if "tau" in x else self.minv0
         try:
             M = np.linalg.inv(Minv)
         except np.linalg.LinAlgError:
@@ -454,7 +508,7 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
         """Solve from the start x₀; never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
-        sol = self.solve(x0)
+        sol = self.solve(x0, self.engine_monitor(lambda x: self.estimate(x)["theta"], t0))
         est = self.estimate(sol)
         T = self.alpha * np.asarray(sol.x["T"])
         return self.transform_outcome(x0, est["theta"], T, finished=self.engine_finished(sol), status=sol.status,
