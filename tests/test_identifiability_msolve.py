@@ -245,8 +245,11 @@ if mode == "sleep":
 if mode == "garbage":
     text = "Killed\\n"
 elif mode == "one solution":  # a well-formed answer that is not this system's: 'globally identifiable'
+    char = open(args[args.index("-f") + 1]).read().splitlines()[1].strip()  # in the field asked for
     text = ("[0, [0, 3, 1, ['x0', 'x1', 'x2'], [0, 0, 1], [1, [[1, [-1, 1]], [0, [1]], [[[0, [-1]], 1], "
-            "[[0, [-1]], 1]]]]], [1, [[[1, 1], [1, 1], [1, 1]]]]]:")
+            "[[0, [-1]], 1]]]]], [1, [[[1, 1], [1, 1], [1, 1]]]]]:") if char == "0" else \
+        (f"[0, [{{char}}, 3, 1, ['x0', 'x1', 'x2'], [0, 0, 1], [1, [[1, [{{int(char) - 1}}, 1]], [0, [1]], "
+         f"[[[0, [{{int(char) - 1}}]]], [[0, [{{int(char) - 1}}]]]]]]]]:")
 else:
     subprocess.run([os.environ["REAL_MSOLVE"], *args], check=True, capture_output=True)
     text = open(out).read()

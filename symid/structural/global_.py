@@ -40,8 +40,12 @@ is given (``msolve=``; :mod:`~symid.structural.msolve`, found by
 many solutions expected), by msolve: F4 and a rational parametrization
 (w, w', v_j, c_j) of the solutions, over ℚ at θ* and over GF(p) at θ**. From it:
 
-* the count: w's degree, which must equal msolve's count with multiplicity and w must be
-  square-free (else a multiple solution: :class:`NonGenericPoint`, as in step 3);
+* first, modulo a random prime p (:func:`_unique_mod_p`, a few times faster than over ℚ):
+  when the ideal there has degree 1, θ* is the only solution — every parameter is
+  single-valued and the real and admissible counts are 1 — and nothing is computed over ℚ;
+* otherwise over ℚ: the count is w's degree, which must equal msolve's count with
+  multiplicity, and w must be square-free (else a multiple solution:
+  :class:`NonGenericPoint`, as in step 3);
 * per parameter: θ_j is single-valued on every complex solution iff
   v_j + c_j·θ_j*·w' is the zero polynomial (x_j = −v_j/(c_j w') on the roots of w, and
   that polynomial has degree < deg w); over GF(p), iff v_j is the constant −θ_j**;
@@ -57,7 +61,10 @@ the same whichever engine ran (the float values of ``solutions`` agree to roundi
 two engines compute them differently). What differs is how the counts are established:
 sympy's over ℚ is exact; msolve's over ℚ is a multi-modular computation with a
 probabilistic stopping criterion (a Monte Carlo answer; see the module
-:mod:`~symid.structural.msolve`), as the confirmation modulo a random prime already is.
+:mod:`~symid.structural.msolve`), as the confirmation modulo a random prime already is,
+and a count of 1 found modulo a random prime at θ* is Monte Carlo in the same way (wrong
+only for the finitely many primes at which the computation degenerates), then confirmed
+at θ** modulo another prime.
 The solutions are listed in a canonical order (by their values, θ* given exactly).
 """
 
@@ -652,6 +659,17 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     R, eqs, aux = _system(summ, params, pt)
     exact_star = [Fraction(int(v.p), int(v.q)) for v in star]
     crossed = [_cross_terms(e, params, exact_star) for e in extra_candidates]
+    if msolve is not None and all(c is not None for c in crossed) and \
+            _unique_mod_p(msolve, R, eqs, star, names, rng):
+        # one solution, θ*: every parameter and every candidate is single-valued
+        times["groebner"] = time.perf_counter() - t1
+        sol = {n: float(v) for n, v in theta_star.items()}
+        every = dict.fromkeys(names, True)
+        k_forms = range(len(linear_forms))
+        return GlobalResult(summ.kind, summ.labels, tuple(summ.expressions()) if expressions else (), theta_star,
+                            True, 1, 1, 1, (sol,), (sol,), every, dict(every), dict(every), (),
+                            (True,) * len(crossed), 0, times, tuple(notes), engine="msolve",
+                            linear_global=tuple(tuple(Fraction(int(i == k)) for i in k_forms) for k in k_forms))
     if msolve is not None and all(c is not None for c in crossed):
         found = _global_msolve(msolve, R, eqs, _aux_values(summ, pt), star, names, positive, rng.randrange(2**31),
                                candidates=crossed, forms=linear_forms)
@@ -915,6 +933,37 @@ def _cross_terms(expr, params, point) -> list[tuple[dict[str, int], Fraction]] |
     names = [q.name for q in params]
     return [({n: e for n, e in zip(names, mono, strict=True) if e}, Fraction(int(c.p), int(c.q)))
             for mono, c in g.terms() if c != 0]
+
+
+def _unique_mod_p(binary: str, R: PolyRing, eqs, star, names: Sequence[str], rng: random.Random) -> bool:
+    """Whether summary(θ) = summary(θ*) has θ* as its only solution, by msolve modulo a random prime.
+
+    The system over ℚ is reduced modulo a random prime p in [2³⁰, :data:`MAX_PRIME`) and
+    msolve's parametrization over GF(p) read: True when the ideal there has degree 1 (one
+    solution, simple) and that solution is θ* mod p. Over ℚ the count is then 1 too, unless
+    p is one of the finitely many primes at which the computation degenerates (a random
+    30-bit prime: the same Monte Carlo argument as msolve's multi-modular answer over ℚ, and
+    the claim is confirmed at an independent point θ** modulo another prime). Anything else
+    (more solutions, a prime that divides a denominator, a non-radical ideal) gives False,
+    and the exact computation over ℚ decides.
+    """
+    modulus = _mod_p_modulus(rng)
+    seed = rng.randrange(2**31)
+    reduced = []
+    for poly in eqs:
+        terms = {}
+        for mono, c in poly.terms():
+            den = int(c.denominator) % modulus
+            if den == 0:
+                return False
+            terms[mono] = int(c.numerator) * pow(den, -1, modulus) % modulus
+        reduced.append(terms)
+    var = [f"x{i}" for i in range(R.ngens)]
+    out = parse_output(run_msolve(binary, input_text(reduced, R.ngens, modulus), options=("-P", "2"), seed=seed),
+                       var, modulus)
+    if out.status != "finite" or out.param.degree != 1 or out.param.n_distinct != 1:
+        return False
+    return all(out.param.single_valued(var[i], Fraction(int(v.p), int(v.q))) for i, v in enumerate(star))
 
 
 def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star, names: Sequence[str],
