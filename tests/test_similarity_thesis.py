@@ -20,12 +20,18 @@ from symid.fit.starts import make_starts
 pytestmark = pytest.mark.slow
 
 
-def test_enose_scr_from_ten_random_starts():
-    """Thesis §6-6-2: from random S, T, "roughly 3 out of every 10" starts reach the global minimum."""
+def test_enose_scr_from_random_starts():
+    """Thesis §6-6-2: from random S, T, "roughly 3 out of every 10" starts reach the global minimum.
+
+    A rate, so measured on 30 starts: ten cannot pin it (at 30 %, 2 or fewer of 10 happen with probability
+    0.38). Measured: 9 of 30, 12 of 40 (seed 0). The first ten of seed 0 reach it once: the starts are drawn per
+    parameter name since d39eab3, which changed every draw (T₀, S₀ are seeded by the start); on the ten starts
+    drawn before it, the same code reaches it from the same 3 as then (benchmarks/results/similarity_thesis.json,
+    with the same local minima, errors 0.89, 1.07, 1.16, 1.12 elsewhere)."""
     entry = si.load_model("enose")
-    cmp = si.compare(entry.model, entry.data(), methods=("scr",), starts=10, seed=0, truth=entry.truth,
+    cmp = si.compare(entry.model, entry.data(), methods=("scr",), starts=30, seed=0, truth=entry.truth,
                      param_tol=1e-3, options={"scr": {"max_iter": 2000}})
-    assert cmp["scr"].n_success >= 3  # thesis §6-6-2: about 3 of 10
+    assert cmp["scr"].n_success >= 6  # thesis §6-6-2: about 3 of 10 (measured 9 of 30)
     best = cmp["scr"].result
     assert relative_parameter_error(best.theta_vector, entry.model.theta_vector(entry.truth)) < 1e-3
 
