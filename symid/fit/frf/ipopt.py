@@ -8,10 +8,10 @@ import casadi as ca
 import numpy as np
 
 from symid.engine.ipopt import HESSIANS, ScaledIpopt, casadi_frf, iteration_reporter
-from symid.errors import OptionError
 from symid.fit.frf.misfit import FrfEstimator, NoiseWeighted
 from symid.fit.options import (
     check_bool,
+    check_callback,
     check_choice,
     check_float,
     check_int,
@@ -135,9 +135,7 @@ class IpoptFRF(NoiseWeighted, FrfEstimator):
         tol = check_float("tol", tol, low=0, strict_low=True)
         time_limit = check_time_limit("time_limit", time_limit)
         verbose = check_bool("verbose", verbose)
-        if callback is not None and not callable(callback):
-            raise OptionError(f"callback must be a function of one IpoptIteration (or None); got "
-                              f"{type(callback).__name__}")
+        check_callback("callback", callback, "IpoptIteration")
         self.lower, self.upper = parameter_bounds(model, bounds, positivity)
         label = self.set_variance(variance)  # weights, the given noise and the noise floor it declares
         named = {n: [float(lo), float(hi)] for n, lo, hi in zip(model.parameter_names, self.lower, self.upper,

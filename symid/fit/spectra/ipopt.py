@@ -8,9 +8,9 @@ import casadi as ca
 import numpy as np
 
 from symid.engine.ipopt import HESSIANS, ScaledIpopt, casadi_frf, casadi_matrices, iteration_reporter
-from symid.errors import OptionError
 from symid.fit.options import (
     check_bool,
+    check_callback,
     check_choice,
     check_float,
     check_int,
@@ -111,9 +111,7 @@ class IpoptPSD(SpectraEstimator):
         tol = check_float("tol", tol, low=0, strict_low=True)
         time_limit = check_time_limit("time_limit", time_limit)
         verbose = check_bool("verbose", verbose)
-        if callback is not None and not callable(callback):
-            raise OptionError(f"callback must be a function of one IpoptIteration (or None); got "
-                              f"{type(callback).__name__}")
+        check_callback("callback", callback, "IpoptIteration")
         check_spectral(model, data)
         self.model, self.data = model, data
         l = model.n_parameters

@@ -35,7 +35,15 @@ import numpy as np
 from symid.engine.ipopt import HESSIANS, IpoptIteration, ScaledIpopt, iteration_reporter, positivity_bounds, start_scale
 from symid.errors import DataError, OptionError
 from symid.fit.base import Estimator
-from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale, check_time_limit
+from symid.fit.options import (
+    check_bool,
+    check_callback,
+    check_choice,
+    check_float,
+    check_int,
+    check_scale,
+    check_time_limit,
+)
 from symid.fit.result import StartOutcome
 from symid.fit.timeseries.records import as_records
 from symid.fit.timeseries.response import balancing, casadi_output, simulate_output, squarings, state_transitions
@@ -178,9 +186,7 @@ class OutputError(Estimator, FisherInformation):
         self._tol = check_float("tol", tol, low=0, strict_low=True)
         self._time_limit = check_time_limit("time_limit", time_limit)
         verbose = check_bool("verbose", verbose)
-        if callback is not None and not callable(callback):
-            raise OptionError(f"callback must be a function of one IpoptIteration (or None); got "
-                              f"{type(callback).__name__}")
+        check_callback("callback", callback, "IpoptIteration")
         self._report = iteration_reporter(callback, verbose)
         self._iterations_before = 0  # of earlier rounds of the same start (run), for the callback's count
         self._deadline: float | None = None  # of the start under way (time_limit), checked every iteration
