@@ -323,34 +323,6 @@ def test_witnesses_on_random5():
         np.testing.assert_allclose(model.frequency_response(sol, w), H0, rtol=1e-9, atol=1e-12)
 
 
-def test_krawczyk_certifies_a_true_root_and_rejects_a_near_miss():
-    import mpmath
-    from sympy import QQ
-
-    from symid.structural.witness import _interval_terms, _krawczyk
-
-    # F(x, y) = (x² − 2, x·y − 1): the root (√2, 1/√2), exact rational coefficients
-    terms = _interval_terms([[((2, 0), QQ(1)), ((0, 0), QQ(-2))], [((1, 1), QQ(1)), ((0, 0), QQ(-1))]])
-    with mpmath.workdps(60):
-        root = [mpmath.sqrt(2), 1 / mpmath.sqrt(2)]
-        near = [root[0] + mpmath.mpf("1e-15"), root[1]]  # outside the 1e-20 box: no root there
-    star = [QQ(1), QQ(1)]
-    assert _krawczyk(terms, [], root, star, [True, True]) is not None
-    assert _krawczyk(terms, [], near, star, [True, True]) is None
-    # the box must exclude θ*: with θ* at the root itself the certificate is refused
-    lin = _interval_terms([[((1, 0), QQ(1)), ((0, 0), QQ(-2))], [((0, 1), QQ(1)), ((0, 0), QQ(-3))]])
-    at = [mpmath.mpf(2), mpmath.mpf(3)]
-    assert _krawczyk(lin, [], at, [QQ(1), QQ(1)], [True, True]) is not None
-    assert _krawczyk(lin, [], at, [QQ(2), QQ(3)], [True, True]) is None
-    with mpmath.workdps(60):
-        neg = [-mpmath.sqrt(2), -1 / mpmath.sqrt(2)]
-    assert _krawczyk(terms, [], neg, star, [False, False]) is not None
-    assert _krawczyk(terms, [], neg, star, [True, True]) is None  # not in the positive orthant
-    # a denominator vanishing at the root (x·y − 1 itself) refuses it
-    den = _interval_terms([[((1, 1), QQ(1)), ((0, 0), QQ(-1))]])
-    assert _krawczyk(terms, den, root, star, [True, True]) is None
-
-
 def _fail(*args, **kwargs):
     from symid.structural.global_ import ExactStepLimit
 
