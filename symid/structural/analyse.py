@@ -389,6 +389,9 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
         member = glob.membership if determined and len(glob.membership) == len(monos) else (None,) * len(monos)
         candidates = [(e, "scaling", member[i]) for i, e in enumerate(monos)]
         candidates += _linear_candidates(free, linear, forms, glob.linear_global if determined else None)
+        if determined and glob.partial:
+            notes.append("the global flags of the combinations are not decided: only some solutions of the slice "
+                         "were computed (exact ones, from symmetries of the summary), enough for every verdict")
         s_kwargs = {"model": model, "known": known_exact, "local": local, "limit": 4 * len(free)}
         status_s, found_s = run_with_deadline(_summary_candidates, s_kwargs, left()) \
             if summary_job is None else summary_job.wait(left())

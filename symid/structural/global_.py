@@ -40,9 +40,12 @@ is given (``msolve=``; :mod:`~symid.structural.msolve`, found by
 many solutions expected), by msolve: F4 and a rational parametrization
 (w, w', v_j, c_j) of the solutions, over ℚ at θ* and over GF(p) at θ**. From it:
 
-* first, modulo a random prime p (:func:`_unique_mod_p`, a few times faster than over ℚ):
-  when the ideal there has degree 1, θ* is the only solution — every parameter is
-  single-valued and the real and admissible counts are 1 — and nothing is computed over ℚ;
+* first, the count modulo a random prime p (:func:`_degree_mod_p`, a few times faster than
+  over ℚ): when it is 1, θ* is the only solution — every parameter is single-valued and the
+  real and admissible counts are 1; when it equals the number of points of the orbit of θ*
+  under exact symmetries of the summary (:mod:`~symid.structural.symmetry`), those exact
+  rational points are the solutions (all real; admissible, single-valued parameters and
+  candidates decided exactly on them). In both cases nothing is computed over ℚ;
 * otherwise over ℚ: the count is w's degree, which must equal msolve's count with
   multiplicity, and w must be square-free (else a multiple solution:
   :class:`NonGenericPoint`, as in step 3);
@@ -96,6 +99,7 @@ from symid.structural.summary import (
     model_kind,
     model_matrices,
 )
+from symid.structural.symmetry import orbit, symmetries
 
 __all__ = ["MAX_QUOTIENT", "POSITIVE_TOL", "REAL_TOL", "ExactStepLimit", "GlobalResult", "NonGenericPoint",
            "confirm_mod_p", "draw_point", "generic_global", "global_analysis", "star_and_summary"]
@@ -175,10 +179,14 @@ class GlobalResult:
         Parameters that are single-valued on the admissible solutions at θ* but not on the
         complex ones, for which another random point (given, as strings) has two admissible
         solutions that differ in them (:func:`generic_global`): proven not global.
-    linear_global : tuple of tuple of Fraction
+    linear_global : tuple of tuple of Fraction, or None
         A basis of the coefficient vectors λ for which Σ λ_k ℓ_k is single-valued on every
         complex solution, ℓ_k the ``linear_forms`` passed in (empty when none were, or the
-        solution set is positive-dimensional).
+        solution set is positive-dimensional; None when not decided).
+    partial : bool
+        Only some solutions are known (exact, from symmetries; ``settle`` of
+        :func:`global_analysis`): the parameters they move are not single-valued, nothing
+        else is claimed (the other ``global_*`` values are False, ``membership`` empty).
     """
 
     summary_kind: str
@@ -205,8 +213,9 @@ class GlobalResult:
     engine: str = "sympy"
     slice_values: dict = field(default_factory=dict)
     slice_result: GlobalResult | None = None
-    linear_global: tuple = ()
+    linear_global: tuple | None = ()
     local_elsewhere: dict = field(default_factory=dict)
+    partial: bool = False
 
 
 STAR_NUMERATORS = (1, 100_000)
@@ -578,7 +587,8 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
 def global_analysis(model, known: Mapping[str, object] | None = None, *, positive: Sequence[bool] | None = None,
                     seed: int = 0, extra_candidates: Sequence[sp.Expr] = (), expressions: bool = True,
                     prepared: tuple | None = None, msolve: str | None = None,
-                    linear_forms: Sequence[Mapping[str, Fraction]] = ()) -> GlobalResult:
+                    linear_forms: Sequence[Mapping[str, Fraction]] = (),
+                    settle: Sequence[str] | None = None) -> GlobalResult:
     """Solve summary(θ) = summary(θ*) exactly at a random rational θ* and classify the solutions.
 
     Parameters
@@ -608,6 +618,12 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     linear_forms : sequence of dict of str to Fraction
         Linear forms Σ a_j θ_j (parameter name → coefficient): which of their
         combinations are single-valued is returned in ``linear_global``.
+    settle : sequence of str, optional
+        Parameters whose verdicts are all that is asked (the counts are not reported, as
+        on a slice): when the orbit of θ* under exact symmetries is only part of the
+        solutions but already moves each of them, that partial result is returned
+        (``partial`` True: those parameters not single-valued, proven by exact admissible
+        solutions; nothing else claimed).
 
     Returns
     -------
@@ -659,8 +675,28 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     R, eqs, aux = _system(summ, params, pt)
     exact_star = [Fraction(int(v.p), int(v.q)) for v in star]
     crossed = [_cross_terms(e, params, exact_star) for e in extra_candidates]
-    if msolve is not None and all(c is not None for c in crossed) and \
-            _unique_mod_p(msolve, R, eqs, star, names, rng):
+    degree = _degree_mod_p(msolve, R, eqs, rng, [*exact_star, *_aux_values(summ, pt)]) \
+        if msolve is not None and all(c is not None for c in crossed) else None
+    if degree is not None and 1 < degree <= MAX_QUOTIENT:
+        points = orbit(exact_star, symmetries(model, known, summ), degree)
+        if points is not None and len(points) == degree:  # the orbit of θ* under exact symmetries: every solution
+            times["groebner"] = time.perf_counter() - t1
+            summary_exprs = tuple(summ.expressions()) if expressions else ()
+            return _orbit_result(summ, summary_exprs, theta_star, names, positive, points, crossed, linear_forms,
+                                 times, notes)
+        if points is not None and settle is not None and len(points) > 1 and degree > PARTIAL_ABOVE:
+            adm = [x for x in points if all(not pos or v > 0 for v, pos in zip(x, positive, strict=True))]
+            moved = {n for i, n in enumerate(names) if any(x[i] != adm[0][i] for x in adm)}
+            if set(settle) <= moved:  # exact admissible solutions already prove every verdict asked for
+                times["groebner"] = time.perf_counter() - t1
+                glob = dict.fromkeys(names, False)
+                sols = tuple(_canonical([{n: float(v) for n, v in zip(names, x, strict=True)} for x in adm],
+                                        theta_star, glob))
+                return GlobalResult(summ.kind, summ.labels, tuple(summ.expressions()) if expressions else (),
+                                    theta_star, True, degree, None, None, sols, sols, glob, dict(glob), dict(glob),
+                                    (), (), 0, times, tuple(notes), engine="msolve", linear_global=None,
+                                    partial=True)
+    if degree == 1:
         # one solution, θ*: every parameter and every candidate is single-valued
         times["groebner"] = time.perf_counter() - t1
         sol = {n: float(v) for n, v in theta_star.items()}
@@ -935,17 +971,19 @@ def _cross_terms(expr, params, point) -> list[tuple[dict[str, int], Fraction]] |
             for mono, c in g.terms() if c != 0]
 
 
-def _unique_mod_p(binary: str, R: PolyRing, eqs, star, names: Sequence[str], rng: random.Random) -> bool:
-    """Whether summary(θ) = summary(θ*) has θ* as its only solution, by msolve modulo a random prime.
+def _degree_mod_p(binary: str, R: PolyRing, eqs, rng: random.Random, point: Sequence[Fraction]) -> int | None:
+    """The number of solutions of summary(θ) = summary(θ*), by msolve modulo a random prime; None if not settled.
 
     The system over ℚ is reduced modulo a random prime p in [2³⁰, :data:`MAX_PRIME`) and
-    msolve's parametrization over GF(p) read: True when the ideal there has degree 1 (one
-    solution, simple) and that solution is θ* mod p. Over ℚ the count is then 1 too, unless
-    p is one of the finitely many primes at which the computation degenerates (a random
-    30-bit prime: the same Monte Carlo argument as msolve's multi-modular answer over ℚ, and
-    the claim is confirmed at an independent point θ** modulo another prime). Anything else
-    (more solutions, a prime that divides a denominator, a non-radical ideal) gives False,
-    and the exact computation over ℚ decides.
+    msolve's parametrization over GF(p) read: its degree when the ideal there is finite and
+    radical (deg w = the degree: every solution simple). Over ℚ the count is the same
+    unless p is one of the finitely many primes at which the computation degenerates (a
+    random 30-bit prime: the same Monte Carlo argument as msolve's multi-modular answer over
+    ℚ; a global claim is confirmed at an independent point θ** modulo another prime). None
+    (then the computation over ℚ decides): a prime that divides a denominator, a
+    positive-dimensional or non-radical ideal modulo p. ``point``: the known solution (θ*
+    and the auxiliary variables), checked to be one of the parametrization's modulo p (an
+    answer that is not this system's raises :class:`~symid.structural.msolve.MsolveError`).
     """
     modulus = _mod_p_modulus(rng)
     seed = rng.randrange(2**31)
@@ -955,15 +993,61 @@ def _unique_mod_p(binary: str, R: PolyRing, eqs, star, names: Sequence[str], rng
         for mono, c in poly.terms():
             den = int(c.denominator) % modulus
             if den == 0:
-                return False
+                return None
             terms[mono] = int(c.numerator) * pow(den, -1, modulus) % modulus
         reduced.append(terms)
     var = [f"x{i}" for i in range(R.ngens)]
     out = parse_output(run_msolve(binary, input_text(reduced, R.ngens, modulus), options=("-P", "2"), seed=seed),
                        var, modulus)
-    if out.status != "finite" or out.param.degree != 1 or out.param.n_distinct != 1:
-        return False
-    return all(out.param.single_valued(var[i], Fraction(int(v.p), int(v.q))) for i, v in enumerate(star))
+    if out.status != "finite" or out.param.n_distinct != out.param.degree:
+        return None
+    if out.param.degree > 1 and not _square_free_mod(out.param.elim, modulus):
+        return None
+    if any(Fraction(v).denominator % modulus == 0 for v in point):
+        return None
+    out.param.check_point(dict(zip(var, point, strict=True)))
+    return out.param.degree
+
+
+def _orbit_result(summ, summary_exprs, theta_star, names, positive, points, crossed, linear_forms, times,
+                  notes) -> GlobalResult:
+    """The global result when the solutions are the orbit of θ* under exact symmetries (exact rationals)."""
+    star = points[0]
+    admissible = [x for x in points if all(not pos or v > 0 for v, pos in zip(x, positive, strict=True))]
+
+    def single(pts) -> dict[str, bool]:
+        return {n: all(x[i] == star[i] for x in pts) for i, n in enumerate(names)}
+
+    def as_dict(x) -> dict[str, float]:
+        return {n: float(v) for n, v in zip(names, x, strict=True)}
+
+    glob_c = single(points)
+    index = {n: i for i, n in enumerate(names)}
+
+    def value(terms, x) -> Fraction:
+        acc = Fraction(0)
+        for expo, c in terms:
+            t = Fraction(c)
+            for n, e in expo.items():
+                t *= x[index[n]] ** e
+            acc += t
+        return acc
+
+    member = tuple(all(value(terms, x) == 0 for x in points) for terms in crossed)
+    lin: tuple = ()
+    if linear_forms:
+        rows = [[QQ(Fraction(d).numerator, Fraction(d).denominator) for d in
+                 (sum((Fraction(a) * (x[index[n]] - star[index[n]]) for n, a in form.items()), Fraction(0))
+                  for form in linear_forms)] for x in points[1:]]
+        if rows:
+            kernel = DomainMatrix(rows, (len(rows), len(linear_forms)), QQ).nullspace().to_list()
+        else:
+            kernel = [[QQ(int(i == k)) for i in range(len(linear_forms))] for k in range(len(linear_forms))]
+        lin = tuple(tuple(Fraction(int(v.numerator), int(v.denominator)) for v in row) for row in kernel)
+    return GlobalResult(summ.kind, summ.labels, summary_exprs, theta_star, True, len(points), len(points),
+                        len(admissible), tuple(_canonical([as_dict(x) for x in admissible], theta_star, glob_c)),
+                        tuple(_canonical([as_dict(x) for x in points], theta_star, glob_c)), glob_c, dict(glob_c),
+                        single(admissible), (), member, 0, times, tuple(notes), engine="msolve", linear_global=lin)
 
 
 def _global_msolve(binary: str, R: PolyRing, eqs, aux: Sequence[Fraction], star, names: Sequence[str],
@@ -1073,6 +1157,10 @@ def _confirm_msolve(binary: str, R: PolyRing, eqs, star, names: Sequence[str], m
     return True, par.degree, single
 
 
+PARTIAL_ABOVE = 24
+"""With ``settle``, a partial orbit is used only above this many solutions (the exact step over ℚ, which also
+decides the combinations' global flags, costs 0.1 s at 6-24 solutions and 3-12 s at 120 on the compartment
+families)."""
 EXTRA_POINTS = 6
 """Further random points tried for a parameter whose other complex values are not admissible at θ*."""
 
@@ -1126,7 +1214,7 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
                    confirm_known: Mapping[str, object] | None = None,
                    linear_forms: Sequence[Mapping[str, Fraction]] = (),
                    extra_known: Sequence[Mapping[str, object]] | None = None,
-                   local_only: Sequence[str] | None = None) -> GlobalResult:
+                   local_only: Sequence[str] | None = None, settle: Sequence[str] | None = None) -> GlobalResult:
     """:func:`global_analysis` at a θ* checked to be generic, and its global claims confirmed at a second point.
 
     1. θ* is drawn (:func:`draw_point`) until the Jacobian has the generic rank
@@ -1149,7 +1237,7 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     ones is looked at in :data:`EXTRA_POINTS` more random points (``extra_known``: the
     known values at each; default ``known``): two admissible solutions that differ in it
     there prove it not global (``local_elsewhere``; only the parameters named in
-    ``local_only``, when given).
+    ``local_only``, when given). ``settle``: as for :func:`global_analysis`.
 
     Examples
     --------
@@ -1168,7 +1256,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
             msolve = None  # infinitely many solutions: sympy (radical membership, basis candidates)
         try:
             res = global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
-                                  expressions=expressions, prepared=prepared, msolve=msolve, linear_forms=linear_forms)
+                                  expressions=expressions, prepared=prepared, msolve=msolve, linear_forms=linear_forms,
+                                  settle=settle)
             break
         except NonGenericPoint as exc:
             star = ", ".join(str(v) for v in prepared[1])

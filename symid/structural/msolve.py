@@ -460,7 +460,8 @@ class Parametrization:
 
         ϑ = the point's value of the parameter variable (or, for a new variable, from
         the linear form: ``Σ form_j x_j = 0``); then w(ϑ) = 0 and
-        x_j·c_j·w'(ϑ) + v_j(ϑ) = 0 for every variable. Raises :class:`MsolveError` otherwise.
+        x_j·c_j·w'(ϑ) + v_j(ϑ) = 0 for every variable (over GF(p): the point reduced
+        modulo p, w(ϑ) ≡ 0 and x_j + v_j(ϑ) ≡ 0). Raises :class:`MsolveError` otherwise.
         """
         if self.parameter in point:
             theta = Fraction(point[self.parameter])
@@ -471,6 +472,27 @@ class Parametrization:
                                                                            strict=True)), Fraction(0))
             theta /= Fraction(self.form[-1])
         p = self.characteristic
+        if p:  # over GF(p): the point reduced modulo p, x_j = −v_j(ϑ)
+            def red(v) -> int:
+                v = Fraction(v)
+                return v.numerator * pow(v.denominator, -1, p) % p
+
+            th = red(theta)
+
+            def ev_p(coeffs) -> int:
+                acc = 0
+                for a in reversed(coeffs):
+                    acc = (acc * th + a) % p
+                return acc
+
+            if ev_p(self.elim):
+                raise MsolveError("msolve's eliminating polynomial does not vanish at the known solution θ* (modulo "
+                                  "p): its output is inconsistent with the system")
+            for name, (v, _) in self.coords.items():
+                if (red(point[name]) + ev_p(v)) % p:
+                    raise MsolveError(f"msolve's parametrization of {name} does not give the known solution θ* "
+                                      "(modulo p): its output is inconsistent with the system")
+            return
 
         def ev(coeffs) -> Fraction:
             acc = Fraction(0)
@@ -478,8 +500,6 @@ class Parametrization:
                 acc = acc * theta + a
             return acc
 
-        if p:
-            raise ValueError("check_point is for parametrizations over ℚ")
         if ev(self.elim) != 0:
             raise MsolveError("msolve's eliminating polynomial does not vanish at the known solution θ*: its output "
                               "is inconsistent with the system")

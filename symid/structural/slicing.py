@@ -137,7 +137,7 @@ def sliced_global(model, known: Mapping[str, object] | None = None, *, fix: Sequ
                          extra_candidates=cands, expressions=False, msolve=msolve,
                          confirm_known={**known, **confirm_values},
                          extra_known=[{**known, **_slice_values(fix, seed, 2 + k)} for k in range(EXTRA_POINTS)],
-                         local_only=sorted(identifiable),
+                         local_only=sorted(identifiable), settle=sorted(identifiable & set(rest)),
                          linear_forms=[{n: a for n, a in form.items() if n not in values} for form in linear_forms])
 
     def whole(part: Mapping[str, bool]) -> dict[str, bool]:
@@ -146,10 +146,12 @@ def sliced_global(model, known: Mapping[str, object] | None = None, *, fix: Sequ
     theta_star = {n: (values[n] if n in values else res.theta_star[n]) for n in names}
     theta_confirm = {**{n: str(v) for n, v in confirm_values.items()}, **res.theta_confirm} \
         if res.theta_confirm else {}
+    counted = f"{res.n_complex} complex, {res.n_admissible} admissible at that point" if not res.partial else \
+        f"{res.n_complex} complex; {len(res.solutions)} admissible ones found exactly, from symmetries"
     notes = (f"not locally identifiable: the solution set was cut by giving {', '.join(fix)} random values "
              f"({', '.join(f'{n} = {v}' for n, v in values.items())}), which leaves finitely many solutions "
-             f"({res.n_complex} complex, {res.n_admissible} admissible at that point); a locally identifiable "
-             "parameter is global iff it is single-valued on them (symid.structural.slicing)",)
+             f"({counted}); a locally identifiable parameter is global iff it is single-valued on them "
+             "(symid.structural.slicing)",)
     return replace(res, theta_star=theta_star, zero_dimensional=False, n_complex=None, n_real=None, n_admissible=None,
                    solutions=(), real_solutions=(),
                    global_complex=whole(res.global_complex), global_real=whole(res.global_real),
