@@ -41,6 +41,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from fractions import Fraction
+from itertools import chain
 
 import numpy as np
 
@@ -74,9 +75,8 @@ def _up(x, k: int):
     return x * (1.0 + 2.0 * (k + 2) * U) + _TINY
 
 
-def _split_rational(c) -> tuple[float, float]:
-    """(hi, lo) doubles with |c − hi − lo| ≤ u |c − hi| for a rational c (``.numerator``, ``.denominator``)."""
-    n, d = int(c.numerator), int(c.denominator)
+def _split_rational(n: int, d: int) -> tuple[float, float]:
+    """(hi, lo) doubles with |c − hi − lo| ≤ u |c − hi| for the rational c = n / d (d > 0)."""
     hi = n / d  # correctly rounded
     p, q = hi.as_integer_ratio()
     return hi, (n * q - p * d) / (d * q)
@@ -97,26 +97,28 @@ class PolySystem:
     def __init__(self, polys: Sequence[Sequence[tuple[tuple[int, ...], object]]], nv: int):
         self.nv = nv
         self.n_polys = len(polys)
-        mons, his, los, sizes = [], [], [], []
+        sizes = [len(terms) for terms in polys]
+        T = sum(sizes)
+        self.E = np.fromiter(chain.from_iterable(m for terms in polys for m, _ in terms), dtype=np.int64,
+                             count=T * nv).reshape(T, nv)
+        his, los = [], []
         for terms in polys:
-            sizes.append(len(terms))
-            for mon, c in terms:
-                mons.append(mon)
-                if int(c.denominator) == 1 and abs(int(c.numerator)) < 2**53:
-                    his.append(float(int(c.numerator)))
+            for _, c in terms:
+                n, d = int(c.numerator), int(c.denominator)
+                if d == 1 and -(2**53) < n < 2**53:
+                    his.append(float(n))
                     los.append(0.0)
                 else:
-                    hi, lo = _split_rational(c)
+                    hi, lo = _split_rational(n, d)
                     his.append(hi)
                     los.append(lo)
-        self.E = np.array(mons, dtype=np.int64).reshape(len(mons), nv)
         self.Ef = self.E.astype(float)
         self.c_hi = np.array(his, dtype=float)
         self.c_lo = np.array(los, dtype=float)
         self.sizes = np.array(sizes, dtype=np.int64)
         self.starts = np.concatenate([[0], np.cumsum(self.sizes)])
         self.deg = self.E.sum(axis=1)
-        self.maxdeg = self.E.max(axis=0) if len(mons) else np.zeros(nv, dtype=np.int64)
+        self.maxdeg = self.E.max(axis=0) if T else np.zeros(nv, dtype=np.int64)
         self.poly_deg = np.array([self.deg[a:b].max() if b > a else 0
                                   for a, b in zip(self.starts[:-1], self.starts[1:], strict=True)])
         m = self.deg + 1.0  # factors per term, the coefficient included

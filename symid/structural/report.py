@@ -117,7 +117,7 @@ class IdentifiabilityReport:
         The admissible solutions (floats), when finitely many.
     witnesses : tuple of dict
         When the Gröbner step did not finish: admissible solutions θ ≠ θ* found
-        numerically and verified at 60 digits. Any witness shows the model is not
+        numerically (:mod:`symid.structural.witness`). Any witness shows the model is not
         globally identifiable (at least ``1 + len(witnesses)`` solutions).
     witnesses_certified : tuple of bool
         Per witness, whether the Krawczyk interval test proved an exact admissible
@@ -125,8 +125,8 @@ class IdentifiabilityReport:
     n_solutions_at_least : int or None
         When the Gröbner step did not finish and witnesses were certified: 1 + the
         number of certified witnesses, a proven lower bound of the number of admissible
-        solutions at θ*. The witness search runs a fixed number of starts, so this
-        number does not depend on the machine's speed.
+        solutions at θ*. The witness search runs a fixed number of steps and starts, so
+        this number does not depend on the machine's speed.
     verdicts_proven : bool
         Whether no verdict is ``"local, global undetermined"``.
     timing : dict of str to float
