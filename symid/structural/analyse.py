@@ -72,6 +72,9 @@ def _verdicts_from_groebner(glob, names, loc, full_rank: bool, *, admissible: bo
         verdict = UNDETERMINED
     return verdict, verdicts
 
+MAX_COMBINATION_TERMS = 300
+"""Summary entries with more terms (numerator and denominator) are not offered as combinations."""
+
 DEFAULT_TIMEOUT = 30.0
 """Default wall-time budget (s) of :func:`identifiability`."""
 
@@ -397,7 +400,11 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
             if summary_job is None else summary_job.wait(left())
         stopped = limit_reason("combinations step", status_s, found_s)
         if status_s == "ok":
+            found_s, skipped = found_s
             candidates += found_s
+            if skipped:
+                notes.append(f"{skipped} summary entr{'y' if skipped == 1 else 'ies'} with more than "
+                             f"{MAX_COMBINATION_TERMS} terms not offered as combinations (too long to read)")
         elif stopped is not None:
             notes.append(f"no combinations from the summary entries: {stopped}")
         elif status_s == "timeout":
@@ -405,8 +412,7 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
         else:
             raise_on_error("combinations", status_s, found_s)
         chosen = select_combinations(local, candidates)
-        combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global}
-                  for c in chosen]
+        combos = [{"expression": sp.sstr(c.expression), "source": c.source, "global": c.is_global} for c in chosen]
         reparam = {f"phi{i + 1}": c["expression"] for i, c in enumerate(combos)}
         if len(local.identifiable) - sum(local.identifiable) > 0 and \
                 sum(local.identifiable) + len(combos) < local.rank:
@@ -467,8 +473,19 @@ def _linear_candidates(free, linear, forms, lam) -> list[tuple]:
     return out
 
 
+def _factored(poly) -> sp.Expr:
+    """A polynomial as an expression with the monomial common to all its terms pulled out (cheap, on the terms)."""
+    terms = list(poly.terms())
+    common = [min(m[i] for m, _ in terms) for i in range(poly.ring.ngens)] if terms else []
+    if not any(common):
+        return poly.as_expr()
+    rest = poly.ring({tuple(e - g for e, g in zip(m, common, strict=True)): c for m, c in terms})
+    return sp.Mul(*[q**e for q, e in zip(poly.ring.symbols, common, strict=True) if e]) * rest.as_expr()
+
+
 def _summary_candidates(model, known, local, limit: int) -> list[tuple]:
-    """The ``limit`` simplest summary entries (fewest terms) as combination candidates, with their gradients.
+    """The ``limit`` simplest summary entries (fewest terms) as combination candidates, with their gradients,
+    and how many were skipped for having more than :data:`MAX_COMBINATION_TERMS` terms.
 
     Run in a child process beside the global step of a model that is not locally
     identifiable: the summary entries are identifiable functions (global by definition),
@@ -476,12 +493,14 @@ def _summary_candidates(model, known, local, limit: int) -> list[tuple]:
     """
     summ = exhaustive_summary(model, known)
     order = sorted(range(len(summ)), key=lambda i: (len(summ.numerators[i]) + len(summ.denominators[i]), i))
-    out = []
+    out, skipped = [], 0
     for i in order[:limit]:
         num, den = summ.numerators[i], summ.denominators[i]
-        expr = sp.factor_terms(num.as_expr() / den.as_expr())  # the same function, common factors pulled out
-        out.append((expr, "summary", True, poly_gradients(num, den, local.points)))
-    return out
+        if len(num) + len(den) > MAX_COMBINATION_TERMS:
+            skipped += 1
+            continue
+        out.append((_factored(num) / _factored(den), "summary", True, poly_gradients(num, den, local.points)))
+    return out, skipped
 
 
 def _check_fix(model, known_exact, fix: tuple[str, ...], seed: int, budget: float | None) -> str:

@@ -259,13 +259,39 @@ def poly_gradients(num, den, points: Sequence[Sequence]) -> list[list]:
     [['1/2', '1/2']]
     """
     out = []
-    gens = num.ring.gens
-    dnum = [num.diff(g) for g in gens]
-    dden = [den.diff(g) for g in gens]
     for pt in points:
-        n, d = num(*pt), den(*pt)
-        out.append([(dn(*pt) * d - n * dd(*pt)) / (d * d) for dn, dd in zip(dnum, dden, strict=True)])
+        if any(v == 0 for v in pt):  # the one-pass rule below divides by the coordinates
+            gens = num.ring.gens
+            n, d = num(*pt), den(*pt)
+            out.append([(num.diff(g)(*pt) * d - n * den.diff(g)(*pt)) / (d * d) for g in gens])
+            continue
+        inv = [1 / v for v in pt]
+        n, dn = _value_and_gradient(num, pt, inv)
+        d, dd = _value_and_gradient(den, pt, inv)
+        out.append([(a * d - n * b) / (d * d) for a, b in zip(dn, dd, strict=True)])
     return out
+
+
+def _value_and_gradient(poly, pt, inv) -> tuple:
+    """p(pt) and ∇p(pt) in one pass over the terms (pt without zero coordinates): a term t = c·Π θ^e adds t·e_i/θ_i
+    to ∂_i p."""
+    n = len(pt)
+    powers: dict = {}
+    value = QQ(0)
+    grad = [QQ(0)] * n
+    for mono, c in poly.terms():
+        t = c
+        for i, e in enumerate(mono):
+            if e:
+                key = (i, e)
+                if key not in powers:
+                    powers[key] = pt[i] ** e
+                t = t * powers[key]
+        value += t
+        for i, e in enumerate(mono):
+            if e:
+                grad[i] += t * e * inv[i]
+    return value, grad
 
 
 def parameters_to_fix(local: LocalResult) -> tuple[sp.Symbol, ...]:

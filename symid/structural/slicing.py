@@ -41,9 +41,10 @@ from dataclasses import replace
 
 import sympy as sp
 
+from symid.structural.formulas import monomial_formulas
 from symid.structural.global_ import EXTRA_POINTS, GlobalResult, draw_point, generic_global
 from symid.structural.local import local_analysis
-from symid.structural.summary import exhaustive_summary, free_parameters
+from symid.structural.summary import KIND_TF, exhaustive_summary, free_parameters
 
 __all__ = ["sliced_global"]
 
@@ -122,6 +123,23 @@ def sliced_global(model, known: Mapping[str, object] | None = None, *, fix: Sequ
     rest = [n for n in names if n not in fix]
     rest_positive = [pos for n, pos in zip(names, positive, strict=True) if n not in fix]
     values = _slice_values(fix, seed, 0)
+    wanted = sorted(identifiable & set(rest))
+    only_units = all(len(form) == 1 for form in linear_forms)  # no linear combination to decide
+    if wanted and not extra_candidates and only_units:
+        # every locally identifiable parameter a checked monomial of the summary entries: global, and nothing else
+        # is asked of the slice (no combination's flag to decide), so it is not computed
+        summ = exhaustive_summary(model, known)
+        found = monomial_formulas(summ, wanted, seed=seed)
+        if set(found) == set(wanted):
+            glob = {n: n in found for n in names}
+            text = "; ".join(f.text(summ.labels) for f in found.values())
+            markov = () if summ.kind == KIND_TF else (
+                "the realisation is not minimal at random points; Markov parameters used as the summary",)
+            return GlobalResult(summ.kind, summ.labels, (), {}, False, None, None, None, (), (), glob, dict(glob),
+                                dict(glob), (), (), 0, notes=(*markov,
+                                    f"every locally identifiable parameter is a monomial in the summary entries c[…], "
+                                    f"checked exactly as a polynomial identity, so globally identifiable: {text} "
+                                    "(symid.structural.formulas)"), linear_global=None, engine="formula")
     if not rest:  # rank 0: the summary does not depend on θ, nothing is even locally identifiable
         summ = exhaustive_summary(model, known)
         falses = dict.fromkeys(names, False)
