@@ -130,3 +130,19 @@ def test_chain_verdicts_are_local_where_witnesses_move_the_parameter():
 def test_a_globally_identifiable_model_yields_no_witness(name):
     res = find_witnesses(si.load_model(name).model)
     assert res.witnesses == () and res.certified == ()
+
+
+def test_rational_formulas_prove_the_chain_parameters_witnesses_cannot_move():
+    from symid.structural.rational_formulas import rational_formulas
+    from symid.structural.summary import exhaustive_summary
+
+    model = identifiability_models.build("chain-4-1n")
+    summ = exhaustive_summary(model)
+    found = rational_formulas(summ, ["c1", "k1", "m1", "k2"], at=[sp.Rational(3 + i, 2) for i in range(12)])
+    assert sorted(found) == ["c1", "k1"]  # m1 and k2 are not global (the certified witness moves them)
+    assert found["k1"].text(summ.labels) == "k1 = (c[d s^0]) / (c[N[0,0] s^0])"  # H(0) = 1/k1
+    assert found["c1"].text(summ.labels) == ("c1 = (c[d s^1]·c[N[0,0] s^0] - c[d s^0]·c[N[0,0] s^1]) / "
+                                             "(c[N[0,0] s^0]^2)")
+    th = si.parameters("th")
+    square = exhaustive_summary(si.StateSpaceModel(A=[[-1]], B=[[th]], C=[[th]]))  # only th² is determined
+    assert rational_formulas(square, ["th"]) == {}
