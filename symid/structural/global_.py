@@ -73,6 +73,7 @@ The solutions are listed in a canonical order (by their values, θ* given exactl
 
 from __future__ import annotations
 
+import functools
 import random
 import time
 from collections.abc import Mapping, Sequence
@@ -89,6 +90,7 @@ from sympy.polys.rings import PolyElement, PolyRing, ring
 
 from symid.errors import ModelError, SolverError
 from symid.structural.local import rank_at
+from symid.structural.modp import BadPrime, compile_poly, residue, value_mod_p
 from symid.structural.msolve import MsolveError, input_text, parse_output, run_msolve
 from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
@@ -479,6 +481,61 @@ def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, lis
     return R, eqs, aux
 
 
+@functools.lru_cache(maxsize=4)
+def _normalised(summ) -> tuple:
+    """The polynomials N_i·(L / D_i) of the normaliser form of :func:`_system` (they do not depend on the point)."""
+    L = summ.normaliser
+    return tuple(num * L.exquo(den) for num, den in
+                 [*zip(summ.numerators, summ.denominators, strict=True), (L, L)])
+
+
+def _system_mod_p(summ, params, star, modulus: int) -> tuple[int, list[dict], list[int]]:
+    """The system of :func:`_system` reduced modulo a prime, built on residues (numpy) rather than rationals.
+
+    Returns the number of variables, the equations (monomial → residue) and the known
+    solution (θ* and the auxiliary variables) modulo the prime. Raises
+    :class:`~symid.structural.modp.BadPrime` when the prime divides a denominator.
+    """
+    p = modulus
+    at = [residue(v, p) for v in star]
+    n = len(params)
+    L = summ.normaliser
+    eqs: list[dict] = []
+    if L is not None and not L.is_ground:  # N_i(θ) = λ N_i(θ*), L(θ) = λ L(θ*), t λ = 1
+        for raw in _normalised(summ):
+            comp = compile_poly(raw, p)
+            eq = {(*m, 0, 0): int(c) for m, c in zip(comp.monomials, comp.coeffs, strict=True) if c}
+            lam = (*([0] * n), 1, 0)
+            eq[lam] = (eq.get(lam, 0) - value_mod_p(comp, at, p)) % p
+            eqs.append({m: c for m, c in eq.items() if c})
+        eqs.append({(*([0] * n), 1, 1): 1, (*([0] * n), 0, 0): p - 1})
+        return n + 2, [e for e in eqs if e], [*at, 1, 1]
+    sat = _saturating(summ)
+    aux = 1 if sat is not None else 0
+    for num, den in zip(summ.numerators, summ.denominators, strict=True):
+        cn, cd = compile_poly(num, p), compile_poly(den, p)
+        nv, dv = value_mod_p(cn, at, p), value_mod_p(cd, at, p)
+        eq: dict = {}
+        for comp, factor in ((cn, dv), (cd, p - nv)):
+            for m, c in zip(comp.monomials, comp.coeffs, strict=True):
+                key = (*m, *([0] * aux))
+                eq[key] = (eq.get(key, 0) + int(c) * factor) % p
+        eq = {m: c for m, c in eq.items() if c}
+        if eq:
+            eqs.append(eq)
+    point = list(at)
+    if sat is not None:
+        cs = compile_poly(sat, p)
+        sv = value_mod_p(cs, at, p)
+        if sv == 0:
+            raise BadPrime("the saturating polynomial vanishes at θ* modulo the prime")
+        eq = {(*m, 1): int(c) for m, c in zip(cs.monomials, cs.coeffs, strict=True) if c}
+        eq[(0,) * (n + 1)] = p - 1
+        eqs.append(eq)
+        point.append(pow(sv, -1, p))
+    return n + aux, eqs or [{}], point
+
+
 def _saturating(summ) -> PolyElement | None:
     """The square-free lcm of the non-constant denominators (saturated by t·sat − 1 = 0), or None."""
     nonconst_den = [d for d in summ.denominators if not d.is_ground]
@@ -537,21 +594,26 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
     names = [p.name for p in params]
     theta2 = {n: str(v) for n, v in zip(names, star, strict=True)}
     pt = [QQ.from_sympy(v) for v in star]
+    exact = [Fraction(int(v.p), int(v.q)) for v in star]
     for _ in range(10):  # a prime that divides a denominator of the system cannot reduce it: take another
         modulus = _mod_p_modulus(rng)
         try:
-            R, eqs, _ = _system(summ, params, pt, modulus)
-            dom = R.domain
-            ptp = [dom(int(v.numerator)) / dom(int(v.denominator)) for v in pt]
+            reduced = _system_mod_p(summ, params, exact, modulus) if msolve is not None else None
             break
-        except (ZeroDivisionError, NotInvertible):
+        except BadPrime:
             continue
     else:  # pragma: no cover - ten random 31-bit primes dividing the denominators: practically impossible
         raise ExactStepLimit("no prime found that reduces the system at θ**")
-    if msolve is not None:
-        found = _confirm_msolve(msolve, R, eqs, star, names, modulus, rng.randrange(2**31))
+    if reduced is not None:
+        found = _confirm_msolve(msolve, *reduced[:2], star, names, modulus, rng.randrange(2**31))
         if found is not None:
             return (*found, theta2)
+    try:
+        R, eqs, _ = _system(summ, params, pt, modulus)
+    except (ZeroDivisionError, NotInvertible):  # pragma: no cover - a prime that reduces one form reduces the other
+        raise ExactStepLimit("no prime found that reduces the system at θ**") from None
+    dom = R.domain
+    ptp = [dom(int(v.numerator)) / dom(int(v.denominator)) for v in pt]
     G = groebner(eqs, R)
     nv = R.ngens
     if not _is_zero_dimensional(G, nv):
@@ -673,10 +735,9 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     # -- polynomial system --------------------------------------------------------
     t1 = time.perf_counter()
     pt = [QQ.from_sympy(v) for v in star]
-    R, eqs, aux = _system(summ, params, pt)
     exact_star = [Fraction(int(v.p), int(v.q)) for v in star]
     crossed = [_cross_terms(e, params, exact_star) for e in extra_candidates]
-    degree = _degree_mod_p(msolve, R, eqs, rng, [*exact_star, *_aux_values(summ, pt)]) \
+    degree = _degree_mod_p(msolve, summ, params, exact_star, rng) \
         if msolve is not None and all(c is not None for c in crossed) else None
     if degree is not None and 1 < degree <= MAX_QUOTIENT:
         points = orbit(exact_star, symmetries(model, known, summ), degree)
@@ -707,6 +768,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
                             True, 1, 1, 1, (sol,), (sol,), every, dict(every), dict(every), (),
                             (True,) * len(crossed), 0, times, tuple(notes), engine="msolve",
                             linear_global=tuple(tuple(Fraction(int(i == k)) for i in k_forms) for k in k_forms))
+    R, eqs, aux = _system(summ, params, pt)
     if msolve is not None and all(c is not None for c in crossed):
         found = _global_msolve(msolve, R, eqs, _aux_values(summ, pt), star, names, positive, rng.randrange(2**31),
                                candidates=crossed, forms=linear_forms)
@@ -972,39 +1034,32 @@ def _cross_terms(expr, params, point) -> list[tuple[dict[str, int], Fraction]] |
             for mono, c in g.terms() if c != 0]
 
 
-def _degree_mod_p(binary: str, R: PolyRing, eqs, rng: random.Random, point: Sequence[Fraction]) -> int | None:
+def _degree_mod_p(binary: str, summ, params, star: Sequence[Fraction], rng: random.Random) -> int | None:
     """The number of solutions of summary(θ) = summary(θ*), by msolve modulo a random prime; None if not settled.
 
-    The system over ℚ is reduced modulo a random prime p in [2³⁰, :data:`MAX_PRIME`) and
-    msolve's parametrization over GF(p) read: its degree when the ideal there is finite and
-    radical (deg w = the degree: every solution simple). Over ℚ the count is the same
-    unless p is one of the finitely many primes at which the computation degenerates (a
-    random 30-bit prime: the same Monte Carlo argument as msolve's multi-modular answer over
-    ℚ; a global claim is confirmed at an independent point θ** modulo another prime). None
-    (then the computation over ℚ decides): a prime that divides a denominator, a
-    positive-dimensional or non-radical ideal modulo p. ``point``: the known solution (θ*
-    and the auxiliary variables), checked to be one of the parametrization's modulo p (an
-    answer that is not this system's raises :class:`~symid.structural.msolve.MsolveError`).
+    The system is built modulo a random prime p in [2³⁰, :data:`MAX_PRIME`)
+    (:func:`_system_mod_p`) and msolve's parametrization over GF(p) read: its degree when
+    the ideal there is finite and radical (deg w = the degree: every solution simple), after
+    checking that θ* is one of its solutions (an answer that is not this system's raises
+    :class:`~symid.structural.msolve.MsolveError`). Over ℚ the count is the same unless p is
+    one of the finitely many primes at which the computation degenerates (a random 30-bit
+    prime: the same Monte Carlo argument as msolve's multi-modular answer over ℚ; a global
+    claim is confirmed at an independent point θ** modulo another prime). None (then the
+    computation over ℚ decides): a prime that divides a denominator, a positive-dimensional
+    or non-radical ideal modulo p.
     """
     modulus = _mod_p_modulus(rng)
     seed = rng.randrange(2**31)
-    reduced = []
-    for poly in eqs:
-        terms = {}
-        for mono, c in poly.terms():
-            den = int(c.denominator) % modulus
-            if den == 0:
-                return None
-            terms[mono] = int(c.numerator) * pow(den, -1, modulus) % modulus
-        reduced.append(terms)
-    var = [f"x{i}" for i in range(R.ngens)]
-    out = parse_output(run_msolve(binary, input_text(reduced, R.ngens, modulus), options=("-P", "2"), seed=seed),
+    try:
+        nvars, eqs, point = _system_mod_p(summ, params, star, modulus)
+    except BadPrime:
+        return None
+    var = [f"x{i}" for i in range(nvars)]
+    out = parse_output(run_msolve(binary, input_text(eqs, nvars, modulus), options=("-P", "2"), seed=seed),
                        var, modulus)
     if out.status != "finite" or out.param.n_distinct != out.param.degree:
         return None
     if out.param.degree > 1 and not _square_free_mod(out.param.elim, modulus):
-        return None
-    if any(Fraction(v).denominator % modulus == 0 for v in point):
         return None
     out.param.check_point(dict(zip(var, point, strict=True)))
     return out.param.degree
@@ -1140,11 +1195,12 @@ def _exact_zeros(par, var: Sequence[str], boxes, positive: Sequence[bool]) -> se
     return out
 
 
-def _confirm_msolve(binary: str, R: PolyRing, eqs, star, names: Sequence[str], modulus: int, seed: int):
-    """msolve's answer at θ** over GF(p): (True, count, single-valued per parameter), or None when the ideal is not
-    radical modulo p or not zero-dimensional there (then sympy decides)."""
-    var = [f"x{i}" for i in range(R.ngens)]
-    text = input_text([{m: int(c) % modulus for m, c in p.terms()} for p in eqs], R.ngens, modulus)
+def _confirm_msolve(binary: str, nvars: int, eqs: Sequence[dict], star, names: Sequence[str], modulus: int,
+                    seed: int):
+    """msolve's answer at θ** over GF(p) for the system of :func:`_system_mod_p`: (True, count, single-valued per
+    parameter), or None when the ideal is not radical modulo p or not zero-dimensional there (then sympy decides)."""
+    var = [f"x{i}" for i in range(nvars)]
+    text = input_text(eqs, nvars, modulus)
     out = parse_output(run_msolve(binary, text, options=("-P", "2"), seed=seed), var, modulus)
     if out.status != "finite":
         return None
