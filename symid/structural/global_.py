@@ -171,7 +171,7 @@ class GlobalResult:
         ``"sympy"`` or ``"msolve"`` (:mod:`~symid.structural.msolve`): which computed the
         solutions (the result is the same either way, up to the float rounding of
         ``solutions``); ``"formula"`` when no solution was computed because every verdict
-        came from checked formulas (:mod:`~symid.structural.formulas`).
+        came from checked formulas (:mod:`~symid.structural.rational_formulas`).
     slice_values : dict of str to sympy.Rational
         For a model that is not locally identifiable, solved on a slice
         (:mod:`~symid.structural.slicing`): the random values given to the parameters

@@ -1,8 +1,7 @@
 """Polynomials over ℚ evaluated modulo a prime, vectorised (numpy int64, primes below 2³¹).
 
 Used where only a residue is needed: the summary system modulo a random prime for msolve
-(:mod:`~symid.structural.global_`) and the exponent search of
-:mod:`~symid.structural.formulas`. A prime that divides a coefficient's denominator makes
+(:mod:`~symid.structural.global_`). A prime that divides a coefficient's denominator makes
 the reduction impossible: :class:`BadPrime` is raised and the caller takes another prime.
 """
 

@@ -41,9 +41,9 @@ from dataclasses import replace
 
 import sympy as sp
 
-from symid.structural.formulas import monomial_formulas
 from symid.structural.global_ import EXTRA_POINTS, GlobalResult, draw_point, generic_global
 from symid.structural.local import local_analysis
+from symid.structural.rational_formulas import rational_formulas
 from symid.structural.summary import KIND_TF, exhaustive_summary, free_parameters
 
 __all__ = ["sliced_global"]
@@ -126,10 +126,10 @@ def sliced_global(model, known: Mapping[str, object] | None = None, *, fix: Sequ
     wanted = sorted(identifiable & set(rest))
     only_units = all(len(form) == 1 for form in linear_forms)  # no linear combination to decide
     if wanted and not extra_candidates and only_units:
-        # every locally identifiable parameter a checked monomial of the summary entries: global, and nothing else
-        # is asked of the slice (no combination's flag to decide), so it is not computed
+        # every locally identifiable parameter a checked rational formula in the summary entries: global, and
+        # nothing else is asked of the slice (no combination's flag to decide), so it is not computed
         summ = exhaustive_summary(model, known)
-        found = monomial_formulas(summ, wanted, seed=seed)
+        found = rational_formulas(summ, wanted, seed=seed)
         if set(found) == set(wanted):
             glob = {n: n in found for n in names}
             text = "; ".join(f.text(summ.labels) for f in found.values())
@@ -137,9 +137,10 @@ def sliced_global(model, known: Mapping[str, object] | None = None, *, fix: Sequ
                 "the realisation is not minimal at random points; Markov parameters used as the summary",)
             return GlobalResult(summ.kind, summ.labels, (), {}, False, None, None, None, (), (), glob, dict(glob),
                                 dict(glob), (), (), 0, notes=(*markov,
-                                    f"every locally identifiable parameter is a monomial in the summary entries c[…], "
-                                    f"checked exactly as a polynomial identity, so globally identifiable: {text} "
-                                    "(symid.structural.formulas)"), linear_global=None, engine="formula")
+                                    f"every locally identifiable parameter is a rational function of the summary "
+                                    f"entries c[…], checked exactly as a polynomial identity, so globally "
+                                    f"identifiable: {text} (symid.structural.rational_formulas)"),
+                                linear_global=None, engine="formula")
     if not rest:  # rank 0: the summary does not depend on θ, nothing is even locally identifiable
         summ = exhaustive_summary(model, known)
         falses = dict.fromkeys(names, False)
