@@ -147,14 +147,23 @@ def test_square_free_test_is_exact():
 
 
 def test_partial_witnesses_prove_local_only_for_the_parameters_they_move(monkeypatch):
-    # the Gröbner step made to hang: the certified witness (a2 + a21, a1 − a21, a21) moves a1 and a2,
-    # which are then proven "local"; a21 (global in truth) is never moved, so it stays undetermined and
-    # the Gröbner step keeps its budget
-    # (for a model that is not locally identifiable the global step is the sliced one: stall both)
+    # the Gröbner step made to hang and no formula found: the certified witness (a2 + a21, a1 − a21, a21) moves
+    # a1 and a2, which are then proven "local"; a21 (global in truth) is never moved, so it stays undetermined
+    # and the Gröbner step keeps its budget
     monkeypatch.setattr("symid.structural.steps.generic_global", lambda *args, **kwargs: time.sleep(600))
-    monkeypatch.setattr("symid.structural.steps.sliced_global", lambda *args, **kwargs: time.sleep(600))
+    monkeypatch.setattr("symid.structural.steps.rational_formulas", lambda *args, **kwargs: {})
     rep = si.identifiability(_two_compartments(), timeout=2.0)
     assert not rep.global_determined and rep.verdict == "local"
     assert rep.verdicts == {"a2": "local", "a21": "local, global undetermined", "a1": "local"}
     assert rep.n_solutions_at_least == 2 and not rep.verdicts_proven
     assert "did not finish within the timeout of 2 s" in rep.global_status
+
+
+def test_witnesses_and_a_formula_settle_every_verdict(monkeypatch):
+    # the same with the formulas: a checked rational formula in the transfer-function coefficients proves a21
+    # global, so the certified witness (a1, a2 local) and the formula settle every verdict without the Gröbner step
+    monkeypatch.setattr("symid.structural.steps.generic_global", lambda *args, **kwargs: time.sleep(600))
+    rep = si.identifiability(_two_compartments(), timeout=5.0)
+    assert rep.verdicts == {"a2": "local", "a21": "global", "a1": "local"} and rep.verdict == "local"
+    assert rep.verdicts_proven and rep.n_solutions_at_least == 2 and not rep.global_determined
+    assert any("a21 = " in n and "rational formula" in n for n in rep.notes)

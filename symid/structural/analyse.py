@@ -28,6 +28,7 @@ from symid.structural.numeric import numeric_local_check
 from symid.structural.report import IdentifiabilityReport, NecessaryCondition
 from symid.structural.steps import limit_reason, raise_on_error, run_global
 from symid.structural.summary import exhaustive_summary, free_parameters, model_kind
+from symid.structural.witness import METHOD as witness_method
 
 _EXACT_LIMIT = 400
 
@@ -159,11 +160,13 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         even it does not finish, the local verdicts come from a floating-point rank,
         flagged as a screen). For a locally identifiable model the Gröbner step and a
         numerical search for other solutions of summary(θ) = summary(θ*) (a fixed
-        number of starts, 384) then run side by side; each solution found is certified
-        by the Krawczyk interval test when the summary system is square (as many
-        equations as unknowns).
-        Certified solutions that move every parameter prove the model locally but not
-        globally identifiable: the report stops there, with ``n_solutions_at_least`` in
+        number of curve steps and starts) then run side by side; each solution found is
+        certified by the Krawczyk interval test when the summary system is square (as
+        many equations as unknowns), and the parameters the certified solutions do not
+        move are tried for a checked rational formula in the summary entries
+        (:mod:`~symid.structural.rational_formulas`: globally identifiable).
+        Certified solutions that move every parameter (but those a formula proves
+        global) settle the verdicts: the report stops there, with ``n_solutions_at_least`` in
         place of the exact count. Otherwise the Gröbner step has the rest of the budget;
         if it does not finish, the global verdict is marked undetermined with the
         reason (the timeout; or a documented limit: more than 400 solutions, out of
@@ -321,11 +324,13 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
                                   "found numerically (not certified): evidence that the model is NOT globally "
                                   "identifiable")
     if witnesses and not determined:
-        notes.append(f"the {len(witnesses)} solution(s) θ ≠ θ* in `witnesses` were found by Gauss–Newton from random "
-                     "starts and refined by Newton's method at 60 digits (residual < 1e-40); "
-                     f"{n_cert} of them certified by the Krawczyk test in interval arithmetic (an exact real "
-                     "admissible solution within relative 1e-20, distinct from θ* and from each other, simple, so "
-                     "it persists for every θ near θ*)")
+        notes.append(f"the {len(witnesses)} solution(s) θ ≠ θ* in `witnesses` were {witness_method}; "
+                     f"{n_cert} of them certified by the Krawczyk test (an exact real admissible solution within "
+                     "relative 1e-6 or less, distinct from θ* and from each other, simple, so it persists for every "
+                     "θ near θ*)")
+    if out.formulas and not determined:
+        notes.append("globally identifiable by a rational formula in the summary entries c[…], checked exactly as a "
+                     f"polynomial identity: {'; '.join(out.formulas.values())} (symid.structural.rational_formulas)")
     t_global = out.seconds
 
     loc = dict(zip(names, local.identifiable, strict=True))
@@ -338,7 +343,8 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
         moved = {nm for w, ok in zip(witnesses, certified, strict=True) if ok for nm in names
                  if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
         for nm in names:
-            verdicts[nm] = "none" if not loc[nm] else (LOCAL if nm in moved else UNDETERMINED)
+            verdicts[nm] = "none" if not loc[nm] else (
+                "global" if nm in out.formulas else (LOCAL if nm in moved else UNDETERMINED))
         verdict = "none" if not full_rank else (LOCAL if n_cert else UNDETERMINED)
         count = (f"at least {1 + n_cert} admissible solutions at θ* (certified lower bound: θ* and {n_cert} "
                  f"solution(s) certified by the Krawczyk test; exact count not computed: {why})") if n_cert else \

@@ -33,6 +33,7 @@ import sympy as sp
 from symid.errors import ModelError, SolverError
 from symid.structural.deadline import Running, run_with_deadline, start, wait_any
 from symid.structural.global_ import GlobalResult, generic_global, star_and_summary
+from symid.structural.rational_formulas import rational_formulas
 from symid.structural.slicing import sliced_global
 from symid.structural.witness import WitnessResult, find_witnesses
 
@@ -62,9 +63,23 @@ def _global_step(model, known, positive, seed, extra_candidates, expressions, ra
 
 
 def _witness_step(model, known, positive, seed, rank):
-    """θ* (the Gröbner step's first draw), the summary and the numerical witness search, in one child process."""
+    """θ* (the Gröbner step's first draw), the summary, the numerical witness search and, for the parameters the
+    certified witnesses do not move, checked rational formulas (:mod:`~symid.structural.rational_formulas`), in
+    one child process: (witnesses, {parameter: formula text})."""
     prepared = star_and_summary(model, known, seed=seed, rank=rank)
-    return find_witnesses(model, known, positive=positive, seed=seed, prepared=prepared)
+    wit = find_witnesses(model, known, positive=positive, seed=seed, prepared=prepared)
+    params, star, _, summ, _ = prepared
+    moved = _moved(wit, [q.name for q in params])
+    rest = [q.name for q in params if q.name not in moved]
+    formulas = rational_formulas(summ, rest, seed=seed, at=star) if moved and rest else {}
+    return wit, {name: f.text(summ.labels) for name, f in formulas.items()}
+
+
+def _moved(wit: WitnessResult, names: Sequence[str]) -> set[str]:
+    """The parameters in which some certified witness differs from θ*."""
+    star_f = {k: float(sp.Rational(v)) for k, v in wit.theta_star.items()}
+    return {nm for w, ok in zip(wit.witnesses, wit.certified, strict=True) if ok
+            for nm in names if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
 
 
 def limit_reason(step: str, status: str, value: object) -> str | None:
@@ -124,7 +139,11 @@ class GlobalOutcome:
     theta_star : dict of str to str
         θ* of the witness search (the same as the Gröbner step's).
     proven_by_witnesses : bool
-        Certified witnesses move every parameter: no parameter is globally identifiable.
+        Every parameter is settled: moved by a certified witness (not globally identifiable)
+        or given by a checked formula (globally identifiable, ``formulas``).
+    formulas : dict of str to str
+        Parameters the witnesses do not move that a checked rational formula in the
+        summary entries proves globally identifiable, with the formula.
     seconds : float
         Wall time of the step.
     notes : list of str
@@ -136,23 +155,24 @@ class GlobalOutcome:
     certified: tuple = ()
     theta_star: dict = field(default_factory=dict)
     proven_by_witnesses: bool = False
+    formulas: dict = field(default_factory=dict)
     seconds: float = 0.0
     notes: list = field(default_factory=list)
 
 
-def _read_witnesses(out: GlobalOutcome, wit: WitnessResult, names: Sequence[str]) -> None:
-    star_f = {k: float(sp.Rational(v)) for k, v in wit.theta_star.items()}
-    moved = {nm for w, ok in zip(wit.witnesses, wit.certified, strict=True) if ok
-             for nm in names if abs(w[nm] - star_f[nm]) > 1e-6 * max(1.0, abs(star_f[nm]))}
+def _read_witnesses(out: GlobalOutcome, value: tuple, names: Sequence[str]) -> None:
+    wit, formulas = value
+    moved = _moved(wit, names)
     out.theta_star, out.witnesses, out.certified = wit.theta_star, wit.witnesses, wit.certified
-    out.proven_by_witnesses = moved == set(names)
+    out.formulas = dict(formulas)
+    out.proven_by_witnesses = bool(moved) and (moved | set(formulas)) == set(names)
     if wit.witnesses and not any(wit.certified):
         why = ("the Krawczyk test failed for each" if wit.square else
                "the Krawczyk test needs as many summary equations as unknowns; this system has more")
         out.notes.append(f"the witnesses are not certified ({why}): they are numerical evidence, not a proof")
     elif not wit.witnesses:
-        out.notes.append(f"no second solution found numerically ({wit.n_starts} starts); this proves nothing "
-                         "about the global verdict")
+        out.notes.append(f"no second solution found numerically (curves and {wit.n_starts} starts); this proves "
+                         "nothing about the global verdict")
 
 
 def run_global(model, known: Mapping[str, sp.Rational], *, names: Sequence[str], positive: Sequence[bool],
