@@ -427,3 +427,12 @@ def test_compiled_problem_options_cannot_be_overridden_by_solve():
         scr.solve("x*y - 1")
     with pytest.raises(ModelError, match="compile\\(\\) needs a BilinearProblem"):
         scr.compile(None)
+
+
+def test_a_constant_sum_of_squares_is_a_constant_objective():
+    # found by hypothesis in a fresh CI environment (tests/test_safe_expressions.py): SumSquares([["0"]]) has no
+    # variable, so its Jacobian has no column; it used to raise numpy's "cannot reshape array of size 0"
+    x, y = sp.symbols("x y")
+    for text, value in (("0", 0.0), ("3", 9.0)):
+        prob = scr.BilinearProblem(variables=[x, y], objective=scr.SumSquares([[text]]))
+        assert prob.objective_value(np.zeros(2)) == pytest.approx(value, abs=1e-15)

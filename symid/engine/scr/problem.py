@@ -138,8 +138,8 @@ def _quadratic_from_sumsquares(term: SumSquares, layout: Layout, name: str) -> t
     if not np.isfinite(w) or w < 0:
         raise ModelError(f"{name}: weight must be finite and ≥ 0, got {term.weight}")
     m = as_map(term.F, layout, name)
-    J = m.coef.reshape(-1, m.idx.size)
     f0 = m.const.reshape(-1)
+    J = m.coef.reshape(f0.size, m.idx.size)  # no column when F does not depend on the variables (a constant)
     Hl = w * (J.conj().T @ J).real
     gl = 2 * w * (f0.conj() @ J).real
     ii, jj = np.meshgrid(m.idx, m.idx, indexing="ij")
