@@ -8,10 +8,6 @@ computed here side by side, and the physics of each model stated at its test.
 
 from __future__ import annotations
 
-import importlib
-import sys
-from pathlib import Path
-
 import pytest
 
 import symid as si
@@ -22,16 +18,7 @@ from symid.structural.msolve import msolve_binary
 from symid.structural.slicing import sliced_global
 
 MSOLVE = msolve_binary()
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
-
-@pytest.fixture(scope="module")
-def families():
-    sys.path.insert(0, str(BENCH))
-    try:
-        yield importlib.import_module("identifiability_models")
-    finally:
-        sys.path.remove(str(BENCH))
 
 
 SMALL = ["rlc-2-ladder", "catenary-3-leak12", "mammillary-3-leak12", "cycle-3-leak12", "catenary-4-leak12"]

@@ -7,10 +7,7 @@ each model (interchangeable compartments, the rates around a one-way cycle).
 
 from __future__ import annotations
 
-import importlib
-import sys
 from fractions import Fraction
-from pathlib import Path
 
 import pytest
 
@@ -21,16 +18,7 @@ from symid.structural.summary import exhaustive_summary
 from symid.structural.symmetry import orbit, symmetries
 
 MSOLVE = msolve_binary()
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
-
-@pytest.fixture(scope="module")
-def families():
-    sys.path.insert(0, str(BENCH))
-    try:
-        yield importlib.import_module("identifiability_models")
-    finally:
-        sys.path.remove(str(BENCH))
 
 
 @pytest.mark.parametrize("name, count", [("mammillary-4-leak1", 6), ("cycle-5-leak1", 24), ("chain-3-11", 1)])

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import random
-import sys
 from fractions import Fraction
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,9 +15,6 @@ import symid as si
 from symid.structural.certify import PolySystem, SummarySystem
 from symid.structural.tracing import CurveTracer, ScaledSystem, newton
 from symid.structural.witness import find_witnesses
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-import identifiability_models
 
 GOLDEN = (1 + 5**0.5) / 2
 
@@ -95,11 +90,11 @@ def test_curves_through_theta_star_meet_the_other_real_roots():
     assert (round(GOLDEN, 9), round(1 / GOLDEN, 9)) in roots
 
 
-def test_chain_with_force_and_sensor_at_opposite_ends_is_proven_local():
+def test_chain_with_force_and_sensor_at_opposite_ends_is_proven_local(families):
     # chain-4-1n (12 parameters): 204 complex solutions of summary(θ) = summary(θ*), out of reach of the exact
     # step within seconds. The traced curves find a certified admissible witness that moves every parameter but
     # c1 and k1, which are globally identifiable: H(0) = 1/k1 (det K = k1 k2 k3 k4) and 1/H(s) = k1 + c1 s + O(s²)
-    model = identifiability_models.build("chain-4-1n")
+    model = families.build("chain-4-1n")
     res = find_witnesses(model, positive=[True] * 12)
     star = {k: float(sp.Rational(v)) for k, v in res.theta_star.items()}
     moved = {k for w, ok in zip(res.witnesses, res.certified, strict=True) if ok
@@ -115,8 +110,8 @@ def test_chain_with_force_and_sensor_at_opposite_ends_is_proven_local():
     assert (again.witnesses, again.certified, again.n_starts) == (res.witnesses, res.certified, res.n_starts)
 
 
-def test_chain_verdicts_are_local_where_witnesses_move_the_parameter():
-    model = identifiability_models.build("chain-4-1n")
+def test_chain_verdicts_are_local_where_witnesses_move_the_parameter(families):
+    model = families.build("chain-4-1n")
     rep = si.identifiability(model, timeout=3.0)
     assert rep.jacobian_ranks[0] == 12
     local = {k for k, v in rep.verdicts.items() if v == "local"}
@@ -132,11 +127,11 @@ def test_a_globally_identifiable_model_yields_no_witness(name):
     assert res.witnesses == () and res.certified == ()
 
 
-def test_rational_formulas_prove_the_chain_parameters_witnesses_cannot_move():
+def test_rational_formulas_prove_the_chain_parameters_witnesses_cannot_move(families):
     from symid.structural.rational_formulas import rational_formulas
     from symid.structural.summary import exhaustive_summary
 
-    model = identifiability_models.build("chain-4-1n")
+    model = families.build("chain-4-1n")
     summ = exhaustive_summary(model)
     found = rational_formulas(summ, ["c1", "k1", "m1", "k2"], at=[sp.Rational(3 + i, 2) for i in range(12)])
     assert sorted(found) == ["c1", "k1"]  # m1 and k2 are not global (the certified witness moves them)
