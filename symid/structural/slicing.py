@@ -29,8 +29,12 @@ sliced system at a generic point. The same holds for any locally identifiable fu
 of θ, such as the monomial combinations whose membership the report uses.
 
 Only the locally identifiable parameters are decided here; the others are "none" by the
-local step, and the combinations of the report come from the summary entries and the
-monomials of the scaling symmetries, as before.
+local step, and the combinations of the report come from the summary entries, the
+monomials of the scaling symmetries and the linear functions of the Jacobian's null
+space (their global flags decided on the slice). When every locally identifiable
+parameter has a checked rational formula in the summary entries
+(:mod:`~symid.structural.rational_formulas`: global at every θ) and no combination's flag
+is asked, the slice is not computed at all (RLC ladders: thousands of sliced solutions).
 """
 
 from __future__ import annotations
