@@ -32,13 +32,13 @@ import random
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-import numpy as np
 import sympy as sp
 from sympy import QQ
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from symid.errors import ModelError
+from symid.structural.modp import rank_mod_p
 from symid.structural.summary import free_parameters, model_kind, rational
 
 __all__ = ["LocalResult", "PoleError", "jacobian_at", "local_analysis", "random_point", "rank_at"]
@@ -309,43 +309,7 @@ def rank_at(model, point: Sequence, known: Mapping[str, object] | None = None, *
         except PoleError:
             continue
         full = min(J.shape)
-        if _rank_mod_p(J) == full:  # rank modulo p never exceeds the rank over ℚ, which never exceeds `full`
+        if rank_mod_p(J.to_list()) == full:  # the rank modulo p never exceeds the rank over ℚ, nor that `full`
             return full
         return J.rank()
     raise ModelError("the transfer function has a pole at every random test frequency; is M(θ) singular?")
-
-
-_RANK_PRIME = 2_147_483_629
-"""The largest prime below 2³¹: products of two residues fit in a signed 64-bit integer."""
-
-
-def _rank_mod_p(J: DomainMatrix) -> int:
-    """Rank of a rational matrix modulo :data:`_RANK_PRIME` (numpy, int64), or −1 when p divides a denominator.
-
-    A lower bound on the rank over ℚ (a minor that is non-zero modulo p is non-zero), so a
-    full rank modulo p proves full rank; a lower value proves nothing.
-    """
-    p = _RANK_PRIME
-    rows = J.to_list()
-    try:
-        A = np.array([[int(v.numerator) % p * pow(int(v.denominator), -1, p) % p for v in row] for row in rows],
-                     dtype=np.int64).reshape(J.shape)
-    except ValueError:  # a denominator divisible by p
-        return -1
-    rank = 0
-    n_rows, n_cols = A.shape
-    for c in range(n_cols):
-        piv = next((r for r in range(rank, n_rows) if A[r, c]), None)
-        if piv is None:
-            continue
-        A[[rank, piv]] = A[[piv, rank]]
-        inv = pow(int(A[rank, c]), -1, p)
-        A[rank] = A[rank] * inv % p
-        below = A[rank + 1:, c].copy()
-        nz = np.nonzero(below)[0]
-        if nz.size:
-            A[rank + 1 + nz] = (A[rank + 1 + nz] - (below[nz, None] * A[rank]) % p) % p
-        rank += 1
-        if rank == n_rows:
-            break
-    return rank

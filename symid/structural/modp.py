@@ -1,8 +1,10 @@
 """Polynomials over ℚ evaluated modulo a prime, vectorised (numpy int64, primes below 2³¹).
 
 Used where only a residue is needed: the summary system modulo a random prime for msolve
-(:mod:`~symid.structural.global_`). A prime that divides a coefficient's denominator makes
-the reduction impossible: :class:`BadPrime` is raised and the caller takes another prime.
+(:mod:`~symid.structural.global_`), the rank check at θ* (:mod:`~symid.structural.local`)
+and the formula search (:mod:`~symid.structural.rational_formulas`). A prime that divides
+a coefficient's denominator makes the reduction impossible: :class:`BadPrime` is raised
+and the caller takes another prime.
 """
 
 from __future__ import annotations
@@ -11,7 +13,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["BadPrime", "Compiled", "compile_poly", "residue", "value_mod_p"]
+__all__ = ["PRIME", "BadPrime", "Compiled", "compile_poly", "rank_mod_p", "residue", "term_values", "value_mod_p"]
+
+PRIME = 2_147_483_629
+"""The largest prime below 2³¹: products of two residues fit in a signed 64-bit integer."""
 
 
 class BadPrime(ArithmeticError):
@@ -55,6 +60,22 @@ def compile_poly(poly, p: int) -> Compiled:
     return Compiled(monos, E, c)
 
 
+def term_values(exponents: np.ndarray, coeffs: np.ndarray, point: Sequence[int], p: int) -> np.ndarray:
+    """Each term's value c·Π θ^e modulo p (rows of ``exponents``, one coefficient each), vectorised over terms."""
+    t = coeffs.copy()
+    for i in range(exponents.shape[1]):
+        col = exponents[:, i]
+        top = int(col.max()) if col.size else 0
+        if top == 0:
+            continue
+        powers = np.empty(top + 1, dtype=np.int64)
+        powers[0] = 1
+        for e in range(1, top + 1):
+            powers[e] = powers[e - 1] * int(point[i]) % p
+        t = t * powers[col] % p
+    return t
+
+
 def value_mod_p(compiled: Compiled, point: Sequence[int], p: int) -> int:
     """The compiled polynomial at ``point`` (residues modulo p).
 
@@ -67,15 +88,42 @@ def value_mod_p(compiled: Compiled, point: Sequence[int], p: int) -> int:
     >>> value_mod_p(compile_poly(x**2 * y + QQ(1, 2), 101), [3, 4], 101)  # 36 + 51 (= 1/2 mod 101)
     87
     """
-    E, t = compiled.exponents, compiled.coeffs.copy()
-    for i in range(E.shape[1]):
-        col = E[:, i]
-        top = int(col.max()) if col.size else 0
-        if top == 0:
+    return int(term_values(compiled.exponents, compiled.coeffs, point, p).sum() % p)
+
+
+def rank_mod_p(rows: Sequence[Sequence], p: int = PRIME) -> int:
+    """Rank of a matrix of rationals modulo p (numpy, int64), or −1 when p divides a denominator.
+
+    A lower bound on the rank over ℚ (a minor that is non-zero modulo p is non-zero), so a
+    full rank modulo p proves full rank; a lower value proves nothing.
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> from symid.structural.modp import rank_mod_p
+    >>> rank_mod_p([[1, 2], [Fraction(1, 2), 1]]), rank_mod_p([[1, 2], [3, 4]])
+    (1, 2)
+    """
+    try:
+        A = np.array([[residue(v, p) if not isinstance(v, int) else v % p for v in row] for row in rows],
+                     dtype=np.int64)
+    except BadPrime:
+        return -1
+    if A.size == 0:
+        return 0
+    rank = 0
+    n_rows, n_cols = A.shape
+    for c in range(n_cols):
+        piv = next((r for r in range(rank, n_rows) if A[r, c]), None)
+        if piv is None:
             continue
-        powers = np.empty(top + 1, dtype=np.int64)
-        powers[0] = 1
-        for e in range(1, top + 1):
-            powers[e] = powers[e - 1] * int(point[i]) % p
-        t = t * powers[col] % p
-    return int(t.sum() % p)
+        A[[rank, piv]] = A[[piv, rank]]
+        A[rank] = A[rank] * pow(int(A[rank, c]), -1, p) % p
+        below = A[rank + 1:, c].copy()
+        nz = np.nonzero(below)[0]
+        if nz.size:
+            A[rank + 1 + nz] = (A[rank + 1 + nz] - (below[nz, None] * A[rank]) % p) % p
+        rank += 1
+        if rank == n_rows:
+            break
+    return rank

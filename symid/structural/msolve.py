@@ -345,19 +345,7 @@ class Parametrization:
         w = list(self.elim)
 
         def reduce(a: list) -> list:
-            a = list(a)
-            lead = w[-1]
-            while len(a) >= len(w):
-                c = a[-1]
-                if c:
-                    f = c * pow(lead, -1, p) % p if p else Fraction(c) / lead
-                    shift = len(a) - len(w)
-                    for i, wi in enumerate(w):
-                        a[shift + i] = (a[shift + i] - f * wi) % p if p else a[shift + i] - f * wi
-                a.pop()
-            while a and a[-1] == 0:
-                a.pop()
-            return a
+            return _rem(a, w, p)
 
         def mul(a: list, b: list) -> list:
             if not a or not b:
@@ -420,16 +408,9 @@ class Parametrization:
         w = list(self.elim)
         n = len(w) - 1
 
-        def reduce(a: list) -> list:
-            a = list(a) + [Fraction(0)] * max(0, n - len(a))
-            while len(a) > n:
-                c = a.pop()
-                if c:
-                    f = Fraction(c) / w[-1]
-                    shift = len(a) - n
-                    for i, wi in enumerate(w[:-1]):
-                        a[shift + i] -= f * wi
-            return a
+        def reduce(a: list) -> list:  # the remainder modulo w, as n coefficients
+            r = _rem(a, w, 0)
+            return r + [Fraction(0)] * (n - len(r))
 
         wp = [Fraction(x) for x in self.denom]
         cols = []
@@ -508,6 +489,24 @@ class Parametrization:
             if Fraction(point[name]) * c * wp + ev(v) != 0:
                 raise MsolveError(f"msolve's parametrization of {name} does not give the known solution θ*: its output "
                                   "is inconsistent with the system")
+
+
+def _rem(a: Sequence, w: Sequence[int], p: int) -> list:
+    """The remainder of the polynomial ``a`` modulo ``w`` (coefficients by increasing degree; over GF(p) when
+    p > 0, else over ℚ), without trailing zeros."""
+    a = list(a)
+    lead = w[-1]
+    while len(a) >= len(w):
+        c = a[-1]
+        if c:
+            f = c * pow(lead, -1, p) % p if p else Fraction(c) / lead
+            shift = len(a) - len(w)
+            for i, wi in enumerate(w):
+                a[shift + i] = (a[shift + i] - f * wi) % p if p else a[shift + i] - f * wi
+        a.pop()
+    while a and a[-1] == 0:
+        a.pop()
+    return a
 
 
 @dataclass(frozen=True)

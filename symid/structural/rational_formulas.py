@@ -35,9 +35,11 @@ from itertools import combinations_with_replacement
 
 import numpy as np
 
+from symid.structural.modp import PRIME, residue, term_values
+
 __all__ = ["RationalFormula", "rational_formulas"]
 
-_P = 2_147_483_629
+_P = PRIME
 """The prime of the linear algebra (largest below 2³¹: products of two residues fit in int64)."""
 MAX_UNKNOWNS = 80
 """Formulas with more unknown coefficients (2 × monomials of degree ≤ D in |S| entries) are not tried."""
@@ -70,10 +72,6 @@ class RationalFormula:
         return f"{self.parameter} = ({poly(self.numerator)}) / ({poly(self.denominator)})"
 
 
-def _mod(q) -> int:
-    return int(q.numerator) % _P * pow(int(q.denominator), -1, _P) % _P
-
-
 class _ModEvaluator:
     """Values and gradients modulo the prime of polynomials given by their terms, vectorised over terms."""
 
@@ -82,7 +80,7 @@ class _ModEvaluator:
         sizes = [len(t) for t in polys]
         self.starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         self.E = np.array([m for t in polys for m, _ in t], dtype=np.int64).reshape(-1, nv)
-        self.c = np.array([_mod(c) for t in polys for _, c in t], dtype=np.int64)
+        self.c = np.array([residue(c, _P) for t in polys for _, c in t], dtype=np.int64)
 
     def _sums(self, x: np.ndarray) -> np.ndarray:
         out = np.zeros(len(self.starts) - 1, dtype=np.int64)
@@ -92,12 +90,7 @@ class _ModEvaluator:
         return out
 
     def terms(self, pt: Sequence[int]) -> np.ndarray:
-        t = self.c.copy()
-        for v in range(self.nv):
-            col = self.E[:, v]
-            for e in np.unique(col[col > 0]):
-                t[col == e] = t[col == e] * pow(int(pt[v]), int(e), _P) % _P
-        return t
+        return term_values(self.E, self.c, pt, _P)
 
     def values(self, pt: Sequence[int]) -> np.ndarray:
         return self._sums(self.terms(pt))
