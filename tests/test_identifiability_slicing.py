@@ -101,3 +101,17 @@ def test_a_parameter_that_is_a_ratio_of_coefficients_is_proven_global_without_so
     rep = si.identifiability(model, timeout=60)
     assert rep.verdicts["S8"] == "global" and {v for k, v in rep.verdicts.items() if k != "S8"} == {"none"}
     assert rep.verdicts_proven and rep.engine == "formula"
+
+
+def test_linear_combinations_do_not_depend_on_the_point():
+    # a 3-compartment star (centre 1 observed and dosed, leaks from 1 and 3): the slice has only two solutions, so at
+    # one point every combination orthogonal to their difference is single-valued — before the intersection over
+    # further points, a combination with coefficients like 3205746512035814/2454635377341561 (θ*-dependent) was
+    # reported global. Structurally: the centre's outflow k0_1 + k2_1 + k3_1 is seen at once, and the trace of A
+    # gives the peripheral outflows k1_2 + k1_3 + k0_3
+    k21, k12, k31, k13, k01, k03 = si.parameters("k2_1 k1_2 k3_1 k1_3 k0_1 k0_3", positive=True)
+    A = [[-(k01 + k21 + k31), k12, k13], [k21, -k12, 0], [k31, 0, -(k13 + k03)]]
+    model = si.StateSpaceModel(A=A, B=[[1], [0], [0]], C=[[1, 0, 0]])
+    rep = si.identifiability(model, timeout=60)
+    linear = {c["expression"]: c["global"] for c in rep.combinations if c["source"] == "linear"}
+    assert linear == {"k0_1 + k2_1 + k3_1": True, "k0_3 + k1_2 + k1_3": True}

@@ -1261,6 +1261,61 @@ def _admissible_elsewhere(res: GlobalResult, model, known, positive, seed: int, 
     return replace(res, local_elsewhere=found, notes=(*res.notes, note))
 
 
+LINEAR_POINTS = 4
+"""Most further random points at which the single-valued linear combinations are intersected."""
+
+
+def _intersect(U: Sequence[Sequence[Fraction]], V: Sequence[Sequence[Fraction]], n: int) -> list[list[Fraction]]:
+    """A basis of span(U) ∩ span(V) (rows of length n): the vectors orthogonal to both annihilators."""
+    def ann(rows):
+        if not rows:
+            return [[QQ(int(i == k)) for i in range(n)] for k in range(n)]
+        M = DomainMatrix([[QQ(Fraction(v).numerator, Fraction(v).denominator) for v in r] for r in rows],
+                         (len(rows), n), QQ)
+        return M.nullspace().to_list()
+
+    N = ann(U) + ann(V)
+    if not N:
+        return [[Fraction(int(i == k)) for i in range(n)] for k in range(n)]
+    basis = DomainMatrix(N, (len(N), n), QQ).nullspace().to_list()
+    return [[Fraction(int(v.numerator), int(v.denominator)) for v in row] for row in basis]
+
+
+def _linear_at_more_points(res: GlobalResult, model, known, positive, seed: int, rank, msolve, summary,
+                           linear_forms, extra_known=None) -> GlobalResult:
+    """The combinations of the linear forms that are single-valued at θ* *and* at further random points.
+
+    Whether a *given* function is single-valued is decided at one generic point; but the
+    combinations found by solving for the coefficients at θ* are those single-valued at
+    that point, a space that can be larger than the structural one (with two solutions, any
+    combination orthogonal to their difference qualifies). The space is intersected with
+    the same at further points (:data:`LINEAR_POINTS` at most) until one more point leaves
+    it unchanged; what remains has coefficients that do not depend on the point.
+    """
+    n = len(linear_forms)
+    if res.linear_global is None or not res.linear_global or len(res.linear_global) == n:
+        return res  # nothing, or every form single-valued (a single solution): nothing point-dependent
+    space = [list(r) for r in res.linear_global]
+    for k in range(LINEAR_POINTS):
+        known_k = known if extra_known is None else extra_known[k % len(extra_known)]
+        try:
+            prepared = star_and_summary(model, known_k, seed=seed, draw=300 + k, rank=rank,
+                                        summary=summary if extra_known is None else None)
+            other = global_analysis(model, known_k, positive=positive, seed=seed, expressions=False,
+                                    prepared=prepared, msolve=msolve, linear_forms=linear_forms)
+        except NonGenericPoint:
+            continue
+        if other.linear_global is None:
+            return replace(res, linear_global=None)
+        smaller = _intersect(space, other.linear_global, n)
+        if len(smaller) == len(space):
+            break
+        space = smaller
+        if not space:
+            break
+    return replace(res, linear_global=tuple(tuple(r) for r in space))
+
+
 def _claims_global(res: GlobalResult) -> bool:
     return (res.zero_dimensional and res.n_complex == 1) or any(res.global_complex.values())
 
@@ -1324,6 +1379,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     draws = draw + 1
     res = _admissible_elsewhere(res, model, known, positive, seed, rank, msolve, prepared[3], extra_known,
                                 local_only)
+    res = _linear_at_more_points(res, model, known, positive, seed, rank, msolve, prepared[3], linear_forms,
+                                 extra_known)
     if not _claims_global(res):
         return replace(res, notes=(*res.notes, *notes), draws=draws)
     zero2, count2, single2, theta2 = confirm_mod_p(model, known if confirm_known is None else confirm_known,
