@@ -1219,50 +1219,8 @@ PARTIAL_ABOVE = 24
 decides the combinations' global flags, costs 0.1 s at 6-24 solutions and 3-12 s at 120 on the compartment
 families)."""
 EXTRA_POINTS = 6
-"""Further random points tried for a parameter whose other complex values are not admissible at θ*."""
-
-
-def _admissible_elsewhere(res: GlobalResult, model, known, positive, seed: int, rank, msolve, summary,
-                          extra_known=None, only=None) -> GlobalResult:
-    """Try :data:`EXTRA_POINTS` more random points for the parameters that are not single-valued over the complex
-    solutions but are over the admissible ones at θ*: two admissible solutions that differ in such a parameter at
-    another point prove it not globally identifiable (they are simple, so they persist near that point)."""
-    if not res.zero_dimensional or res.n_complex is None:
-        return res
-    open_ = [n for n, single in res.global_complex.items() if not single and res.global_admissible.get(n, False)
-             and (only is None or n in only)]
-    found: dict[str, dict] = {}
-    for k in range(EXTRA_POINTS if open_ else 0):
-        known_k = known if extra_known is None else extra_known[k]
-        try:
-            prepared = star_and_summary(model, known_k, seed=seed, draw=100 + k, rank=rank,
-                                        summary=summary if extra_known is None else None)
-            other = global_analysis(model, known_k, positive=positive, seed=seed, expressions=False,
-                                    prepared=prepared, msolve=msolve)
-        except NonGenericPoint:
-            continue
-        for n in list(open_):
-            if not other.global_admissible.get(n, True):
-                fixed = {} if extra_known is None else {q: str(v) for q, v in extra_known[k].items()
-                                                         if (known or {}).get(q) != v}
-                found[n] = {**fixed, **{q: str(v) for q, v in other.theta_star.items()}}
-                open_.remove(n)
-        if not open_:
-            break
-    if not found:
-        return res
-    points: dict[str, list[str]] = {}
-    for n, pt in found.items():
-        points.setdefault(", ".join(f"{q} = {v}" for q, v in pt.items()), []).append(n)
-    where = "; ".join(f"{', '.join(ns)} at θ = ({pt})" for pt, ns in points.items())
-    note = (f"{', '.join(found)}: a single value on the admissible solutions at θ* but not on the complex ones; at "
-            f"another random point two admissible solutions differ in {'it' if len(found) == 1 else 'each'} "
-            f"(proven not global): {where}")
-    return replace(res, local_elsewhere=found, notes=(*res.notes, note))
-
-
-LINEAR_POINTS = 4
-"""Most further random points at which the single-valued linear combinations are intersected."""
+"""Further random points tried for a parameter whose other complex values are not admissible at θ*, and for the
+single-valued linear combinations (:func:`_at_more_points`)."""
 
 
 def _intersect(U: Sequence[Sequence[Fraction]], V: Sequence[Sequence[Fraction]], n: int) -> list[list[Fraction]]:
@@ -1281,39 +1239,63 @@ def _intersect(U: Sequence[Sequence[Fraction]], V: Sequence[Sequence[Fraction]],
     return [[Fraction(int(v.numerator), int(v.denominator)) for v in row] for row in basis]
 
 
-def _linear_at_more_points(res: GlobalResult, model, known, positive, seed: int, rank, msolve, summary,
-                           linear_forms, extra_known=None) -> GlobalResult:
-    """The combinations of the linear forms that are single-valued at θ* *and* at further random points.
+def _at_more_points(res: GlobalResult, model, known, positive, seed: int, rank, msolve, summary, linear_forms,
+                    extra_known=None, only=None) -> GlobalResult:
+    """What one point θ* cannot settle, looked at in up to :data:`EXTRA_POINTS` more random points.
 
-    Whether a *given* function is single-valued is decided at one generic point; but the
-    combinations found by solving for the coefficients at θ* are those single-valued at
-    that point, a space that can be larger than the structural one (with two solutions, any
-    combination orthogonal to their difference qualifies). The space is intersected with
-    the same at further points (:data:`LINEAR_POINTS` at most) until one more point leaves
-    it unchanged; what remains has coefficients that do not depend on the point.
+    * A parameter single-valued on the admissible solutions at θ* but not on the complex
+      ones: two admissible solutions that differ in it at another point prove it not
+      globally identifiable (they are simple, so they persist near that point):
+      ``local_elsewhere`` (only the parameters in ``only``, when given).
+    * The single-valued combinations of the linear forms: whether a *given* function is
+      single-valued is decided at one generic point, but the combinations found by solving
+      for the coefficients at θ* are those single-valued at that point, a space that can be
+      larger than the structural one (with two solutions, any combination orthogonal to
+      their difference qualifies). It is intersected with the same at further points until
+      one more point leaves it unchanged; what remains does not depend on the point.
     """
-    n = len(linear_forms)
-    if res.linear_global is None or not res.linear_global or len(res.linear_global) == n:
-        return res  # nothing, or every form single-valued (a single solution): nothing point-dependent
-    space = [list(r) for r in res.linear_global]
-    for k in range(LINEAR_POINTS):
-        known_k = known if extra_known is None else extra_known[k % len(extra_known)]
+    finite = res.zero_dimensional and res.n_complex is not None
+    open_ = [n for n, single in res.global_complex.items() if not single and res.global_admissible.get(n, False)
+             and (only is None or n in only)] if finite else []
+    n_forms = len(linear_forms)
+    space = None if res.linear_global is None else [list(r) for r in res.linear_global]
+    linear_open = space is not None and 0 < len(space) < n_forms  # empty, or all forms (one solution): settled
+    found: dict[str, dict] = {}
+    for k in range(EXTRA_POINTS):
+        if not open_ and not linear_open:
+            break
+        known_k = known if extra_known is None else extra_known[k]
         try:
-            prepared = star_and_summary(model, known_k, seed=seed, draw=300 + k, rank=rank,
+            prepared = star_and_summary(model, known_k, seed=seed, draw=100 + k, rank=rank,
                                         summary=summary if extra_known is None else None)
             other = global_analysis(model, known_k, positive=positive, seed=seed, expressions=False,
-                                    prepared=prepared, msolve=msolve, linear_forms=linear_forms)
+                                    prepared=prepared, msolve=msolve, linear_forms=linear_forms if linear_open else ())
         except NonGenericPoint:
             continue
-        if other.linear_global is None:
-            return replace(res, linear_global=None)
-        smaller = _intersect(space, other.linear_global, n)
-        if len(smaller) == len(space):
-            break
-        space = smaller
-        if not space:
-            break
-    return replace(res, linear_global=tuple(tuple(r) for r in space))
+        for n in list(open_):
+            if not other.global_admissible.get(n, True):
+                fixed = {} if extra_known is None else {q: str(v) for q, v in extra_known[k].items()
+                                                         if (known or {}).get(q) != v}
+                found[n] = {**fixed, **{q: str(v) for q, v in other.theta_star.items()}}
+                open_.remove(n)
+        if linear_open:
+            if other.linear_global is None:
+                space, linear_open = None, False
+            else:
+                smaller = _intersect(space, other.linear_global, n_forms)
+                linear_open = 0 < len(smaller) < len(space)
+                space = smaller
+    res = replace(res, linear_global=None if space is None else tuple(tuple(r) for r in space))
+    if not found:
+        return res
+    points: dict[str, list[str]] = {}
+    for n, pt in found.items():
+        points.setdefault(", ".join(f"{q} = {v}" for q, v in pt.items()), []).append(n)
+    where = "; ".join(f"{', '.join(ns)} at θ = ({pt})" for pt, ns in points.items())
+    note = (f"{', '.join(found)}: a single value on the admissible solutions at θ* but not on the complex ones; at "
+            f"another random point two admissible solutions differ in {'it' if len(found) == 1 else 'each'} "
+            f"(proven not global): {where}")
+    return replace(res, local_elsewhere=found, notes=(*res.notes, note))
 
 
 def _claims_global(res: GlobalResult) -> bool:
@@ -1377,10 +1359,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     if res is None:
         raise ExactStepLimit(f"no generic point θ* in {MAX_DRAWS} random draws")
     draws = draw + 1
-    res = _admissible_elsewhere(res, model, known, positive, seed, rank, msolve, prepared[3], extra_known,
-                                local_only)
-    res = _linear_at_more_points(res, model, known, positive, seed, rank, msolve, prepared[3], linear_forms,
-                                 extra_known)
+    res = _at_more_points(res, model, known, positive, seed, rank, msolve, prepared[3], linear_forms, extra_known,
+                          local_only)
     if not _claims_global(res):
         return replace(res, notes=(*res.notes, *notes), draws=draws)
     zero2, count2, single2, theta2 = confirm_mod_p(model, known if confirm_known is None else confirm_known,
