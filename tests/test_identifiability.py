@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import warnings
@@ -460,6 +461,22 @@ def test_a_stopped_child_is_killed_and_reaped(monkeypatch, tmp_path):
     assert multiprocessing.active_children() == []
 
 
+def _temp_file_then_hang(where):
+    with tempfile.NamedTemporaryFile(delete=False) as f:  # as msolve's input and output files are
+        f.write(b"x")
+    Path(where).write_text(f.name + "\n")
+    time.sleep(600)
+
+
+def test_a_child_killed_at_its_deadline_leaves_no_temporary_files(tmp_path):
+    # killed with SIGKILL, the child cannot clean up: its files live in a directory the parent removes
+    status, _ = run_with_deadline(_temp_file_then_hang, {"where": tmp_path / "name"}, 1.0)
+    assert status == "timeout"
+    left = Path((tmp_path / "name").read_text().strip())
+    assert left.parent != Path(tempfile.gettempdir())
+    assert not left.exists() and not left.parent.exists()
+
+
 _HANGING_PARENT = """
 import os, sys, time
 import symid as si, symid.structural.steps as steps
@@ -480,8 +497,10 @@ def test_the_groebner_child_never_outlives_its_parent(tmp_path, how):
     # KeyboardInterrupt and kills the child (which ignores SIGINT). A parent killed outright
     # (SIGKILL) cannot clean up: the orphaned child notices and exits by itself.
     pidfile = tmp_path / "pid"
+    scratch = tmp_path / "tmp"  # the parent's temporary directory: the child's files go below it
+    scratch.mkdir()
     proc = subprocess.Popen([sys.executable, "-c", _HANGING_PARENT, str(pidfile)], stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
+                            text=True, start_new_session=True, env={**os.environ, "TMPDIR": str(scratch)})
     try:
         end = time.monotonic() + 60
         while not (pidfile.exists() and pidfile.read_text().endswith("\n")):
@@ -496,6 +515,7 @@ def test_the_groebner_child_never_outlives_its_parent(tmp_path, how):
         if how == "ctrl-c":
             assert proc.returncode == -signal.SIGINT and err.rstrip().endswith("KeyboardInterrupt"), err
         assert _exited(child, 5.0)  # measured: at once (Ctrl-C), within 0.25 s (parent killed)
+        assert list(scratch.iterdir()) == []  # and its temporary directory is gone with it
     finally:
         if proc.poll() is None:
             proc.kill()

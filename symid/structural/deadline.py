@@ -24,14 +24,18 @@ terminal, stops the child), and a child whose parent has gone (killed with SIGKI
 say) exits by itself within ``_ORPHAN_POLL`` seconds, so no orphan keeps computing.
 On POSIX the child leads its own process group, and stopping it kills the whole group:
 a program it runs (msolve, :mod:`~symid.structural.msolve`) is stopped with it, at the
-deadline or when the parent has gone.
+deadline or when the parent has gone. A child killed at its deadline cannot clean up
+after itself, so its temporary files (:mod:`tempfile`, e.g. msolve's input and output)
+go to a directory of its own that the parent removes when it stops the child.
 """
 
 from __future__ import annotations
 
 import multiprocessing as mp
 import os
+import shutil
 import signal
+import tempfile
 import threading
 import time
 import traceback
@@ -47,10 +51,11 @@ _MAX_WAIT = 86400.0
 """Longest single wait (s): longer timeouts are waited in slices (the OS refuses waits beyond ~292 years)."""
 
 
-def _exit_when_orphaned(parent: int) -> None:  # pragma: no cover - runs in the child process
+def _exit_when_orphaned(parent: int, scratch: str) -> None:  # pragma: no cover - runs in the child process
     def watch() -> None:
         while os.getppid() == parent:
             time.sleep(_ORPHAN_POLL)
+        shutil.rmtree(scratch, ignore_errors=True)  # the parent that would have removed it is gone
         _kill_own_group()
         os._exit(70)
 
@@ -74,10 +79,11 @@ def _kill_own_group() -> None:  # pragma: no cover - runs in the child process
             pass
 
 
-def _child(conn, fn, kwargs, parent):  # pragma: no cover - runs in the child process
+def _child(conn, fn, kwargs, parent, scratch):  # pragma: no cover - runs in the child process
     _lead_own_group()
+    tempfile.tempdir = scratch  # this process's temporary files go where the parent removes them
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent decides, and stops this process
-    _exit_when_orphaned(parent)
+    _exit_when_orphaned(parent, scratch)
     try:
         outcome = ("ok", fn(**kwargs))
     except BaseException as exc:
@@ -120,13 +126,15 @@ class Running:
         ctx = mp.get_context(method)
         self._outcome: tuple[str, Any] | None = None
         self._recv, send = ctx.Pipe(duplex=False)
-        self._proc = ctx.Process(target=_child, args=(send, fn, dict(kwargs), os.getpid()), daemon=True,
-                                 name=f"symid-{getattr(fn, '__name__', 'job')}")
+        self._scratch = tempfile.mkdtemp(prefix="symid-job-")
+        self._proc = ctx.Process(target=_child, args=(send, fn, dict(kwargs), os.getpid(), self._scratch),
+                                 daemon=True, name=f"symid-{getattr(fn, '__name__', 'job')}")
         self.started = time.monotonic()
         try:
             self._proc.start()
         except BaseException:
             self._recv.close()
+            shutil.rmtree(self._scratch, ignore_errors=True)
             raise
         finally:
             send.close()  # only the child writes: its death closes the pipe (EOF here)
@@ -175,6 +183,7 @@ class Running:
             self._proc.kill()
         self._proc.join(5)
         self._recv.close()
+        shutil.rmtree(self._scratch, ignore_errors=True)
 
 
 def _wait_for(connections: Sequence[Any], timeout: float | None) -> list:
