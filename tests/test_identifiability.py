@@ -595,6 +595,38 @@ def test_exhaustive_summary_transfer_function():
     assert summ.expressions() == [a, b]  # H = b / (s + a)
 
 
+@pytest.mark.parametrize("half", [1, sp.Rational(1, 2)])
+def test_summary_with_integer_or_fractional_coefficients(half):
+    # integer coefficients are computed over ZZ, a fraction sends the summary over QQ: the entries are the
+    # transfer function's coefficients either way (H = 1/(m s² + half·c s + k), normalised by m)
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[half * c]], K=[[k]], B=[[1]], C=[[1]])
+    summ = exhaustive_summary(model)
+    entries = dict(zip(summ.labels, summ.expressions(), strict=True))
+    assert entries == {"d s^0": k / m, "d s^1": half * c / m, "N[0,0] s^0": 1 / m}
+
+
+def test_minimality_modulo_a_prime_never_claims_what_is_false():
+    # full rank modulo p proves full rank over Q; a non-minimal point must fall through to the exact answer
+    from symid.structural.global_ import free_parameters, model_kind, model_matrices
+    from symid.structural.summary import _minimal_mod_p, is_minimal_at
+
+    m, k, c = si.parameters("m k c", positive=True)
+    twin = si.SecondOrderModel(M=sp.diag(m, m), V=sp.diag(c, c), K=sp.diag(k, k), B=[[1], [1]], C=[[1, 1]])
+    a, b = si.parameters("a b")
+    hidden = si.StateSpaceModel(A=[[-a, 0], [0, -b]], B=[[1], [1]], C=[[1, 0]])
+    chain = si.SecondOrderModel(M=sp.diag(m, 2 * m), V=[[2 * c, -c], [-c, c]], K=[[2 * k, -k], [-k, k]],
+                                B=[[1], [0]], C=[[0, 1]], output="acceleration")
+    for model, minimal in ((twin, False), (hidden, False), (chain, True)):
+        mats, params = model_matrices(model, None), free_parameters(model, None)
+        kind, out = model_kind(model), getattr(model, "output", None)
+        for pt in ([2, 3, 5], [sp.Rational(1, 3), 7, sp.Rational(5, 2)]):
+            pt = pt[:len(params)]
+            subs = {q: sp.Rational(v) for q, v in zip(params, pt, strict=True)}
+            assert _minimal_mod_p(mats, kind, out, subs) is minimal
+            assert is_minimal_at(mats, kind, out, params, pt) is minimal
+
+
 def _summary_models():
     a, b, c, d, e, f, g = si.parameters("a b c d e f g")
     return {

@@ -13,7 +13,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["PRIME", "BadPrime", "Compiled", "compile_poly", "rank_mod_p", "residue", "term_values", "value_mod_p"]
+__all__ = ["PRIME", "BadPrime", "Compiled", "compile_poly", "inverse_mod_p", "matmul_mod_p", "matrix_mod_p",
+           "rank_mod_p", "residue", "term_values", "value_mod_p"]
 
 PRIME = 2_147_483_629
 """The largest prime below 2³¹: products of two residues fit in a signed 64-bit integer."""
@@ -127,3 +128,42 @@ def rank_mod_p(rows: Sequence[Sequence], p: int = PRIME) -> int:
         if rank == n_rows:
             break
     return rank
+
+
+def matrix_mod_p(rows: Sequence[Sequence], p: int = PRIME) -> np.ndarray:
+    """A matrix of rationals (or ints) modulo p, as int64 residues; :class:`BadPrime` when p divides a denominator."""
+    return np.array([[residue(v, p) if not isinstance(v, int) else v % p for v in row] for row in rows],
+                    dtype=np.int64).reshape(len(rows), -1 if rows else 0)
+
+
+def matmul_mod_p(A: np.ndarray, B: np.ndarray, p: int = PRIME) -> np.ndarray:
+    """A·B modulo p, exactly (Python integers inside: the sums of products would overflow int64)."""
+    return ((A.astype(object) @ B.astype(object)) % p).astype(np.int64)
+
+
+def inverse_mod_p(A: np.ndarray, p: int = PRIME) -> np.ndarray | None:
+    """The inverse of a square matrix of residues modulo p, or None when it is singular modulo p.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.structural.modp import inverse_mod_p
+    >>> inverse_mod_p(np.array([[2, 0], [0, 3]]), 7).tolist()  # 2·4 ≡ 3·5 ≡ 1 (mod 7)
+    [[4, 0], [0, 5]]
+    >>> inverse_mod_p(np.array([[1, 2], [2, 4]]), 7) is None
+    True
+    """
+    n = A.shape[0]
+    W = np.hstack([np.asarray(A, dtype=np.int64) % p, np.eye(n, dtype=np.int64)])
+    for c in range(n):
+        piv = next((r for r in range(c, n) if W[r, c]), None)
+        if piv is None:
+            return None
+        W[[c, piv]] = W[[piv, c]]
+        W[c] = W[c] * pow(int(W[c, c]), -1, p) % p
+        col = W[:, c].copy()
+        col[c] = 0
+        nz = np.nonzero(col)[0]
+        if nz.size:
+            W[nz] = (W[nz] - (col[nz, None] * W[c]) % p) % p
+    return W[:, n:]
