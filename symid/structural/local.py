@@ -32,13 +32,14 @@ import random
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+import numpy as np
 import sympy as sp
 from sympy import QQ
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from symid.errors import ModelError
-from symid.structural.modp import rank_mod_p
+from symid.structural.modp import PRIME, BadPrime, inverse_mod_p, matmul_mod_p, rank_mod_p, residue
 from symid.structural.summary import free_parameters, model_kind, rational
 
 __all__ = ["LocalResult", "PoleError", "jacobian_at", "local_analysis", "random_point", "rank_at"]
@@ -200,6 +201,76 @@ def jacobian_at(model, point: Sequence, known: Mapping[str, object] | None = Non
     return DomainMatrix(rows, (len(rows), npar), QQ)
 
 
+def _full_rank_mod_p(parts: _Parts, point: Sequence, frequencies: Sequence, p: int = PRIME) -> bool:
+    """Whether the Jacobian of :func:`jacobian_at` has full column rank modulo p (True proves it over ℚ).
+
+    A minor non-zero modulo p is non-zero. False (a frequency that is a pole modulo p, p
+    dividing a denominator, or a rank drop modulo p) proves nothing: the caller decides
+    over ℚ.
+    """
+    J = _jacobian_mod_p(parts, point, frequencies, p)
+    return J is not None and rank_mod_p(J.tolist(), p) == len(point)
+
+
+def _jacobian_mod_p(parts: _Parts, point: Sequence, frequencies: Sequence, p: int = PRIME) -> np.ndarray | None:
+    """The Jacobian of :func:`jacobian_at` modulo p, computed on residues; None where it has no residue.
+
+    (Z mod p)⁻¹ = Z⁻¹ mod p when det Z is a unit modulo p, so this is the exact Jacobian
+    reduced modulo p. None: a frequency is a pole modulo p, or p divides a denominator.
+    """
+    npar = len(point)
+    try:
+        pt = [residue(QQ.convert(v) if not isinstance(v, sp.Basic) else QQ.from_sympy(v), p) for v in point]
+
+        def at(name: str) -> np.ndarray:
+            X = np.array([[residue(v, p) for v in row] for row in parts.constant[name].to_list()],
+                         dtype=object).reshape(parts.constant[name].shape)
+            for v, entries in zip(pt, parts.coefficients[name], strict=True):
+                for i, j, c in entries:
+                    X[i, j] += v * residue(c, p)
+            return (X % p).astype(np.int64)
+
+        co = {k: [[(i, j, residue(c, p)) for i, j, c in e] for e in parts.coefficients[k]]
+              for k in parts.coefficients}
+        shift = _SHIFT.get(parts.output, 0)
+        if parts.kind == "state-space":
+            A, B, C = (at(k) for k in "ABC")
+        else:
+            M, V, K, B, C = (at(k) for k in "MVKBC")
+        rows = []
+        for s_q in frequencies:
+            s = residue(QQ.convert(s_q), p)
+            if parts.kind == "state-space":
+                Z = (s * np.eye(A.shape[0], dtype=object) - A.astype(object)) % p
+                dZ, scale, sign = co["A"], 1, 1
+            else:
+                Z = (M.astype(object) * (s * s) + V.astype(object) * s + K.astype(object)) % p
+                dZ = [[(i, j, v * f % p) for k, f in (("M", s * s), ("V", s), ("K", 1)) for i, j, v in co[k][col]]
+                      for col in range(npar)]
+                scale, sign = pow(s, shift, p), p - 1
+            Zi = inverse_mod_p(Z.astype(np.int64), p)
+            if Zi is None:
+                return None
+            X, Y = matmul_mod_p(Zi, B, p).astype(object), matmul_mod_p(C, Zi, p).astype(object)
+            block = np.zeros((C.shape[0] * B.shape[1], npar), dtype=object)
+            for col in range(npar):
+                dH = np.zeros((C.shape[0], B.shape[1]), dtype=object)
+                for i, j, v in co["C"][col]:
+                    dH[i, :] += v * X[j, :]
+                for i, j, v in co["B"][col]:
+                    dH[:, j] += v * Y[:, i]
+                for i, j, v in dZ[col]:
+                    dH += np.outer(Y[:, i], X[j, :]) * (v * sign)
+                if parts.kind == "state-space":
+                    for i, j, v in co["D"][col]:
+                        dH[i, j] += v
+                block[:, col] = (dH * scale % p).reshape(-1)
+            rows.append(block)
+    except BadPrime:
+        return None
+    return np.vstack(rows).astype(np.int64).reshape(-1, npar)
+
+
 @dataclass(frozen=True, eq=False)
 class LocalResult:
     """Outcome of the local test.
@@ -266,6 +337,9 @@ def local_analysis(model, known: Mapping[str, object] | None = None, *, seed: in
         for _attempt in range(20):
             pt = random_point(rng, len(free))
             freqs = _frequencies(rng, 2 * parts.n_order + 1 + shift)
+            if free and _full_rank_mod_p(parts, pt, freqs):  # full rank modulo p: no pole, null space {0}
+                J = None
+                break
             try:
                 J = jacobian_at(model, pt, known, frequencies=freqs, _parts=parts)
             except PoleError:  # a frequency hit a pole (or M(θ) is singular): draw again
@@ -275,7 +349,7 @@ def local_analysis(model, known: Mapping[str, object] | None = None, *, seed: in
             raise ModelError("the transfer function has a pole at every random test frequency; "
                              "is M(θ) singular for every θ?")
         points.append(tuple(pt))
-        ns = [list(v) for v in J.nullspace().to_list()] if free else []
+        ns = [list(v) for v in J.nullspace().to_list()] if free and J is not None else []
         ranks.append(len(free) - len(ns))
         nulls.append(ns)
     rank = max(ranks)
@@ -304,6 +378,8 @@ def rank_at(model, point: Sequence, known: Mapping[str, object] | None = None, *
     rng = random.Random(0) if rng is None else rng
     for _ in range(20):
         freqs = _frequencies(rng, 2 * parts.n_order + 1 + shift)
+        if point and _full_rank_mod_p(parts, point, freqs):
+            return len(point)
         try:
             J = jacobian_at(model, point, known, frequencies=freqs, _parts=parts)
         except PoleError:
