@@ -126,13 +126,14 @@ def input_text(polynomials: Sequence[Mapping[tuple[int, ...], object]], nvars: i
     --------
     >>> from fractions import Fraction
     >>> from symid.structural.msolve import input_text
-    >>> print(input_text([{(1, 0): Fraction(1, 3), (0, 2): -1, (0, 0): Fraction(1, 2)}], 2))
+    >>> print(input_text([{(1, 0): Fraction(1, 3), (0, 2): -1, (0, 0): Fraction(1, 2)}], 2), end="")
     x0,x1
     0
     2*x0-6*x1^2+3
     """
     names = [f"x{i}" for i in range(nvars)]
     lines = []
+    texts: dict[tuple[int, ...], str] = {}  # monomial → its text (the equations share most monomials)
     for poly in polynomials:
         terms = [(mono, (int(c.numerator), int(c.denominator)) if characteristic == 0 else int(c))
                  for mono, c in poly.items() if c]
@@ -147,9 +148,12 @@ def input_text(polynomials: Sequence[Mapping[tuple[int, ...], object]], nvars: i
             ints = [(m, c % characteristic) for m, c in terms]
         out = []
         for mono, c in sorted(ints, reverse=True):
-            if len(mono) != nvars or any(e < 0 for e in mono):
-                raise ValueError(f"bad monomial {mono} for {nvars} variables")
-            mon = "*".join(f"{names[i]}^{e}" if e > 1 else names[i] for i, e in enumerate(mono) if e)
+            mon = texts.get(mono)
+            if mon is None:
+                if len(mono) != nvars or any(e < 0 for e in mono):
+                    raise ValueError(f"bad monomial {mono} for {nvars} variables")
+                mon = texts[mono] = "*".join(f"{names[i]}^{e}" if e > 1 else names[i]
+                                             for i, e in enumerate(mono) if e)
             if not mon:
                 out.append(str(c))
             elif c == 1:
