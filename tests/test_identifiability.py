@@ -647,6 +647,26 @@ def test_jacobian_modulo_a_prime_is_the_exact_jacobian_reduced(name):
     assert local._jacobian_mod_p(parts, pt, freqs).tolist() == reduced
 
 
+@pytest.mark.parametrize("domain", ["ZZ", "QQ"])
+def test_determinant_on_packed_monomials_matches_sympy(domain):
+    # the summary's determinant multiplies packed monomials; sympy's own determinant is the reference
+    from sympy.polys.matrices import DomainMatrix
+    from sympy.polys.rings import ring
+
+    from symid.structural.summary import _det
+
+    R, x, y, z = ring("x y z", sp.ZZ if domain == "ZZ" else sp.QQ)
+    rng = random.Random(3)
+    for n in (1, 2, 4, 5):
+        rows = [[sum((R.domain.convert(rng.randint(-3, 3)) * x ** rng.randint(0, 3) * y ** rng.randint(0, 2)
+                      * z ** rng.randint(0, 1) for _ in range(rng.randint(0, 3))), R.zero)
+                 for _ in range(n)] for _ in range(n)]
+        if domain == "QQ":
+            rows[0][0] = rows[0][0] + R.domain.convert(sp.QQ(1, 3)) * x
+        mat = DomainMatrix(rows, (n, n), R.to_domain())
+        assert _det(mat) == mat.det()
+
+
 def _summary_models():
     a, b, c, d, e, f, g = si.parameters("a b c d e f g")
     return {

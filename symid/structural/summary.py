@@ -283,28 +283,84 @@ def _det(mat: DomainMatrix) -> PolyElement:
     """Determinant of a square polynomial matrix by expansion in minors (division-free).
 
     Row by row, the minors on every set of columns are built from the previous row's
-    (n·2ⁿ⁻¹ products). sympy's fraction-free elimination divides polynomials exactly at
-    every step, which costs far more for the small matrices (n ≤ 6) of a model.
+    (n·2ⁿ⁻¹ products, far fewer for the sparse matrices of chains and ladders). sympy's
+    fraction-free elimination divides polynomials exactly at every step, which costs far
+    more for the small matrices (n ≤ 8) of a model. The products are computed on packed
+    monomials (:class:`_Packed`): a minor times an entry is then one integer addition per
+    pair of terms (measured: the determinant of an 8-mass chain, 43 691 terms, 0.31 →
+    0.07 s).
     """
     rows = mat.to_list()
     n = len(rows)
     if n == 0:
         return mat.domain.one
-    minors = {(j,): rows[0][j] for j in range(n)}
+    R = mat.domain.ring
+    pack = _Packed(R, rows)
+    if not pack.usable:  # pragma: no cover - an exponent of 256 or more in a determinant of a model
+        return mat.det()
+    prows = [[pack.encode(e) for e in row] for row in rows]
+    minors = {(j,): prows[0][j] for j in range(n) if prows[0][j]}
     for r in range(1, n):
-        nxt = {}
+        nxt: dict[tuple[int, ...], dict] = {}
         for cols, val in minors.items():
-            if not val:
-                continue
             for j in range(n):
-                if j in cols:
+                entry = prows[r][j]
+                if j in cols or not entry:
                     continue
-                sign = -1 if sum(1 for c in cols if c > j) % 2 else 1
+                negative = sum(1 for c in cols if c > j) % 2 == 1
                 key = tuple(sorted((*cols, j)))
-                term = val * rows[r][j]
-                nxt[key] = nxt.get(key, mat.domain.zero) + (term if sign > 0 else -term)
-        minors = nxt
-    return minors.get(tuple(range(n)), mat.domain.zero)
+                acc = nxt.get(key)
+                if acc is None:
+                    acc = nxt[key] = {}
+                _add_product(acc, val, entry, negative)
+        minors = {k: v for k, v in ((k, {m: c for m, c in v.items() if c}) for k, v in nxt.items()) if v}
+    return pack.decode(minors.get(tuple(range(n)), {}))
+
+
+def _add_product(acc: dict, big: dict, small: dict, negative: bool) -> None:
+    """acc += ±big·small on packed monomials (a product of monomials is the sum of their codes)."""
+    get = acc.get
+    for ms, cs in small.items():
+        c = -cs if negative else cs
+        for m, v in big.items():
+            k = m + ms
+            acc[k] = get(k, 0) + v * c
+
+
+class _Packed:
+    """Monomials of a ring packed into one integer each, for products without tuple arithmetic.
+
+    Variable i occupies byte i (little-endian), so that a code is the exponent tuple's
+    bytes and decoding is ``int.to_bytes``. A byte holds any exponent of a minor of
+    ``rows`` when the sum over the rows of the variable's largest exponent in the row is
+    below 256 (a minor's term takes one entry from each row): the codes of a product then
+    add without carries. Otherwise :attr:`usable` is False.
+    """
+
+    def __init__(self, R: PolyRing, rows: list[list[PolyElement]]):
+        self.R = R
+        self.k = R.ngens
+        top = [0] * self.k
+        for row in rows:
+            row_top = [0] * self.k
+            for e in row:
+                for mono in e.keys():
+                    for i, x in enumerate(mono):
+                        if x > row_top[i]:
+                            row_top[i] = x
+            top = [a + b for a, b in zip(top, row_top, strict=True)]
+        self.usable = max(top, default=0) < 256
+
+    def encode(self, p: PolyElement) -> dict:
+        return {int.from_bytes(bytes(mono), "little"): c for mono, c in p.items() if c}
+
+    def decode(self, d: dict) -> PolyElement:
+        k = self.k
+        out = self.R.zero.copy()
+        for code, c in d.items():
+            if c:
+                out[tuple(code.to_bytes(k, "little"))] = c
+        return out
 
 
 def _bilinear_adjugate(P: DomainMatrix, c: list, b: list, detP: PolyElement) -> PolyElement:
@@ -414,11 +470,20 @@ def _monomial_gcd(num: PolyElement, mono: PolyElement) -> PolyElement:
     if not num:
         return mono.monic()
     (exps,) = mono.keys()
+    common = {i: e for i, e in enumerate(exps) if e}  # only the monomial's variables can be common
     for m in num.keys():  # unsorted: the minimum does not depend on the order
-        exps = tuple(min(a, b) for a, b in zip(exps, m, strict=True))
-        if not any(exps):
+        for i, e in list(common.items()):
+            if m[i] < e:
+                if m[i]:
+                    common[i] = m[i]
+                else:
+                    del common[i]
+        if not common:
             break
-    return R({exps: R.domain.one})
+    out = [0] * R.ngens
+    for i, e in common.items():
+        out[i] = e
+    return R({tuple(out): R.domain.one})
 
 
 def _to_ring(p: PolyElement, R: PolyRing, names: list[sp.Symbol]) -> PolyElement:
