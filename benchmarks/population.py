@@ -155,10 +155,17 @@ def run_problem(log: RunLog, p: Problem, args: argparse.Namespace, executor: Exe
                            **({"force_scr": True} if m == "scr" else {})}  # SCR itself, even where ls applies
                        for m in {x.removesuffix("+polish") for x in methods}}
             scope = log.scoped(f"{p.name}/noise{noise:g}/{kind}/")
+            rerun = [m for m in args.rerun if m in methods and (scope.get(f"{m}/rerun") or {}).get("commit")
+                     != args.commit]
+            for m in rerun:  # run again by this code (until a finished rerun is marked with its commit)
+                for key in [f"{m}/setup", *(f"{m}/start{i}" for i in range(len(starts)))]:
+                    scope.forget(key)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # identifiability was checked above
                 si.compare(p.model, data, methods=methods, starts=starts, options=options, log=scope,
                            executor=executor, progress=args.progress, noise_floor=None)
+            for m in rerun:
+                scope.append(f"{m}/rerun", {"commit": args.commit})
 
 
 def resolved(p: Problem) -> bool:
@@ -185,7 +192,7 @@ def summarise(log: RunLog) -> dict[str, Any]:
     for rec in log.records():
         parts = rec["key"].split("/")
         if parts[0] == "run" and len(parts) == 2:
-            runs.append({k: rec.get(k) for k in ("started", "commit", "methods", "sizes")})
+            runs.append({k: rec.get(k) for k in ("started", "commit", "methods", "sizes", "rerun") if k in rec})
         elif parts[-1] == "problem":
             res = _logged_resolution(rec)
             if res > RESOLUTION_FLOOR:
@@ -204,6 +211,8 @@ def summarise(log: RunLog) -> dict[str, Any]:
         prob = problems[name]
         cell = cells[(prob["cls"], method, noise_key, kind)]
         by_size = cells[(f"n={prob['n']}", method, noise_key, kind)]
+        if what == "rerun":  # the marker of a finished rerun (--rerun), not a start
+            continue
         if what == "setup":
             cell["setup"] += float(rec.get("setup_time", 0.0))
             by_size["setup"] += float(rec.get("setup_time", 0.0))
@@ -277,17 +286,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--fresh", action="store_true", help="start over: discard the log")
     ap.add_argument("--summary-only", action="store_true", help="rebuild the summary from the log; run nothing")
     ap.add_argument("--progress", action="store_true", help="progress bars per method")
+    ap.add_argument("--rerun", default="", help="methods whose logged starts are run again by this commit "
+                    "(e.g. after a change to the method; the new records supersede the old ones)")
     args = ap.parse_args(argv)
     args.classes = [c for c in args.classes.split(",") if c]
     bad = sorted(set(args.classes) - set(CLASSES))
     if bad:
         ap.error(f"unknown classes {bad}; choose among {', '.join(CLASSES)}")
     args.methods = [m for m in args.methods.split(",") if m]
+    args.rerun = [m for m in args.rerun.split(",") if m]
     args.noise = _floats(args.noise)
     args.kinds = [k for k in args.kinds.split(",") if k]
     sizes = [int(v) for v in args.sizes.split(",") if v]
     log = RunLog(args.log, fresh=args.fresh)
-    header = {"commit": _git_commit(), "machine": platform.machine(), "cpus": os.cpu_count(),
+    args.commit = _git_commit()
+    header = {"commit": args.commit, "machine": platform.machine(), "cpus": os.cpu_count(),
               "python": platform.python_version()}
 
     def write_summary() -> dict[str, Any]:
@@ -314,7 +327,8 @@ def main(argv: list[str] | None = None) -> int:
     elif args.workers > 1:
         executor = ProcessPoolExecutor(max_workers=args.workers, mp_context=get_context("spawn"))
     # which code ran which rows of a log that several runs fill (a resumed run of the same code adds nothing)
-    run = {"commit": header["commit"], "methods": args.methods, "sizes": sizes}
+    run = {"commit": header["commit"], "methods": args.methods, "sizes": sizes,
+           **({"rerun": args.rerun} if args.rerun else {})}
     last = [r for r in log.records() if r["key"].startswith("run/")][-1:]
     if not last or any(last[0].get(k) != v for k, v in run.items()):
         started = time.strftime("%Y-%m-%dT%H:%M:%S")

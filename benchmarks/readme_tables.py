@@ -196,8 +196,9 @@ def population_table(doc: dict) -> str:
     lines = [*head, *block(doc["rows"]), "", "By size (masses, states or compartments; every class):", "", *head,
              *block(doc["size_rows"])]
     sizes = "; ".join(f"{k} {', '.join(map(str, v))}" for k, v in sorted(doc["sizes"].items()))
-    runs = "; ".join(f"{r['commit']} ({', '.join(r['methods'])}; n = {', '.join(map(str, r.get('sizes') or []))})"
-                     for r in doc.get("runs", []))
+    runs = "; ".join(f"{r['commit']} ({', '.join(r['methods'])}; n = {', '.join(map(str, r.get('sizes') or []))}"
+                     + (f"; {', '.join(r['rerun'])} run again, superseding earlier rows" if r.get("rerun") else "")
+                     + ")" for r in doc.get("runs", []))
     code = f"runs at {runs}" if runs else f"code {doc['commit']}"
     lines.append(f"\n{doc['problems']} problems (sizes: {sizes}); {code}.")
     skipped = doc.get("unresolved") or {}

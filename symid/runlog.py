@@ -174,6 +174,13 @@ class RunLog:
         """Every record under this view's prefix, in the order they were written."""
         return [r for k, r in self._records.items() if k.startswith(self.prefix)]
 
+    def forget(self, key: str) -> None:
+        """Drop a finished run from this view so that it is run again (nothing if it is not there).
+
+        The file keeps the old line; the record appended for the new run supersedes it
+        when the log is read back (the last line with a key wins)."""
+        self._records.pop(self.prefix + key, None)
+
     def append(self, key: str, record: Mapping[str, Any]) -> None:
         """Write one finished run (flushed and synced before returning)."""
         full = self.prefix + key

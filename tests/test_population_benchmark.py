@@ -101,6 +101,25 @@ def test_a_tiny_run_logs_resumes_and_summarises(bench, tmp_path):
     assert [(r["methods"], r["sizes"]) for r in doc["runs"]] == [(["lm", "ipopt"], [2])]  # the resume added none
 
 
+def test_rerun_runs_a_method_again_once_per_commit(bench, tmp_path):
+    _, pop = bench
+    log, out = tmp_path / "pop.jsonl", tmp_path / "pop.json"
+    argv = ["--classes", "compartment", "--sizes", "2", "--problems", "1", "--starts", "1", "--methods", "lm",
+            "--noise", "0", "--kinds", "uninformed", "--time-limit", "30", "--log", str(log), "--out", str(out)]
+    assert pop.main(argv) == 0
+    first = log.read_text(encoding="utf-8").splitlines()
+    assert pop.main([*argv, "--rerun", "lm"]) == 0
+    again = log.read_text(encoding="utf-8").splitlines()
+    # a run header naming the rerun, lm's setup and start again, and the marker of the finished rerun
+    added = [json.loads(line)["key"].split("/")[-1] for line in again[len(first):]]
+    assert added[0].startswith("20") and sorted(added[1:]) == ["rerun", "setup", "start0"]
+    assert pop.main([*argv, "--rerun", "lm"]) == 0  # this commit's rerun is done: nothing run again
+    assert log.read_text(encoding="utf-8").splitlines() == again
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    assert [r["starts"] for r in doc["rows"]] == [1]  # the new start replaces the old one; the marker is no start
+    assert doc["runs"][-1]["rerun"] == ["lm"]
+
+
 def test_resolution_is_the_first_order_misfit_of_the_worst_1e_3_error(bench):
     """population_models.resolution against a direct computation: the misfit of θ* (1 + δ) at the δ it
     implies (box-constrained, some |δₖ| = 1e-3) agrees to first order, and no single-parameter 1e-3 error
