@@ -39,6 +39,7 @@ from sympy import QQ
 from sympy.polys.matrices import DomainMatrix
 
 from symid.structural.local import LocalResult, PoleError, jacobian_at, random_point
+from symid.structural.modp import rank_mod_p
 
 __all__ = ["Combination", "linear_expression", "linear_space", "monomial_candidates", "parameters_to_fix",
            "poly_gradients", "rref_rows", "select_combinations"]
@@ -128,7 +129,9 @@ def linear_space(local: LocalResult, model=None, known: Mapping[str, object] | N
     ``model``, more random points are added (the exact Jacobian at each) until one more
     point leaves it unchanged (a spurious direction survives a random point with
     probability zero), at most ``max_points``. Without ``model`` only the points of
-    ``local`` are used.
+    ``local`` are used. The space's dimension while points are added is computed modulo a
+    31-bit prime; the space itself exactly, once (none when full rank modulo the prime
+    proves it is {0}).
 
     Examples
     --------
@@ -149,21 +152,31 @@ def linear_space(local: LocalResult, model=None, known: Mapping[str, object] | N
     def kernel_of(rows_: list) -> DomainMatrix:
         return DomainMatrix(rows_, (len(rows_), len(nonid)), QQ).nullspace()
 
-    kernel = kernel_of(rows)
+    def dimension(rows_: list) -> int:
+        # the kernel's dimension modulo p decides when to stop adding points (the null vectors' entries run to
+        # hundreds of digits: the exact kernel is computed once, at the end, and only when it is not {0}; full
+        # rank modulo p proves full rank over ℚ); a prime that divides a denominator: exact
+        r = rank_mod_p(rows_)
+        return len(nonid) - r if r >= 0 else kernel_of(rows_).shape[0]
+
+    dim = dimension(rows)
     rng = random.Random(20_011 + seed)
     for _ in range(max_points if model is not None else 0):
-        if kernel.shape[0] == 0:
+        if dim == 0:
             break
         try:
             J = jacobian_at(model, random_point(rng, len(params)), known)
         except PoleError:
             continue
         new_rows = [[vec[k] for k in nonid] for vec in J.nullspace().to_list()]
-        smaller = kernel_of(rows + new_rows)
+        smaller = dimension(rows + new_rows)
         rows += new_rows
-        if smaller.shape[0] == kernel.shape[0]:
+        if smaller == dim:
             break
-        kernel = smaller
+        dim = smaller
+    if dim == 0:
+        return []
+    kernel = kernel_of(rows)
     if kernel.shape[0] == 0:
         return []
     out = []
