@@ -340,3 +340,91 @@ def test_command_line_engine(capsys):
     assert main(["identifiability", "belt_drive", "--engine", "sympy", "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     assert rep["engine"] == "sympy" and rep["verdict"] == "global"
+
+
+# -- confirmation at θ** beside θ* (a spare core) ------------------------------------------
+
+def _slow_system() -> str:
+    # 7 dense cubics modulo a prime: 2187 solutions, about 3 s of msolve on this machine
+    import itertools
+    import random
+
+    rng = random.Random(0)
+    p = 1073741827
+    monos = [m for m in itertools.product(range(4), repeat=7) if sum(m) <= 3]
+    return input_text([{m: rng.randrange(1, p) for m in monos} for _ in range(7)], 7, p)
+
+
+@needs_msolve
+def test_a_cancelled_msolve_run_is_killed_at_once():
+    import threading
+
+    from symid.structural.msolve import MsolveCancelled, run_msolve
+
+    cancel = threading.Event()
+    threading.Timer(0.2, cancel.set).start()
+    t0 = time.perf_counter()
+    with pytest.raises(MsolveCancelled):
+        run_msolve(MSOLVE, _slow_system(), cancel=cancel)
+    assert time.perf_counter() - t0 < 1.5  # polled every 20 ms; the run alone takes seconds
+    # the same call without cancelling finishes and reads like the plain run's output
+    done = threading.Event()
+    assert run_msolve(MSOLVE, input_text([{(1,): 1, (0,): -2}], 1, 101), cancel=done).startswith("[0,")
+
+
+def test_a_call_ahead_starts_only_on_a_spare_core_and_is_taken_or_dropped():
+    import threading
+
+    from symid.structural.global_ import _Ahead
+
+    calls = []
+
+    def work(x, cancel):
+        calls.append(x)
+        return 2 * x
+
+    spare = threading.Event()
+    never = _Ahead(spare, work, {"x": 1})  # no spare core ever: never runs, the caller computes
+    assert never.take(wanted=True) is None and calls == []
+    spare.set()
+    ahead = _Ahead(spare, work, {"x": 3})
+    deadline = time.monotonic() + 10
+    while not calls and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert ahead.take(wanted=True) == 6 and calls == [3]
+
+    def cancelled(cancel):
+        assert cancel.wait(10)  # set by take(wanted=False)
+        raise AssertionError("never seen: the result is dropped")
+
+    dropped = _Ahead(spare, cancelled, {})
+    time.sleep(0.1)
+    assert dropped.take(wanted=False) is None
+
+
+@needs_msolve
+@pytest.mark.parametrize("name", ["mass_damper_2dof", "two compartments"])
+def test_confirmation_beside_theta_star_gives_the_same_result(name, monkeypatch):
+    import dataclasses
+    import threading
+
+    from symid.structural import global_
+
+    where = []
+
+    def confirm(*args, **kwargs):
+        where.append(threading.current_thread().name)
+        return confirm_mod_p(*args, **kwargs)
+
+    confirm_mod_p = global_.confirm_mod_p
+    monkeypatch.setattr(global_, "confirm_mod_p", confirm)
+    model = _two_compartments() if name == "two compartments" else si.load_model(name).model
+    n = len(model.parameters)
+    spare = threading.Event()
+    spare.set()
+    alone = global_.generic_global(model, rank=n, msolve=MSOLVE, seed=2)
+    beside = global_.generic_global(model, rank=n, msolve=MSOLVE, seed=2, spare_core=spare)
+    assert where == ["MainThread", "symid-confirm-ahead"]  # the second confirmation ran beside θ*
+    assert alone.engine == beside.engine == "msolve" and alone.confirmed
+    # θ*, θ**, counts, per-parameter verdicts, notes: all but the timings
+    assert dataclasses.replace(alone, times={}) == dataclasses.replace(beside, times={})

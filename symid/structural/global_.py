@@ -75,10 +75,12 @@ from __future__ import annotations
 
 import functools
 import random
+import threading
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -91,7 +93,7 @@ from sympy.polys.rings import PolyElement, PolyRing, ring
 from symid.errors import ModelError, SolverError
 from symid.structural.local import rank_at
 from symid.structural.modp import BadPrime, compile_poly, residue, value_mod_p
-from symid.structural.msolve import MsolveError, input_text, parse_output, run_msolve
+from symid.structural.msolve import MsolveCancelled, MsolveError, input_text, parse_output, run_msolve
 from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
     KIND_TF,
@@ -573,7 +575,8 @@ def _mod_p_modulus(rng: random.Random) -> int:
 
 def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int = 0, draw: int = 500,
                   rank: int | None = None, msolve: str | None = None,
-                  summary=None) -> tuple[bool, int | None, dict, dict]:
+                  summary=None, cancel: threading.Event | None = None,
+                  msolve_only: bool = False) -> tuple[bool, int | None, dict, dict] | None:
     """Solve summary(θ) = summary(θ**) modulo a random prime at an independent generic point θ**.
 
     Used to confirm global claims (:func:`generic_global`): the same algebra as
@@ -584,7 +587,9 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
     With ``msolve`` (the program's path), msolve's parametrization modulo p gives them
     when the ideal is radical there (the generic case); otherwise sympy's computation.
     ``summary``: θ*'s summary, reused when it is exhaustive at θ** too
-    (:func:`star_and_summary`).
+    (:func:`star_and_summary`). ``cancel``: an event that stops msolve once set
+    (:class:`~symid.structural.msolve.MsolveCancelled`); ``msolve_only``: return None
+    where msolve does not decide (instead of sympy's computation).
 
     Returns
     -------
@@ -605,9 +610,11 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
     else:  # pragma: no cover - ten random 31-bit primes dividing the denominators: practically impossible
         raise ExactStepLimit("no prime found that reduces the system at θ**")
     if reduced is not None:
-        found = _confirm_msolve(msolve, *reduced[:2], star, names, modulus, rng.randrange(2**31))
+        found = _confirm_msolve(msolve, *reduced[:2], star, names, modulus, rng.randrange(2**31), cancel=cancel)
         if found is not None:
             return (*found, theta2)
+    if msolve_only:
+        return None
     try:
         R, eqs, _ = _system(summ, params, pt, modulus)
     except (ZeroDivisionError, NotInvertible):  # pragma: no cover - a prime that reduces one form reduces the other
@@ -1196,12 +1203,12 @@ def _exact_zeros(par, var: Sequence[str], boxes, positive: Sequence[bool]) -> se
 
 
 def _confirm_msolve(binary: str, nvars: int, eqs: Sequence[dict], star, names: Sequence[str], modulus: int,
-                    seed: int):
+                    seed: int, cancel: threading.Event | None = None):
     """msolve's answer at θ** over GF(p) for the system of :func:`_system_mod_p`: (True, count, single-valued per
     parameter), or None when the ideal is not radical modulo p or not zero-dimensional there (then sympy decides)."""
     var = [f"x{i}" for i in range(nvars)]
     text = input_text(eqs, nvars, modulus)
-    out = parse_output(run_msolve(binary, text, options=("-P", "2"), seed=seed), var, modulus)
+    out = parse_output(run_msolve(binary, text, options=("-P", "2"), seed=seed, cancel=cancel), var, modulus)
     if out.status != "finite":
         return None
     par = out.param
@@ -1298,6 +1305,56 @@ def _at_more_points(res: GlobalResult, model, known, positive, seed: int, rank, 
     return replace(res, local_elsewhere=found, notes=(*res.notes, note))
 
 
+class _Ahead:
+    """A call run in a thread once a core is spare (``spare.wait``), for a result that may not be wanted.
+
+    :meth:`take` decides: a call not started by then never starts (None); with
+    ``wanted=True`` a started call is waited for and its result returned (None where its
+    msolve did not decide); with ``wanted=False`` it is cancelled (the call gets
+    ``cancel=``, a ``threading.Event`` that kills its msolve run).
+    """
+
+    def __init__(self, spare: Any, fn: Callable[..., Any], kwargs: dict):
+        self._lock = threading.Lock()
+        self._cancel = threading.Event()
+        self._closed = False
+        self._started = False
+        self._result: Any = None
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, args=(spare, fn, kwargs), daemon=True,
+                                        name="symid-confirm-ahead")
+        self._thread.start()
+
+    def _run(self, spare: Any, fn: Callable[..., Any], kwargs: dict) -> None:
+        while True:
+            free = spare.wait(0.02)
+            with self._lock:
+                if self._closed:
+                    return
+                if free:
+                    self._started = True
+                    break
+        try:
+            self._result = fn(**kwargs, cancel=self._cancel)
+        except MsolveCancelled:
+            pass
+        except BaseException as exc:  # raised where the result is taken
+            self._error = exc
+
+    def take(self, *, wanted: bool) -> Any:
+        with self._lock:
+            self._closed = True
+            started = self._started
+        if not wanted:
+            self._cancel.set()
+        self._thread.join()
+        if not (started and wanted):
+            return None
+        if self._error is not None:
+            raise self._error
+        return self._result
+
+
 def _claims_global(res: GlobalResult) -> bool:
     return (res.zero_dimensional and res.n_complex == 1) or any(res.global_complex.values())
 
@@ -1308,7 +1365,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
                    confirm_known: Mapping[str, object] | None = None,
                    linear_forms: Sequence[Mapping[str, Fraction]] = (),
                    extra_known: Sequence[Mapping[str, object]] | None = None,
-                   local_only: Sequence[str] | None = None, settle: Sequence[str] | None = None) -> GlobalResult:
+                   local_only: Sequence[str] | None = None, settle: Sequence[str] | None = None,
+                   spare_core: Any = None) -> GlobalResult:
     """:func:`global_analysis` at a θ* checked to be generic, and its global claims confirmed at a second point.
 
     1. θ* is drawn (:func:`draw_point`) until the Jacobian has the generic rank
@@ -1332,6 +1390,10 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     known values at each; default ``known``): two admissible solutions that differ in it
     there prove it not global (``local_elsewhere``; only the parameters named in
     ``local_only``, when given). ``settle``: as for :func:`global_analysis`.
+    ``spare_core``: an event (``threading`` or ``multiprocessing``) set when a processor
+    core is free; with msolve, the confirmation at θ** then starts beside the step at θ*
+    (its msolve in a process of its own), and is used when θ* claims anything global
+    (otherwise stopped). The result is the same as without it, only sooner.
 
     Examples
     --------
@@ -1344,29 +1406,44 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     """
     notes: list[str] = []
     res = None
-    for draw in range(MAX_DRAWS):
-        prepared = star_and_summary(model, known, seed=seed, draw=draw, rank=rank)
-        if msolve is not None and rank != len(prepared[0]):
-            msolve = None  # infinitely many solutions: sympy (radical membership, basis candidates)
-        try:
-            res = global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
-                                  expressions=expressions, prepared=prepared, msolve=msolve, linear_forms=linear_forms,
-                                  settle=settle)
-            break
-        except NonGenericPoint as exc:
-            star = ", ".join(str(v) for v in prepared[1])
-            notes.append(f"θ* = ({star}) was not generic ({exc}); drawn again")
-    if res is None:
-        raise ExactStepLimit(f"no generic point θ* in {MAX_DRAWS} random draws")
-    draws = draw + 1
-    res = _at_more_points(res, model, known, positive, seed, rank, msolve, prepared[3], linear_forms, extra_known,
-                          local_only)
-    if not _claims_global(res):
-        return replace(res, notes=(*res.notes, *notes), draws=draws)
-    zero2, count2, single2, theta2 = confirm_mod_p(model, known if confirm_known is None else confirm_known,
-                                                   seed=seed, draw=500, rank=rank,
-                                                   msolve=msolve if res.engine == "msolve" else None,
-                                                   summary=prepared[3] if confirm_known is None else None)
+    ahead: _Ahead | None = None
+    confirm_args = {"known": known if confirm_known is None else confirm_known, "seed": seed, "draw": 500,
+                    "rank": rank}
+    try:
+        for draw in range(MAX_DRAWS):
+            prepared = star_and_summary(model, known, seed=seed, draw=draw, rank=rank)
+            if msolve is not None and rank != len(prepared[0]):
+                msolve = None  # infinitely many solutions: sympy (radical membership, basis candidates)
+            if draw == 0 and msolve is not None and spare_core is not None:
+                ahead = _Ahead(spare_core, confirm_mod_p, {"model": model, **confirm_args, "msolve": msolve,
+                                                           "summary": prepared[3] if confirm_known is None else None,
+                                                           "msolve_only": True})
+            try:
+                res = global_analysis(model, known, positive=positive, seed=seed, extra_candidates=extra_candidates,
+                                      expressions=expressions, prepared=prepared, msolve=msolve,
+                                      linear_forms=linear_forms, settle=settle)
+                break
+            except NonGenericPoint as exc:
+                star = ", ".join(str(v) for v in prepared[1])
+                notes.append(f"θ* = ({star}) was not generic ({exc}); drawn again")
+        if res is None:
+            raise ExactStepLimit(f"no generic point θ* in {MAX_DRAWS} random draws")
+        draws = draw + 1
+        res = _at_more_points(res, model, known, positive, seed, rank, msolve, prepared[3], linear_forms,
+                              extra_known, local_only)
+        if not _claims_global(res):
+            return replace(res, notes=(*res.notes, *notes), draws=draws)
+        # the run started beside θ* had the same arguments as this call when θ* was the first draw and msolve
+        # decided there; otherwise (or when it never started for want of a spare core) the confirmation runs now
+        found = ahead.take(wanted=True) if ahead is not None and draws == 1 and res.engine == "msolve" else None
+        ahead = None
+        if found is None:
+            found = confirm_mod_p(model, **confirm_args, msolve=msolve if res.engine == "msolve" else None,
+                                  summary=prepared[3] if confirm_known is None else None)
+        zero2, count2, single2, theta2 = found
+    finally:
+        if ahead is not None:
+            ahead.take(wanted=False)
     glob_c = {k: v and single2.get(k, False) for k, v in res.global_complex.items()}
     agree = glob_c == res.global_complex and zero2 == res.zero_dimensional and count2 == res.n_complex
     if not agree:

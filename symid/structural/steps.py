@@ -24,9 +24,12 @@ weaker verdict):
 
 from __future__ import annotations
 
+import multiprocessing as mp
+import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import sympy as sp
 
@@ -48,18 +51,30 @@ _LIMITS = ("ExactStepLimit", "MemoryError")
 
 
 def _global_step(model, known, positive, seed, extra_candidates, expressions, rank, msolve=None, fix=(),
-                 linear_forms=(), identifiable=None):
+                 linear_forms=(), identifiable=None, spare_core=None):
     """A generic θ*, the summary and the Gröbner step (confirmed at θ**), in one child process.
 
     ``fix``: for a model that is not locally identifiable, the parameters that cut its solution set
     (:mod:`~symid.structural.slicing`), and ``linear_forms`` the linear functions whose single-valued
-    combinations are asked.
+    combinations are asked. ``spare_core``: an event the parent sets when the witness search no longer
+    needs its core (:func:`~symid.structural.global_.generic_global` then confirms at θ** beside θ*).
     """
     if fix:
         return sliced_global(model, known, fix=fix, positive=positive, seed=seed, extra_candidates=extra_candidates,
                              msolve=msolve, linear_forms=linear_forms, identifiable=identifiable)
     return generic_global(model, known, positive=positive, seed=seed, rank=rank, extra_candidates=extra_candidates,
-                          expressions=expressions, msolve=msolve)
+                          expressions=expressions, msolve=msolve, spare_core=spare_core)
+
+
+def _spare_core_event() -> Any:
+    """An event shared with child processes, or None on a machine with one usable core (nothing to spare)."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not on Linux
+        cores = os.cpu_count() or 1
+    if cores < 2:
+        return None
+    return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn").Event()
 
 
 def _witness_step(model, known, positive, seed, rank):
@@ -217,11 +232,14 @@ def _side_by_side(model, known, names, positive, seed, g_kwargs, full_rank, exac
     gjob: Running | None = None
     wjob: Running | None = None
     status, value = "timeout", None
+    spare = _spare_core_event()  # set once the witness search is not (or no longer) running
     try:
-        gjob = start(_global_step, g_kwargs)
+        gjob = start(_global_step, {**g_kwargs, "spare_core": spare})
         if full_rank and gjob.wait(min(HEAD_START, left()))[0] == "timeout":  # a fast basis needs no witnesses
             wjob = start(_witness_step, {"model": model, "known": known, "positive": list(positive), "seed": seed,
                                          "rank": rank})
+        elif spare is not None:
+            spare.set()
         while True:
             wait_any([j for j in (gjob, wjob) if j is not None], left())
             status, value = gjob.wait(0)
@@ -231,6 +249,8 @@ def _side_by_side(model, known, names, positive, seed, g_kwargs, full_rank, exac
                 wstatus, wit = wjob.wait(0)
                 if wstatus != "timeout":
                     wjob = None
+                    if spare is not None:
+                        spare.set()
                     why = limit_reason("numerical search for a second solution", wstatus, wit)
                     if why is not None:
                         out.notes.append(why)
