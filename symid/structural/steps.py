@@ -5,7 +5,10 @@ and the numerical witness search then run side by side in two child processes
 (:mod:`~symid.structural.deadline`), started once each (the witness search after a
 head start of ``HEAD_START`` s, and only if the basis is not ready by then). Certified witnesses that move
 every parameter settle the verdicts and the Gröbner child is stopped (unless
-``exact_count``); otherwise the Gröbner child has the rest of the budget.
+``exact_count``); otherwise the Gröbner child has the rest of the budget. Once the
+witness search has ended (or when it is not run), the Gröbner child is told that a core
+is spare and starts the confirmation at θ** beside the step at θ*
+(:func:`~symid.structural.global_.generic_global`'s ``spare_core``).
 
 How an outcome is read (issue 12, item 5: an internal failure is never turned into a
 weaker verdict):
