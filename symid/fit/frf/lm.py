@@ -42,21 +42,33 @@ in physical units, whatever their scale (measured on the generated population of
 5. **A fit is doubted when a black box fits much better.** A fit that is not exact
    (misfit above 1e-10: the whiteness or noise-floor rule of :mod:`symid.fit.success`
    accepted it) does not stop the restarts while a vector fit of the data with as many
-   poles as the model has states (:meth:`LmFRF.black_box_floor`, a few milliseconds,
+   poles as the model has states (:meth:`LmFRF.black_box_floor`, milliseconds,
    built once per estimator) fits them more than ten times better: no grey box of that
    order can do much better than that black box, so a wide gap says the data are cleaner
-   than the fit. On noise-free data of generated 5- and 8-mass chains the whiteness rule
-   accepted misfits of 2e-9 to 2e-6 at parameter errors far above 100 % (the black box:
-   below 1e-23), and ``auto`` stopped there. On noisy data the black box is no better
-   than the noise allows (on 1 % noise about half to all of the misfit at the truth), so
-   a correct fit is not doubted. The outcome's ``success`` is still the success rule's.
+   than the fit. On noise-free data the whiteness rule accepted misfits of 2e-9 on an
+   8-mass chain with two sensors (the population benchmark's chain_sensors-n8-1, three of
+   four starts, parameters 280 % to 6600 % off, before this rule) and 2.3e-6 on a 5-mass
+   chain (50 000 % off), and ``auto`` stopped there; the black box fits such data to
+   rounding. On noisy data it is no better than the noise allows, so a correct fit is not
+   doubted (tests/test_lm_auto.py: on 1 % noise of a 5-mass chain, between 0.2 and 1 times
+   the misfit at the truth). The outcome's ``success`` is still the success rule's.
 
-Measured on the population benchmark (``benchmarks/population.py``, README): the
-restarts around the typical values and the doubt together.
+Measured on generated 5-mass chains the population benchmark does not use (noise-free,
+uninformed starts, 45 s each; ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python
+benchmarks/auto_restarts.py``): the truth from 4 of 8 starts with every restart around
+the start, 5/8 with every other one around the typical values, 6/8 with the doubt too
+(one start settled for a whiteness fit at misfit 2e-6, 500-fold off; with the doubt it
+went on to the truth in 8 s). On the population benchmark's own n = 5 and 8 problems
+(README) no noise-free row moved: its misses there are 5- and 8-mass chains where the
+passes end in other basins or, at n = 8, 45 s hold only 3–5 passes of 10–20 s each.
 
 Also tried and not kept: a pass from the black-box start of
 :func:`symid.fit.frf.modal.black_box_start` (the model's poles placed on a vector fit's)
-when the pass from the start does not fit (``benchmarks/black_box_pass.py``).
+when the pass from the start does not fit. It is cheap (0.6 s to build at 5 masses, 1.2 s
+at 8, median) but rarely near enough: on exact data of generated chains, chains with two
+sensors and chains with gains the benchmark does not use, one ``auto`` pass from it reached
+the truth on 3 of 8 problems at n = 5 and 1 of 5 at n = 8 (a median 15–17 % of its
+parameters more than a factor 10 off; ``benchmarks/black_box_pass.py``).
 
 Also tried in earlier probes and not kept: basin hopping around the best point so far (worse
 than restarts around the start: 0/5 against 3/5 on a 3-mass chain), and a homotopy that
@@ -109,14 +121,15 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     data : FrequencyData
     scale : array_like, optional
         Typical magnitude of each parameter (one number or one per parameter): the unit
-        of φ for parameters of either sign, and the centre of restarts for a parameter
-        whose start is 0. Default: the start itself (|x0ₖ|, or 1 where x0ₖ = 0).
+        of φ for parameters of either sign, the centre of every other restart of the
+        parameters declared positive, and of all restarts for a parameter whose start is
+        0. Default: the start itself (|x0ₖ|, or 1 where x0ₖ = 0).
     restarts : int, optional
         Further passes from random points when the estimate does not fit the data
         (default 0 for ``"lm"``, 30 for ``"auto"``).
     spread : float, optional
-        Restart points are drawn log-uniformly within a factor ``spread`` of the start
-        (default 10: two decades around it).
+        Restart points are drawn log-uniformly within a factor ``spread`` of the start,
+        every other one of ``scale`` when it is given (default 10: two decades around it).
     bands : int, optional
         Continuation over frequency: stage 1 first fits the lowest 1/``bands`` of the
         lines, then 2/``bands``, ..., then all of them (default 1, no continuation, for
