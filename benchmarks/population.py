@@ -45,7 +45,11 @@ Run (one BLAS thread per process)::
 
 Every finished start is appended to ``benchmarks/results/population.jsonl`` (``--log``) as
 it ends; running the command again resumes (finished starts are read back), ``--fresh``
-starts over. ``--summary-only`` rebuilds the summary from the log. The summary
+starts over. A finished start is never run again unless its method is named in
+``--rerun`` (after a change to the method): its logged starts on the problems of this run
+are then run again once by the current commit, the new records superseding the old ones (a
+``rerun`` marker per problem, noise level and kind of start records the finished rerun, so a
+resumed rerun does not repeat it). ``--summary-only`` rebuilds the summary from the log. The summary
 (``benchmarks/results/population.json``, the README table's source) is rewritten from the
 whole log after every problem, so it always describes exactly what the log holds.
 ``--workers N`` runs the starts in a local process pool; ``--dask ADDRESS`` on a Dask
