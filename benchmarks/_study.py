@@ -15,6 +15,7 @@ without writing the summary.
 from __future__ import annotations
 
 import argparse
+import subprocess
 import sys
 import time
 from collections.abc import Callable, Mapping
@@ -23,9 +24,18 @@ from typing import Any
 
 from symid.runlog import RunLog, json_safe, write_json_atomic
 
-__all__ = ["add_log_arguments", "finish_log", "logged", "run_study"]
+__all__ = ["add_log_arguments", "finish_log", "git_commit", "logged", "run_study"]
 
 RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def git_commit() -> str:
+    """The short hash of the checked-out commit (which code a result came from), or ``"unknown"``."""
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True,
+                              cwd=Path(__file__).resolve().parent).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
 
 
 def add_log_arguments(parser: argparse.ArgumentParser, name: str) -> None:

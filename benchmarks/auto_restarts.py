@@ -30,7 +30,6 @@ import argparse
 import json
 import math
 import platform
-import subprocess
 import sys
 import time
 from collections import defaultdict
@@ -42,6 +41,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+from _study import git_commit  # noqa: E402
 from population import parameter_error  # noqa: E402
 from population_models import RESOLUTION_FLOOR, make_problem  # noqa: E402
 
@@ -95,8 +95,7 @@ def main(argv: list[str] | None = None) -> int:
         groups[r["variant"]].append(r)
     summary = [{"variant": v, "starts": len(groups[v]), "truth": sum(r["truth"] for r in groups[v]),
                 "median_seconds": float(np.median([r["seconds"] for r in groups[v]]))} for v in VARIANTS if groups[v]]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     doc = {"command": " ".join(["benchmarks/auto_restarts.py", *(argv if argv is not None else sys.argv[1:])]),
            "commit": commit, "python": platform.python_version(), "wall_seconds": time.perf_counter() - t0,
            "summary": summary, "rows": rows}

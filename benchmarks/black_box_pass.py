@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import json
 import platform
-import subprocess
 import sys
 import time
 import warnings
@@ -41,6 +40,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+from _study import git_commit  # noqa: E402
 from population import parameter_error  # noqa: E402
 from population_models import RESOLUTION_FLOOR, make_problem  # noqa: E402
 
@@ -115,8 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = run(args.classes.split(","), [int(v) for v in args.sizes.split(",")],
                [int(v) for v in args.indices.split(",")], [float(v) for v in args.noise.split(",")], args.time_limit)
     summary = summarise(rows)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     doc = {"command": " ".join(["benchmarks/black_box_pass.py", *(argv if argv is not None else sys.argv[1:])]),
            "commit": commit, "python": platform.python_version(), "wall_seconds": time.perf_counter() - t0,
            "summary": summary, "rows": rows}

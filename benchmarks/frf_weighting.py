@@ -35,11 +35,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import time
 from pathlib import Path
 
 import numpy as np
+from _study import git_commit  # benchmarks/_study.py (the script's folder is on the path)
 
 import symid as si
 from symid.fit.frf.ls import LinearFRF
@@ -142,8 +142,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{problem:16} {method:11} {profile:7} {n:7d} {r['mse_weighted']:12.3e} {r['mse_equal']:10.3e} "
               f"{r['ratio']:7.3f} {r['successes_weighted']:3d}/{r['successes_equal']:<4d} "
               f"{r['median_seconds']:6.3f}  {se}", flush=True)
-    code = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                          cwd=Path(__file__).resolve().parent).stdout.strip()
+    code = git_commit()
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps({"code": code, "records": args.records, "scr_records": args.scr_records,

@@ -62,7 +62,6 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import subprocess
 import sys
 import time
 import warnings
@@ -73,6 +72,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _study import git_commit  # benchmarks/ (the script's folder) is on the path
 from population_models import (  # benchmarks/ (the script's folder) is on the path
     CLASSES,
     RESOLUTION_FLOOR,
@@ -249,14 +249,6 @@ def summarise(log: RunLog) -> dict[str, Any]:
             "unresolved": {k: unresolved[k] for k in sorted(unresolved)}}
 
 
-def _git_commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True,
-                              cwd=Path(__file__).resolve().parent).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
 def print_table(summary: dict[str, Any]) -> None:
     head = ("class", "method", "noise", "starts", "problems", "success", "median s/start", "time to solution s")
     print(" | ".join(head))
@@ -303,7 +295,7 @@ def main(argv: list[str] | None = None) -> int:
     args.kinds = [k for k in args.kinds.split(",") if k]
     sizes = [int(v) for v in args.sizes.split(",") if v]
     log = RunLog(args.log, fresh=args.fresh)
-    args.commit = _git_commit()
+    args.commit = git_commit()
     header = {"commit": args.commit, "machine": platform.machine(), "cpus": os.cpu_count(),
               "python": platform.python_version()}
 
