@@ -26,13 +26,16 @@ On POSIX the child leads its own process group, and stopping it kills the whole 
 a program it runs (msolve, :mod:`~symid.structural.msolve`) is stopped with it, at the
 deadline or when the parent has gone. A child killed at its deadline cannot clean up
 after itself, so its temporary files (:mod:`tempfile`, e.g. msolve's input and output)
-go to a directory of its own that the parent removes when it stops the child.
+go to a directory of its own that the parent removes when it stops the child. The child
+creates that directory itself, under a random name the parent chose: a parent killed
+between creating it and starting the child would leave it behind for good.
 """
 
 from __future__ import annotations
 
 import multiprocessing as mp
 import os
+import secrets
 import shutil
 import signal
 import tempfile
@@ -81,6 +84,13 @@ def _kill_own_group() -> None:  # pragma: no cover - runs in the child process
 
 def _child(conn, fn, kwargs, parent, scratch):  # pragma: no cover - runs in the child process
     _lead_own_group()
+    try:  # created here, not by the parent: a parent killed before the fork leaves no directory behind
+        os.mkdir(scratch, 0o700)
+    except OSError as exc:
+        conn.send(("error", (type(exc).__name__, f"the job's temporary directory: {exc}",
+                             traceback.format_exc(limit=8))))
+        conn.close()
+        return
     tempfile.tempdir = scratch  # this process's temporary files go where the parent removes them
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent decides, and stops this process
     _exit_when_orphaned(parent, scratch)
@@ -126,7 +136,9 @@ class Running:
         ctx = mp.get_context(method)
         self._outcome: tuple[str, Any] | None = None
         self._recv, send = ctx.Pipe(duplex=False)
-        self._scratch = tempfile.mkdtemp(prefix="symid-job-")
+        # The child creates its temporary directory (see ``_child``) under a name chosen here, so that
+        # the parent can remove it after a kill, and a parent killed before the fork leaves nothing.
+        self._scratch = os.path.join(tempfile.gettempdir(), f"symid-job-{secrets.token_hex(8)}")
         self._proc = ctx.Process(target=_child, args=(send, fn, dict(kwargs), os.getpid(), self._scratch),
                                  daemon=True, name=f"symid-{getattr(fn, '__name__', 'job')}")
         self.started = time.monotonic()
