@@ -322,8 +322,8 @@ def test_bounds_reach_a_method_that_takes_them(capsys):
 
 
 OPTION_ERRORS = {
-    "time limit on ls": (["identify", "belt_drive", "--method", "ls", "--time-limit", "5"],
-                         "--time-limit: not taken by method 'ls'"),
+    "backend on ls": (["identify", "belt_drive", "--method", "ls", "--backend", "admm"],
+                      "--backend: not taken by method 'ls'"),
     "backend on ipopt": (["identify", "belt_drive", "--method", "ipopt", "--backend", "admm"],
                          "--backend: not taken by method 'ipopt'"),
     "x0 incomplete": (["identify", "belt_drive", "--x0", "theta1=1"], "x0: start lacks theta2, theta3, theta4"),

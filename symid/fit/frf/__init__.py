@@ -22,9 +22,11 @@ from symid.fit.frf.misfit import check_frf
 from symid.fit.frf.scale import typical_scale
 from symid.fit.options import check_bool, check_known_names
 
-__all__ = ["METHODS", "prepare", "typical_scale"]
+__all__ = ["METHODS", "SHARED_OPTIONS", "prepare", "typical_scale"]
 
 METHODS = ("scr", "ipopt", "ls", "lm", "auto")
+SHARED_OPTIONS = ("variance", "time_limit", "callback", "verbose")
+"""Options of ``"scr"`` that pass to ``"ls"`` when the linear case runs instead (both take them, alike)."""
 
 
 def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
@@ -34,8 +36,8 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     ``"scr"`` on a second-order model whose C or B is known, square and invertible runs
     the exact linear least squares instead (reported as method ``"ls"``, with the reason
     in ``options["chosen_because"]``); ``force_scr=True`` runs SCR anyway, and SCR
-    options given without it are refused (they would be ignored), except ``variance``,
-    which both take.
+    options given without it are refused (they would be ignored), except those both take:
+    ``variance``, ``time_limit``, ``callback`` and ``verbose`` (:data:`SHARED_OPTIONS`).
     """
     from symid.fit.frf.ipopt import IpoptFRF
     from symid.fit.frf.lm import AutoFRF, LmFRF
@@ -60,7 +62,7 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     check_known_names("method 'scr' (frequency response)", opts, (*ScrFRF.option_names(), "force_scr"))
     case = ls_applicable(model) if isinstance(model, SecondOrderModel) else None
     if case is not None and not force:
-        shared = {k: opts.pop(k) for k in ("variance",) if k in opts}  # options both methods take
+        shared = {k: opts.pop(k) for k in SHARED_OPTIONS if k in opts}
         if opts:
             raise OptionError(f"options {', '.join(sorted(opts))} are SCR options, but the linear least squares "
                               f"({case} case, thesis (4-10)/(4-11)) applies and runs instead; pass force_scr=True "

@@ -14,10 +14,11 @@ import numpy as np
 
 from symid.errors import ModelError
 from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted
-from symid.fit.options import check_bool, check_choice
+from symid.fit.options import check_bool, check_choice, check_time_limit
 from symid.fit.result import StartOutcome
+from symid.fit.similarity.data import budget_message
 
-__all__ = ["LinearFRF", "ls_applicable"]
+__all__ = ["LinearFRF", "equation_residual", "ls_applicable"]
 
 _GLS_MAX = 50  # solves of the iterated noise-weighted least squares (class text)
 
@@ -113,6 +114,20 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         ``False`` returns the unconstrained solution, never a success when a declared-positive
         parameter comes out negative.
     {variance}
+    time_limit : float, optional
+        Wall-time budget of one run in seconds, checked after every solve of the
+        noise-weighted iteration (status ``"time_limit"``; the last solve's estimate is
+        kept, not weighted to its fixed point, so the run is not finished and never a
+        success). Default: none (one solve without a variance; with one, 3–6 measured,
+        at most 50).
+    callback : callable, optional
+        Called after every solve with a :class:`symid.engine.scr.ScrProgress` (solve,
+        residual ‖Jθ + r₀‖ / ‖|r₀| + |J| |θ|‖ of the (weighted) linear equations relative
+        to the size of their terms, data misfit, elapsed seconds, θ); the bounded least
+        squares of ``positivity`` is one more solve. A true return value stops the
+        noise-weighted iteration (status ``"stopped"``).
+    verbose : bool, optional
+        Print one line per solve (solve, residual, misfit, elapsed). Default False.
 
     Examples
     --------
@@ -129,7 +144,8 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
     method = "ls"
 
     def __init__(self, model: Any, data: Any, *, case: str | None = None, positivity: bool = True,
-                 variance: Any = "data"):
+                 variance: Any = "data", time_limit: float | None = None, callback: Any = None,
+                 verbose: bool = False):
         if case is None:
             case = ls_applicable(model)
         if case is None:
@@ -142,8 +158,12 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
             raise ModelError(f"case='actuators' needs B known, square and invertible; here: {_why_not(model)}")
         self.model, self.data, self.case = model, data, case
         self.positivity = check_bool("positivity", positivity)
+        self.time_limit = check_time_limit("time_limit", time_limit)
+        self._progress_options(callback, verbose)
         label = self.set_variance(variance)
-        self.options = {"case": case, "positivity": self.positivity, "variance": label}
+        self.options = {"case": case, "positivity": self.positivity, "variance": label,
+                        "time_limit": self.time_limit, "callback": None if callback is None else "given",
+                        "verbose": self._verbose}
         w = np.asarray(data.w, dtype=float)
         H = np.asarray(data.H, dtype=complex)
         second = "M" in model.maps
@@ -224,11 +244,21 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         r0 = np.concatenate([W @ r for W, r in zip(Ws, self._rows0, strict=True)])
         return np.vstack([J.real, J.imag]), np.concatenate([r0.real, r0.imag])
 
-    def _gls(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-        """The iterated noise-weighted solution from ``theta`` (class text): θ̂, its J and r0, and the solves."""
+    def _gls(self, theta: np.ndarray, report: Any = None, deadline: float | None = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, str]:
+        """The iterated noise-weighted solution from ``theta`` (the unweighted solution, solve 1; class text):
+        θ̂, its J and r0, the solves and the status: ``"solved"`` (θ̂ moved less than 1e-12, or 50 solves),
+        ``"stopped"`` (``report`` returned True after a solve) or ``"time_limit"`` (``deadline`` passed after a
+        solve with more to do)."""
         norms = self._norms
         solves = 1  # the unweighted solution that started it
-        while solves <= _GLS_MAX:
+        asked = report is not None and report(1, equation_residual(self._J, self._r0, theta), theta)
+        J, r0 = self._J, self._r0
+        while solves < _GLS_MAX + 1:
+            if asked:
+                return theta, J, r0, solves, "stopped"
+            if deadline is not None and time.perf_counter() >= deadline:
+                return theta, J, r0, solves, "time_limit"
             solves += 1
             J, r0 = self._weighted_system(theta)
             cn = np.linalg.norm(J, axis=0)
@@ -236,9 +266,10 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
             new = np.linalg.lstsq(J / cn, -r0, rcond=None)[0] / cn
             done = np.linalg.norm((new - theta) * norms) <= 1e-12 * np.linalg.norm(new * norms)
             theta = new
+            asked = report is not None and report(solves, equation_residual(J, r0, theta), theta)
             if done:
                 break
-        return theta, J, r0, solves
+        return theta, J, r0, solves, "solved"
 
     def _bounded(self, pos: np.ndarray, J: np.ndarray, r0: np.ndarray) -> tuple[np.ndarray, str]:
         """min ‖Jθ + r0‖ with θₖ ≥ 0 where ``pos``: bounded-variable least squares on unit-norm columns."""
@@ -256,25 +287,59 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         return theta, how
 
     def run(self, x0: np.ndarray | None = None) -> StartOutcome:
-        """Solve the least squares (the start is irrelevant; kept for a uniform signature)."""
+        """Solve the least squares (the start is irrelevant; kept for a uniform signature).
+
+        Without a variance, one solve; with one, the noise-weighted iteration (class text),
+        which ``time_limit`` and ``callback`` may stop after any solve (status
+        ``"time_limit"`` or ``"stopped"``, not finished: never a success). The bounded least
+        squares of ``positivity`` is applied to the estimate kept in every case.
+        """
         t0 = time.perf_counter()
+        deadline = None if self.time_limit is None else t0 + self.time_limit
+        report = self.progress_reporter(t0)
         theta = np.linalg.lstsq(self._J / self._norms, -self._r0, rcond=None)[0] / self._norms
-        J, r0, solves = self._J, self._r0, 1
+        J, r0, solves, status, asked = self._J, self._r0, 1, "solved", False
         start = np.zeros(self.model.n_parameters) if x0 is None else np.asarray(x0, dtype=float)
         msg = f"linear least squares ({self.case} case)"
         if self.line_variance is not None:
-            theta, J, r0, solves = self._gls(theta)
+            theta, J, r0, solves, status = self._gls(theta, report, deadline)
             msg = (f"linear least squares ({self.case} case), noise-weighted: generalised least squares on the "
                    f"equation error, {solves} solves")
+            if status == "time_limit":
+                msg += "; " + budget_message(self.time_limit, solves, "solve") + " (not weighted to its fixed point)"
+            elif status == "stopped":
+                msg += f"; stopped by the callback after {solves} solves (not weighted to its fixed point)"
+        elif report is not None:  # one solve: nothing left for a stop to cut short
+            asked = report(1, equation_residual(J, r0, theta), theta)
         pos = np.array(self.model.positive, dtype=bool)
         negative = [n for n, p, v in zip(self.model.parameter_names, pos, theta, strict=True) if p and v < 0]
+        iterations = solves
         if negative and self.positivity:
             theta, how = self._bounded(pos, J, r0)
+            iterations += 1
             msg += f"; the unconstrained solution had {', '.join(negative)} < 0: {how}"
+            if report is not None and status == "solved" and not asked:
+                report(iterations, equation_residual(J, r0, theta), theta)
         elif negative:
             msg += f"; parameters declared positive came out negative: {', '.join(negative)} (positivity=False)"
-        return self.outcome(start, theta, finished=True, status="solved", message=msg, iterations=solves,
-                            wall_time=time.perf_counter() - t0)
+        return self.outcome(start, theta, finished=status == "solved", status=status, message=msg,
+                            iterations=iterations, wall_time=time.perf_counter() - t0)
+
+
+def equation_residual(J: np.ndarray, r0: np.ndarray, theta: np.ndarray) -> float:
+    """‖Jθ + r₀‖ / ‖|r₀| + |J| |θ|‖: the residual of the linear equations Jθ + r₀ = 0 relative to the size of
+    their terms (0 when every term is 0).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.frf.ls import equation_residual
+    >>> equation_residual(np.array([[1.0]]), np.array([-3.0]), np.array([1.0]))     # |1 − 3| / (3 + 1)
+    0.5
+    """
+    top = float(np.linalg.norm(J @ theta + r0))
+    size = float(np.linalg.norm(np.abs(r0) + np.abs(J) @ np.abs(theta)))
+    return top / size if size > 0 else 0.0
 
 
 LinearFRF.__doc__ = (LinearFRF.__doc__ or "").replace("{variance}", VARIANCE_OPTION_DOC)

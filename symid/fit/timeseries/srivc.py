@@ -53,8 +53,9 @@ import scipy.linalg
 import sympy as sp
 
 from symid.errors import ModelError, OptionError
-from symid.fit.options import check_choice, check_float, check_int
+from symid.fit.options import check_choice, check_float, check_int, check_time_limit
 from symid.fit.result import StartOutcome
+from symid.fit.similarity.data import budget_message
 from symid.fit.timeseries.blackbox import JudgedOnSamples
 from symid.fit.timeseries.oe import OutputError
 from symid.fit.timeseries.response import interval_groups
@@ -264,6 +265,12 @@ def _stable(den: np.ndarray) -> tuple[np.ndarray, bool]:
     return np.real(np.poly(roots))[1:][::-1].copy(), True
 
 
+def _relative_residual(Phi: np.ndarray, b: np.ndarray, theta: np.ndarray) -> float:
+    """‖Φθ − b‖ / ‖b‖ (0 when b = 0)."""
+    size = float(np.linalg.norm(b))
+    return float(np.linalg.norm(Phi @ theta - b)) / size if size > 0 else 0.0
+
+
 class SimplifiedRIVC(JudgedOnSamples):
     """SRIVC: prefilter by the model's own denominator, instruments from its noise-free output (module text).
 
@@ -293,6 +300,17 @@ class SimplifiedRIVC(JudgedOnSamples):
         constants of the slowest root of D at each iterate.
     initial_state : None, "estimate" or array_like, optional
         For the misfit to the samples (as :class:`~symid.fit.timeseries.oe.OutputError`).
+    time_limit : float, optional
+        Wall-time budget of one start in seconds, the least-squares start included,
+        checked after every iteration (status ``"time_limit"``; the last iterate is kept,
+        and the start is not finished, so never a success). Default: none.
+    callback : callable, optional
+        Called after every iteration with a :class:`symid.engine.scr.ScrProgress`
+        (iteration, residual ‖Φθ − b‖ / ‖b‖ of the equation prefiltered by the iteration's
+        1/D(s, θ̂), misfit to the samples, elapsed seconds, θ); a true return value stops
+        the start (status ``"stopped"``).
+    verbose : bool, optional
+        Print one line per iteration (iteration, residual, misfit, elapsed). Default False.
 
     Examples
     --------
@@ -312,7 +330,8 @@ class SimplifiedRIVC(JudgedOnSamples):
 
     def __init__(self, model: Any, data: Any, *, init: str = "ls", bandwidth: float | None = None,
                  max_iter: int = 20, tol: float = 1e-9, hold: str = "zoh", skip: float | None = None,
-                 initial_state: Any = None):
+                 initial_state: Any = None, time_limit: float | None = None, callback: Any = None,
+                 verbose: bool = False):
         self.samples = OutputError(model, data, initial_state=initial_state)
         self.model, self.data = model, data
         self.poly = transfer_polynomials(model)
@@ -324,6 +343,8 @@ class SimplifiedRIVC(JudgedOnSamples):
         self._max_iter = check_int("max_iter", max_iter, low=1, high=10**4)
         self._tol = check_float("tol", tol, low=0, strict_low=True)
         self._hold = check_choice("hold", hold, _HOLDS)
+        self.time_limit = check_time_limit("time_limit", time_limit)
+        self._progress_options(callback, verbose)
         at_rest = self.samples.options["initial_state"] == "zero"
         self._skip = (None if skip is None and not at_rest else 0.0 if skip is None
                       else check_float("skip", skip, low=0))
@@ -331,7 +352,8 @@ class SimplifiedRIVC(JudgedOnSamples):
         self._out_weight = 1.0 / np.where(rms > 0, rms, 1.0)
         self.options = {"init": self._init, "bandwidth": self._lambda, "max_iter": self._max_iter, "tol": self._tol,
                         "hold": self._hold, "skip": "15 time constants of D" if self._skip is None else self._skip,
-                        "initial_state": self.samples.options["initial_state"],
+                        "initial_state": self.samples.options["initial_state"], "time_limit": self.time_limit,
+                        "callback": None if callback is None else "given", "verbose": self._verbose,
                         "fits": "the input-output equation prefiltered by 1/D(s, θ̂) (instrumental variables); "
                                 "cost, success and uncertainty on the measured samples"}
         if self._skip is not None:
@@ -398,10 +420,14 @@ class SimplifiedRIVC(JudgedOnSamples):
         Each iteration solves θ = (ZᵀΦ)⁻¹ Zᵀ b with Φ, b the equation prefiltered by
         1/D(s, θ̂) and Z the same built from x̂ = N̂/D̂ u (Young & Jakeman 1980). Stops
         when θ moves less than ``tol`` relative (status ``"converged"``), after
-        ``max_iter`` iterations (``"max_iter"``), or when D's leading coefficient
-        vanishes or the instruments are singular at an iterate (the last good θ is kept).
+        ``max_iter`` iterations (``"max_iter"``), when D's leading coefficient
+        vanishes or the instruments are singular at an iterate (the last good θ is kept), or
+        after an iteration when ``callback`` asks to (``"stopped"``) or ``time_limit`` is
+        spent with iterations left (``"time_limit"``). Only ``"converged"`` is finished.
         """
         t0 = time.perf_counter()
+        deadline = None if self.time_limit is None else t0 + self.time_limit
+        report = self.progress_reporter(t0)
         l = self.model.n_parameters
         start = np.asarray(x0, dtype=float).reshape(-1)
         used = 0
@@ -442,8 +468,15 @@ class SimplifiedRIVC(JudgedOnSamples):
             steps += 1
             moved = np.linalg.norm(new - theta) / max(np.linalg.norm(new), 1e-300)
             theta = new
+            asked = report is not None and report(steps, _relative_residual(Phi, b, theta), theta)
             if moved < self._tol:
                 status = "converged"
+                break
+            if asked:
+                status, why = "stopped", "; stopped by the callback"
+                break
+            if deadline is not None and time.perf_counter() >= deadline and steps < self._max_iter:
+                status, why = "time_limit", "; " + budget_message(self.time_limit, steps)
                 break
         flips = f"; D had right-half-plane roots at {reflected} iterate(s), reflected for the prefilter" \
             if reflected else ""

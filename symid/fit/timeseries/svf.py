@@ -37,8 +37,9 @@ import numpy as np
 import scipy.linalg
 
 from symid.errors import ModelError, OptionError
-from symid.fit.options import check_choice, check_float, check_int
+from symid.fit.options import check_choice, check_float, check_int, check_time_limit
 from symid.fit.result import StartOutcome
+from symid.fit.similarity.data import budget_message
 from symid.fit.timeseries.blackbox import JudgedOnSamples
 from symid.fit.timeseries.oe import OutputError
 from symid.fit.timeseries.response import interval_groups
@@ -119,6 +120,17 @@ class StateVariableFilter(JudgedOnSamples):
     initial_state : None, "estimate" or array_like, optional
         For the misfit to the samples (as :class:`~symid.fit.timeseries.oe.OutputError`);
         the least squares itself needs none.
+    time_limit : float, optional
+        Wall-time budget of one start in seconds, checked after the least squares and after
+        every instrumental-variable step (status ``"time_limit"``; the last estimate is
+        kept, and the start is not finished, so never a success). Default: none.
+    callback : callable, optional
+        Called after the least squares (iteration 1) and after every IV step with a
+        :class:`symid.engine.scr.ScrProgress` (iteration, residual ‖Φθ − b‖ / ‖b‖ of the
+        filtered equation with the measured regressors, misfit to the samples, elapsed
+        seconds, θ); a true return value stops the start (status ``"stopped"``).
+    verbose : bool, optional
+        Print one line per iteration (iteration, residual, misfit, elapsed). Default False.
 
     Examples
     --------
@@ -137,7 +149,8 @@ class StateVariableFilter(JudgedOnSamples):
     route = "state-variable-filtered derivatives (equation error)"
 
     def __init__(self, model: Any, data: Any, *, bandwidth: float | None = None, order: int | None = None,
-                 hold: str = "zoh", iv_iterations: int = 5, initial_state: Any = None):
+                 hold: str = "zoh", iv_iterations: int = 5, initial_state: Any = None,
+                 time_limit: float | None = None, callback: Any = None, verbose: bool = False):
         self.samples = OutputError(model, data, initial_state=initial_state)
         self.model, self.data = model, data
         self._kind = _check_model(model)
@@ -149,8 +162,11 @@ class StateVariableFilter(JudgedOnSamples):
                         else check_float("bandwidth", bandwidth, low=0, strict_low=True))
         self._hold = check_choice("hold", hold, _HOLDS)
         self._iv = check_int("iv_iterations", iv_iterations, low=0, high=100)
+        self.time_limit = check_time_limit("time_limit", time_limit)
+        self._progress_options(callback, verbose)
         self.options = {"bandwidth": self._lambda, "order": self._order, "hold": self._hold, "iv_iterations": self._iv,
-                        "initial_state": self.samples.options["initial_state"],
+                        "initial_state": self.samples.options["initial_state"], "time_limit": self.time_limit,
+                        "callback": None if callback is None else "given", "verbose": self._verbose,
                         "fits": "filtered derivatives (equation error); cost, success and uncertainty on the "
                                 "measured samples"}
         self._rows, self._rhs, self._used = self._regression([r.y for r in records])
@@ -190,6 +206,11 @@ class StateVariableFilter(JudgedOnSamples):
             return np.zeros((0, self.model.n_parameters)), np.zeros(0), 0
         return np.vstack(rows), np.concatenate(rhs), used
 
+    def equation_residual(self, theta: np.ndarray) -> float:
+        """‖Φθ − b‖ / ‖b‖: the filtered equation's residual at θ with the measured regressors (0 when b = 0)."""
+        size = float(np.linalg.norm(self._rhs))
+        return float(np.linalg.norm(self._rows @ theta - self._rhs)) / size if size > 0 else 0.0
+
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Least squares, then ``iv_iterations`` instrumental-variable steps (``x0`` plays no role).
 
@@ -198,17 +219,28 @@ class StateVariableFilter(JudgedOnSamples):
         θ = (ZᵀΦ)⁻¹ Zᵀ b. Noise in the measured outputs enters Φ (the filtered derivatives)
         and biases least squares toward zero; the instruments carry no noise. Stops when θ
         moves less than 1e-10 relative, or when the simulation at an iterate is not finite
-        (keeping the last good estimate).
+        (keeping the last good estimate); or, before a further step, when ``callback``
+        asked to stop (status ``"stopped"``) or ``time_limit`` is spent (``"time_limit"``):
+        neither is finished, so neither is a success.
         """
         t0 = time.perf_counter()
+        deadline = None if self.time_limit is None else t0 + self.time_limit
+        report = self.progress_reporter(t0)
         scale = np.linalg.norm(self._rows, axis=0)
         scale = np.where(scale > 0, scale, 1.0)
         sol, _, rank, _ = np.linalg.lstsq(self._rows / scale, self._rhs, rcond=None)
         theta = sol / scale
         l = self.model.n_parameters
-        finished = rank == l
+        status = "least squares" if rank == l else "rank deficient"
+        asked = report is not None and report(1, self.equation_residual(theta), theta)
         steps, why = 0, ""
-        for _ in range(self._iv if finished else 0):
+        for _ in range(self._iv if status == "least squares" else 0):
+            if asked:
+                status, why = "stopped", "; stopped by the callback"
+                break
+            if deadline is not None and time.perf_counter() >= deadline:
+                status, why = "time_limit", "; " + budget_message(self.time_limit, 1 + steps)
+                break
             try:
                 sims = self.samples.simulate(theta)
             except (np.linalg.LinAlgError, ValueError, ModelError):
@@ -226,14 +258,15 @@ class StateVariableFilter(JudgedOnSamples):
             steps += 1
             moved = np.linalg.norm(new - theta) / max(np.linalg.norm(theta), 1e-300)
             theta = new
+            asked = report is not None and report(1 + steps, self.equation_residual(theta), theta)
             if moved < 1e-10:
                 break
         message = (f"least squares on {self._used} filtered samples (λ = {self._lambda:.4g} rad/s, order "
-                   f"{self._order}, {self._hold}), {steps} IV step(s){why}" if finished else
+                   f"{self._order}, {self._hold}), {steps} IV step(s){why}" if status != "rank deficient" else
                    f"the filtered regression has rank {rank} < {l}: the records do not determine θ")
-        return self.outcome(np.asarray(x0, dtype=float), theta, finished=finished,
-                            status="least squares" if finished else "rank deficient", message=message,
-                            iterations=1 + steps, wall_time=time.perf_counter() - t0)
+        return self.outcome(np.asarray(x0, dtype=float), theta, finished=status == "least squares",
+                            status=status, message=message, iterations=1 + steps,
+                            wall_time=time.perf_counter() - t0)
 
 
 def _check_model(model: Any) -> str:
