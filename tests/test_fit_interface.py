@@ -118,6 +118,41 @@ def test_fit_test_rules():
     assert not fit_test(float("inf"), n_data=4, n_parameters=1).fits
 
 
+def test_fit_test_refuses_a_fit_a_black_box_of_the_same_order_beats_tenfold():
+    # source of the rule: symid.fit.success (ratio 10, only when the black box has at most N/2 parameters)
+    noise = np.random.default_rng(0).standard_normal(200) + 0j
+    white = {"n_data": 400, "n_parameters": 4, "residuals": noise}
+    assert fit_test(1e-4, **white, black_box=lambda: (2e-5, 20)).fits  # 5x: as noise leaves it
+    refused = fit_test(1e-4, **white, black_box=lambda: (9e-6, 20))
+    assert not refused.fits and refused.rule == "black box" and "1.00e-04 > 10 × 9.00e-06" in refused.text
+    assert fit_test(1e-4, **white, black_box=lambda: (1e-30, 201)).fits  # more parameters than N/2: it fits noise
+    assert fit_test(1e-4, **white, black_box=lambda: None).fits
+    assert fit_test(1e-12, n_data=400, n_parameters=4, black_box=lambda: (1e-30, 20)).fits  # an exact fit stays one
+    assert not fit_test(1.5e-4, n_data=60, n_parameters=4, noise_floor=1e-4, black_box=lambda: (1e-30, 20)).fits
+
+
+def test_an_overstated_noise_floor_does_not_pass_a_wrong_fit_of_exact_data(frf):
+    # 1 % noise declared (noise_floor=1e-4) on noise-free data: an estimate 0.3 % off in k2 leaves a misfit within
+    # the χ² bound of that floor, but a vector fit of order 4 reproduces the data to rounding (misfit < 1e-20).
+    # Reference: TRUTH_2DOF, thesis (4-20), the values the data are simulated from.
+    from symid.fit.frf.ipopt import IpoptFRF
+
+    est = IpoptFRF.create(chain(), frf, {}, noise_floor=1e-4)
+    floor, b = est.black_box()
+    assert floor < 1e-20 and b == 4 + 5 * 1
+    wrong = np.array([1, 1, 0.1, 0.3, 2, 1.003])
+    assert EXACT_FIT < est.misfit(wrong) < 1e-4
+    out = est.outcome(wrong, wrong, finished=True, status="converged", message="", iterations=0, wall_time=0.0)
+    assert not out.success and "black box" in out.fit
+    truth = np.array([1, 1, 0.1, 0.3, 2, 1.0])
+    assert est.outcome(truth, truth, finished=True, status="converged", message="", iterations=0,
+                       wall_time=0.0).success
+    noisy = si.simulate_frf(chain(), TRUTH_2DOF, np.logspace(np.log10(0.5), np.log10(2), 30), noise=0.01, seed=1)
+    est = IpoptFRF.create(chain(), noisy, {}, noise_floor=1e-4)
+    fitted = si.identify(chain(), noisy, method="ipopt", x0=truth, identifiability_check=False)
+    assert fitted.success and est.misfit(fitted.theta_vector) <= 10 * est.black_box()[0]
+
+
 def test_whiteness_of_noise_is_standard_normal():
     # the scaled lag-1 autocorrelation of independent noise is ~N(0, 1): P(z > 3) = 0.13 %; 2000 records
     rng = np.random.default_rng(1)

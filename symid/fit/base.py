@@ -117,6 +117,12 @@ class Estimator(abc.ABC):
         """Number of real data values the misfit sums over."""
         return 0
 
+    def black_box(self) -> tuple[float, int] | None:
+        """``(misfit, b)`` of a black box of the model's order fitted to the data, in the same misfit, with its
+        number of real parameters b; ``None`` (default) when the data kind has none. The success rule refuses a
+        fit that is not exact when this black box fits more than ten times better (:mod:`symid.fit.success`)."""
+        return None
+
     # -- the method's part ------------------------------------------------------------------
     @abc.abstractmethod
     def run(self, x0: np.ndarray) -> StartOutcome:
@@ -173,7 +179,7 @@ class Estimator(abc.ABC):
         cost = self.misfit(theta) if finite else float("inf")
         res = self.residuals(theta) if finite and np.isfinite(cost) else None
         test = fit_test(cost, n_data=self.n_data(), n_parameters=int(theta.size), residuals=res,
-                        noise_floor=self.noise_floor)
+                        noise_floor=self.noise_floor, black_box=self.black_box)
         fits, fit_text = test.fits, test.text
         unphysical = physical_check(self.model, theta)  # never a success against the model's declarations
         if unphysical is not None:

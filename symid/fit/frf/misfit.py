@@ -209,6 +209,31 @@ class FrfEstimator(Estimator, FrfFisher):
         """2·s·p·m real values."""
         return 2 * int(np.asarray(self.data.H).size)
 
+    def black_box(self) -> tuple[float, int] | None:
+        """A vector fit of the data with as many poles N as the model has states and a constant term
+        (:func:`symid.signal.vectfit.vector_fit`, each line's error relative to its level): its
+        :meth:`misfit` and its N + (N + 1)·p·m real parameters; built once per estimator (milliseconds
+        to a second at 16 states). ``None`` when it cannot be built (too few frequencies, say)."""
+        if not hasattr(self, "_black_box"):
+            self._black_box = _vector_fit_floor(self.model, self.data, self.line_weights)
+        return self._black_box
+
+
+def _vector_fit_floor(model: Any, data: Any, weights: np.ndarray | None) -> tuple[float, int] | None:
+    from symid.signal.vectfit import vector_fit
+
+    H = np.asarray(data.H)
+    n = int(model.n_states)
+    try:
+        bb = vector_fit(np.asarray(data.w, dtype=float), H, n, weight="relative")
+        Hb = np.asarray(bb.response(np.asarray(data.w, dtype=float))).reshape(H.shape)
+    except (DataError, OptionError, ModelError, np.linalg.LinAlgError, ValueError, FloatingPointError):
+        return None
+    cost = _relative(H, Hb, weights)
+    if not math.isfinite(cost):
+        return None
+    return cost, n + (n + 1) * H.shape[1] * H.shape[2]
+
 
 class NoiseWeighted:
     """Mixin of an FRF method with a ``variance=`` option: the weights, the variance, and the noise floor it
