@@ -30,6 +30,19 @@ def _coef(amap: Any) -> np.ndarray:
     return np.asarray(amap.Xi, dtype=float)
 
 
+def _flat(amap: Any) -> np.ndarray:
+    """Coefficients Xₖ of an affine map flattened to (r·c, l)."""
+    xi = _coef(amap)
+    return xi.reshape(xi.shape[0], -1).T
+
+
+def _outer(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """(s, p, m, n·r) array of left[s, p, n]·right[s, r, m], so that ``_outer(L, R) @ _flat(X)`` is L Xₖ R."""
+    s, p = left.shape[:2]
+    m = right.shape[2]
+    return (left[:, :, None, :, None] * np.swapaxes(right, 1, 2)[:, None, :, None, :]).reshape(s, p, m, -1)
+
+
 def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndarray]:
     """H(ωᵢ, θ) and its exact derivative with respect to θ.
 
@@ -75,11 +88,13 @@ def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndar
             ZB = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
             CZ = np.swapaxes(np.linalg.solve(np.swapaxes(Z, 1, 2),
                                              np.broadcast_to(C.T.astype(complex), (w.size, *C.T.shape))), 1, 2)
-            dZ = (_coef(maps["K"])[None] - (w**2)[:, None, None, None] * _coef(maps["M"])[None]
-                  + 1j * w[:, None, None, None] * _coef(maps["V"])[None])  # (s, l, n, n)
             G = C @ ZB
+            # C Z⁻¹ Xₖ Z⁻¹ B for X = K, M, V: the outer products (C Z⁻¹)ₚₙ (Z⁻¹ B)ᵣₘ against the coefficients
+            # flattened over (n, r): one matrix product each, never an (s, l, n, n) array
+            outer = _outer(CZ, ZB)
+            wc = w[:, None, None, None]
             dG = (np.einsum("kpn,snm->spmk", _coef(maps["C"]), ZB)
-                  - np.einsum("spn,sknr,srm->spmk", CZ, dZ, ZB, optimize=True)
+                  - outer @ _flat(maps["K"]) + wc**2 * (outer @ _flat(maps["M"])) - 1j * wc * (outer @ _flat(maps["V"]))
                   + np.einsum("spn,knm->spmk", CZ, _coef(maps["B"])))
             f = {"position": np.ones(w.size, complex), "velocity": 1j * w,
                  "acceleration": -(w**2) + 0j}[model.output]
@@ -92,7 +107,7 @@ def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndar
                                          np.broadcast_to(C.T.astype(complex), (w.size, *C.T.shape))), 1, 2)
         H = C @ RB + D
         dH = (np.einsum("kpn,snm->spmk", _coef(maps["C"]), RB)
-              + np.einsum("spn,knr,srm->spmk", CR, _coef(maps["A"]), RB, optimize=True)
+              + _outer(CR, RB) @ _flat(maps["A"])
               + np.einsum("spn,knm->spmk", CR, _coef(maps["B"])))
         if "D" in maps:
             dH = dH + np.moveaxis(_coef(maps["D"]), 0, -1)[None]
