@@ -14,6 +14,7 @@ import symid as si
 from symid import scr
 from symid.fit.frf.ipopt import IpoptFRF
 from symid.fit.frf.scr import ScrFRF
+from symid.fit.polish import polish_outcome
 from symid.fit.starts import make_starts
 
 
@@ -61,11 +62,19 @@ def test_belt_drive_on_noisy_data_returns_the_least_squares_estimate_of_its_equa
     data = (si.simulate_frf(model, truth, exact.w, noise=1e-4, seed=1) if kind == "noise 1e-4" else
             si.FrequencyData(exact.w, np.round(np.asarray(exact.H), 6)))
     out = ScrFRF(model, data, backend=backend).run(np.zeros(4))
-    assert out.success and out.status == "converged", out.message
+    assert out.status == "converged", out.message
     assert "least-squares sense" in out.message
     np.testing.assert_allclose(out.theta, belt_reference(data), rtol=1e-10)
     # and it is an estimate from noisy data, not the truth
     assert 1e-7 < np.max(np.abs(out.theta - truth) / np.abs(truth)) < 1e-3
+    # The least-squares estimate of SCR's equations is not the least-squares fit of H: on these 10 lines its
+    # misfit is 3.7 (noise) and 15 (rounding) times what the truth leaves, more than ten times what a vector
+    # fit of order 3 leaves, so the success rule does not call it a fit (measured: 9.4e-9 against 2.6e-9 at
+    # the truth and 7.6e-10 for the black box; 1.2e-10 against 7.8e-12 and 5.9e-12). Polished, it is one.
+    est = IpoptFRF(model, data)
+    assert out.cost > 2 * est.misfit(truth) and not out.success and "black box" in out.fit
+    polished = polish_outcome(est, out)
+    assert polished.success and polished.cost <= est.misfit(truth)
 
 
 def test_presolve_judges_consistency_relative_to_the_data():
