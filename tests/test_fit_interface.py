@@ -153,6 +153,20 @@ def test_an_overstated_noise_floor_does_not_pass_a_wrong_fit_of_exact_data(frf):
     assert fitted.success and est.misfit(fitted.theta_vector) <= 10 * est.black_box()[0]
 
 
+def test_a_start_stopped_by_its_budget_is_a_success_when_its_estimate_fits(frf):
+    # success is the fit, whatever stopped the solver; finished says whether it reached its own rule.
+    # Reference: TRUTH_2DOF, thesis (4-20), the values the data are simulated from.
+    from symid.fit.frf.ipopt import IpoptFRF
+
+    est = IpoptFRF.create(chain(), frf, {})
+    truth = np.array(list(TRUTH_2DOF.values()), dtype=float)
+    out = est.outcome(truth, truth, finished=False, status="time_limit", message="", iterations=3, wall_time=1.0)
+    assert out.success and not out.finished and out.status == "time_limit"
+    off = truth * 1.5
+    out = est.outcome(truth, off, finished=True, status="converged", message="", iterations=3, wall_time=1.0)
+    assert not out.success and out.finished and out.status == "converged"
+
+
 def test_whiteness_of_noise_is_standard_normal():
     # the scaled lag-1 autocorrelation of independent noise is ~N(0, 1): P(z > 3) = 0.13 %; 2000 records
     rng = np.random.default_rng(1)

@@ -173,7 +173,8 @@ class Estimator(abc.ABC):
     def outcome(self, x0: np.ndarray, theta: np.ndarray, *, finished: bool, status: str, message: str,
                 iterations: int, wall_time: float, history: tuple[ScrIteration, ...] = ()) -> StartOutcome:
         """A :class:`StartOutcome` with its cost and the success rule applied (:mod:`symid.fit.success`:
-        :func:`~symid.fit.success.fit_test` and :func:`~symid.fit.success.physical_check`)."""
+        :func:`~symid.fit.success.fit_test` and :func:`~symid.fit.success.physical_check`); ``finished``
+        (the solver reached its own stopping rule) is reported beside ``success``, not folded into it."""
         theta = np.asarray(theta, dtype=float).reshape(-1)
         finite = bool(np.all(np.isfinite(theta)))
         cost = self.misfit(theta) if finite else float("inf")
@@ -187,7 +188,7 @@ class Estimator(abc.ABC):
         if not finite:
             message = f"{message}; the estimate is not finite"
         return StartOutcome(start=np.asarray(x0, dtype=float), theta=theta, cost=cost,
-                            success=bool(finished and fits), finished=bool(finished), status=status,
+                            success=bool(fits), finished=bool(finished), status=status,
                             iterations=int(iterations), wall_time=float(wall_time), message=message,
                             fit=fit_text, history=history)
 

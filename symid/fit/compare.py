@@ -115,7 +115,7 @@ class Comparison:
     A start counts as a success when its parameter error (``param_error``: the largest
     relative error of any parameter, or ‖θ − θ*‖₂/‖θ*‖₂) is ≤ ``param_tol`` if the truth
     is known, otherwise when the start's own ``success``
-    holds (the solver finished and the estimate fits the data, :mod:`symid.fit.success`).
+    holds (the estimate fits the data, :mod:`symid.fit.success`).
 
     Attributes
     ----------
@@ -291,7 +291,7 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
                          f"get_executor()); got {type(executor).__name__}")
     criterion = ((f"largest relative parameter error <= {param_tol:g}" if param_error == "largest" else
                   f"relative parameter error ‖θ − θ*‖₂/‖θ*‖₂ <= {param_tol:g}") if truth_vec is not None
-                 else "the start's own success (solver finished and the estimate fits the data)")
+                 else "the start's own success (the estimate fits the data)")
     stats: list[MethodStats] = []
 
     def tabulate(method: str, meta: dict[str, Any], outcomes: list[StartOutcome], interrupted: bool = False

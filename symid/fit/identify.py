@@ -96,7 +96,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     -------
     IdentificationResult
         The best start by data misfit, and every start's outcome in ``result.starts``.
-        ``success`` means the solver finished and the estimate fits the data.
+        ``success`` means the estimate fits the data (the solver's own verdict is ``status``).
 
     Warns
     -----

@@ -1,8 +1,9 @@
 """Result types shared by every estimation method, so methods compare like for like.
 
-``success`` means the same thing everywhere: the solver finished (reached its own
-stopping rule) **and** the estimate fits the data (:mod:`symid.fit.success`). The
-solver's own verdict is kept apart, in ``status`` and ``message``.
+``success`` means the same thing everywhere: the estimate fits the data and nothing the
+model declares rules it out (:mod:`symid.fit.success`). Whether the solver reached its
+own stopping rule is reported beside it, in ``finished``, ``status`` and ``message``,
+never instead of it: a start stopped by its budget whose estimate fits is a success.
 """
 
 from __future__ import annotations
@@ -78,9 +79,9 @@ class StartOutcome:
         The data misfit of the estimate; what it measures depends on the data kind
         (``IdentificationResult.cost_kind``).
     success : bool
-        ``finished`` and the estimate fits the data (:mod:`symid.fit.success`).
+        The estimate fits the data (:mod:`symid.fit.success`), whether or not the solver finished.
     finished : bool
-        The solver reached its own stopping rule (converged, or stationary).
+        The solver reached its own stopping rule (converged, or stationary), not a budget or a callback.
     status : str
         The solver's own status word (IPOPT's return status, SCR's ``"converged"``,
         ``"max_iter"``, ...).
@@ -165,7 +166,7 @@ class IdentificationResult:
     cost_kind : str
         What ``cost`` measures for this data kind (e.g. the relative FRF misfit).
     success : bool
-        The best start's solver finished and its estimate fits the data.
+        The best start's estimate fits the data (its solver's own verdict is ``status``).
     status : str
         The solver's own status on the best start.
     iterations : int

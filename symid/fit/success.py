@@ -1,6 +1,7 @@
-"""When an estimate counts as a success: the solver finished AND the estimate fits the data.
+"""When an estimate counts as a success: the estimate fits the data.
 
-One rule for every method and data kind. A solver's own verdict (IPOPT's
+One rule for every method and data kind, whether the solver finished or was stopped by
+its budget (``finished`` reports that beside ``success``). A solver's own verdict (IPOPT's
 ``Solve_Succeeded``, SCR's "converged") says that its iteration stopped where its
 stopping rule is met, not that the model reproduces the measurements: IPOPT stops at
 local minima, SCR at a stationary point of its relaxation. So :func:`fit_test` also

@@ -394,7 +394,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 "time_limit": f"time limit of {limit:g} s reached after {passes} pass(es)" if limit else "",
                 "stopped": f"stopped by the callback after {passes} pass(es)",
                 "repeated": f"{_REPEATS} of {passes} passes ended at the same best misfit"}[status]
-        out = self.outcome(x0, best.theta, finished=status != "time_limit" or best.success, status=status,
+        out = self.outcome(x0, best.theta, finished=status not in ("time_limit", "stopped"), status=status,
                            message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}",
                            iterations=total_nfev, wall_time=wall)
         others = tuple(c for c in visited if c is not best)

@@ -117,8 +117,8 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
     time_limit : float, optional
         Wall-time budget of one run in seconds, checked after every solve of the
         noise-weighted iteration (status ``"time_limit"``; the last solve's estimate is
-        kept, not weighted to its fixed point, so the run is not finished and never a
-        success). Default: none (one solve without a variance; with one, 3–6 measured,
+        kept, not weighted to its fixed point, so the run is not finished; it is a success
+        only if that estimate fits the data). Default: none (one solve without a variance; with one, 3–6 measured,
         at most 50).
     callback : callable, optional
         Called after every solve with a :class:`symid.engine.scr.ScrProgress` (solve,
@@ -291,7 +291,7 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
 
         Without a variance, one solve; with one, the noise-weighted iteration (class text),
         which ``time_limit`` and ``callback`` may stop after any solve (status
-        ``"time_limit"`` or ``"stopped"``, not finished: never a success). The bounded least
+        ``"time_limit"`` or ``"stopped"``, not finished; a success only if the estimate fits). The bounded least
         squares of ``positivity`` is applied to the estimate kept in every case.
         """
         t0 = time.perf_counter()

@@ -303,7 +303,7 @@ class SimplifiedRIVC(JudgedOnSamples):
     time_limit : float, optional
         Wall-time budget of one start in seconds, the least-squares start included,
         checked after every iteration (status ``"time_limit"``; the last iterate is kept,
-        and the start is not finished, so never a success). Default: none.
+        and the start is not finished; a success only if that estimate fits the data). Default: none.
     callback : callable, optional
         Called after every iteration with a :class:`symid.engine.scr.ScrProgress`
         (iteration, residual ‖Φθ − b‖ / ‖b‖ of the equation prefiltered by the iteration's

@@ -123,7 +123,7 @@ class StateVariableFilter(JudgedOnSamples):
     time_limit : float, optional
         Wall-time budget of one start in seconds, checked after the least squares and after
         every instrumental-variable step (status ``"time_limit"``; the last estimate is
-        kept, and the start is not finished, so never a success). Default: none.
+        kept, and the start is not finished; a success only if that estimate fits the data). Default: none.
     callback : callable, optional
         Called after the least squares (iteration 1) and after every IV step with a
         :class:`symid.engine.scr.ScrProgress` (iteration, residual ‖Φθ − b‖ / ‖b‖ of the
