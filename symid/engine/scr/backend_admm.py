@@ -29,6 +29,11 @@ over-relaxation α (Boyd et al. 2011, §3.4.3):
   fall, the steps settle instead of jittering at the residual's level;
 * ρ is rebalanced from the ratio of the normalised residuals (residual balancing, as in
   OSQP) when they differ by more than a factor 5; the KKT matrix is then refactorised.
+* each LMI block b has its own penalty ρκ_b (``lmi_rho``, on by default), balanced on the
+  block's own normalised residuals like ρ; in the iteration it is a row factor √κ_b of
+  the block (ŷ_b = √κ_b y_b, as the equilibration below), so a change of κ keeps the dual
+  Λ = ρ D u and refactorises the KKT matrix. An idle LMI otherwise holds z at its last
+  value with the weight of a whole block (see :class:`ADMMOptions`);
 * optionally (``equilibrate``, off by default), 𝒜 is equilibrated before every sub-problem
   by :func:`ruiz`: ŷ = D y with one factor per block (a scalar keeps a block's nuclear
   norm, (w/d)‖Ŷ‖_*, and its PSD cone), ẑ = E⁻¹ z with one factor per variable, as SCS
@@ -107,6 +112,18 @@ class ADMMOptions:
         §4-6-2 it changes nothing but the time (+7 %), and on the belt drive with whole
         blocks relaxed (presolve off) SCR stopped short of the tolerance where the plain
         iteration met it.
+    lmi_rho : bool
+        One penalty per LMI block, ρκ_b, balanced on that block's own residuals (the rule
+        of ``adaptive_rho``, κ_b in [1e-8, 1e4], at most every ``adapt_every`` inner
+        iterations) instead of the terms' ρ. Default on. An LMI that does not bind still
+        enters the z-update as the proximal term ρκ_b‖𝒜_b(z − z_k)‖², which pins z where
+        the bilinear terms' map is nearly singular: on the spectra of thesis §5-6
+        (``msd3_psd``) that map has singular values from 5 down to 4e-5 against √2 for the
+        LMI rows, and with one shared ρ ADMM ended every sub-problem where it started
+        (1e-3–2e-2 above Clarabel's value after 2000 inner iterations, θ still 13–10⁴ from
+        Clarabel's optimum; tests/test_scr_admm_lmi_rho.py). κ of an idle LMI falls to its
+        floor, of a binding one stays large. Measured on ``msd3_psd``, from the start
+        ADMM-SCR then converges (``benchmarks/admm_scaling.py``).
 
     Examples
     --------
@@ -127,6 +144,7 @@ class ADMMOptions:
     adapt_every: int = 25
     tighten: float | None = 1.0
     equilibrate: bool = False
+    lmi_rho: bool = True
 
     def __post_init__(self) -> None:
         if self.rho is not None and not (np.isfinite(self.rho) and self.rho > 0):
@@ -222,6 +240,7 @@ def _segment_max(vals: np.ndarray, starts: np.ndarray) -> np.ndarray:
     return out
 
 
+_KAPPA = (1e-8, 1e4)  # range of the LMI blocks' penalties relative to ρ
 _RUIZ_PASSES = 25  # as SCS (NUM_RUIZ_PASSES)
 _RUIZ_TOL = 0.1  # stop once every block and column maximum is within 10 % of 1
 _SCALE_RANGE = (1e-4, 1e4)  # bounds on the accumulated factors, as OSQP (MIN_SCALING, MAX_SCALING)
@@ -314,6 +333,11 @@ class ADMMBackend:
         self.u = np.zeros(self.m)  # scaled dual of the equilibrated problem, u = D⁻¹Λ/ρ
         self.started = False
         self.d_blocks = np.ones(self.block_starts.size - 1)  # row factor of each block
+        self.d_base = np.ones(self.block_starts.size - 1)  # Ruiz factors (1 without equilibration)
+        self.kappa = np.ones(self.block_starts.size - 1)  # penalty of each block relative to ρ (LMIs adapted)
+        self._lmi_first = int(self._term_blocks[-1])  # blocks from here on are LMIs
+        self.lmi_adapt = bool(options.lmi_rho) and self.block_starts.size - 1 > self._lmi_first
+        self.scaled = bool(options.equilibrate) or self.lmi_adapt  # the iteration runs on ŷ = D y, ẑ = E⁻¹z
         self.d_rows = np.ones(self.m)
         self.e_cols = np.ones(red.nz)  # column factor of each variable
         self.scalings: list[tuple[float, float]] = []  # (spread of d, spread of e) per sub-problem
@@ -354,12 +378,18 @@ class ADMMBackend:
             tb = self._term_blocks
             self.rho = 2.0 * float(np.median(np.concatenate(
                 [g.weight / d[tb[k]:tb[k + 1]] for k, g in enumerate(self.groups)])))
-        d_rows = np.repeat(d, np.diff(self.block_starts))
-        self.u *= self.d_rows / d_rows  # Λ = ρ D u is kept
-        self.d_blocks, self.d_rows, self.e_cols = d, d_rows, e
-        self._set_taus()
+        self.d_base, self.e_cols = d, e
+        self._set_d()
         spread = [float(v.max() / v.min()) if v.size else 1.0 for v in (d, e)]
         self.scalings.append((spread[0], spread[1]))
+
+    def _set_d(self) -> None:
+        """Row factors from the Ruiz factors and the block penalties κ (ρ_b = ρ d_b² κ_b); Λ = ρ D u is kept."""
+        d = self.d_base * np.sqrt(self.kappa)
+        d_rows = np.repeat(d, np.diff(self.block_starts))
+        self.u *= self.d_rows / d_rows
+        self.d_blocks, self.d_rows = d, d_rows
+        self._set_taus()
 
     def _prox(self, x: np.ndarray, shifts: list[np.ndarray | None]) -> np.ndarray:
         """Y-update (SVT) and S-update (PSD projection) on the stacked vector x."""
@@ -391,6 +421,47 @@ class ADMMBackend:
         self.rho = rho
         self._set_taus()
 
+    def _scaled(self, A0: sps.csr_matrix, c0: np.ndarray) -> tuple:
+        """The data of the iteration on ẑ = E⁻¹z, ŷ = D y for the current factors: A, Aᵀ, AᵀA, c, H, D, g."""
+        red = self.red
+        H, Dm, g = red.H, red.D, red.g
+        A, c = A0, c0
+        if self.scaled:
+            dr, ec = self.d_rows, self.e_cols
+            A = sps.csr_matrix(sps.diags(dr) @ A0 @ sps.diags(ec))
+            c = dr * c0
+            H = sps.csr_matrix(sps.diags(ec) @ H @ sps.diags(ec))
+            Dm = sps.csr_matrix(Dm @ sps.diags(ec))
+            g = ec * g
+        AT = A.T.tocsr()
+        AtA = AT @ A
+        if self.m * red.nz <= _DENSE_OPERATOR:  # small problems: dense products have less overhead
+            A, AT = A.toarray(), AT.toarray()
+        return A, AT, AtA, c, H, Dm, g
+
+    def _lmi_ratios(self, A: np.ndarray | sps.csr_matrix, az: np.ndarray, y_new: np.ndarray, y: np.ndarray,
+                    a_rms: float) -> np.ndarray:
+        """Residual-balancing ratio of every LMI block, √((r_p/scale_p) / (r_d/scale_d)) on the scaled problem
+        (1 where both residuals vanish)."""
+        lo = int(self.offsets[len(self.groups)])
+        starts = self.block_starts[self._lmi_first:] - lo
+        b = starts[:-1]
+
+        def norms(v: np.ndarray) -> np.ndarray:
+            return np.sqrt(np.add.reduceat(v * v, b))
+
+        rp = norms((az - y_new)[lo:])
+        sp_ = np.maximum(norms(az[lo:]), norms(y_new[lo:]))
+        AL = A[lo:] if isinstance(A, np.ndarray) else A[lo:].toarray()
+        rd = self.rho * np.linalg.norm(np.add.reduceat(AL * (y_new - y)[lo:, None], b, axis=0), axis=1)
+        sd = self.rho * norms(self.u[lo:]) * a_rms
+        num = rp * np.maximum(sd, 1e-300)
+        den = rd * np.maximum(sp_, 1e-300)
+        out = np.ones(rp.size)
+        moving = (num > 0) | (den > 0)
+        out[moving] = np.sqrt(num[moving]) / np.sqrt(np.maximum(den[moving], 1e-300))  # no overflow
+        return out
+
     def step(self, built: list[tuple[np.ndarray, np.ndarray]], W: list[np.ndarray] | None,
              z0: np.ndarray, residual: float = np.inf, deadline: float | None = None
              ) -> tuple[np.ndarray, bool, str, dict]:
@@ -410,22 +481,13 @@ class ADMMBackend:
         nz, m = red.nz, self.m
         tm = {"build": 0.0, "factor": 0.0, "solve": 0.0, "svd": 0.0, "projection": 0.0}
         t = time.perf_counter()
-        A, c = self._assemble(built)
-        scaled = bool(opt.equilibrate)
-        a_rms = np.sqrt(float(A.data @ A.data) / max(nz, 1)) if scaled else 0.0  # RMS column norm of 𝒜
-        H, Dm, g = red.H, red.D, red.g
-        if scaled:
-            self._equilibrate(A)
-            dr, ec = self.d_rows, self.e_cols
-            A = sps.csr_matrix(sps.diags(dr) @ A @ sps.diags(ec))
-            c = dr * c
-            H = sps.csr_matrix(sps.diags(ec) @ H @ sps.diags(ec))
-            Dm = sps.csr_matrix(Dm @ sps.diags(ec))
-            g = ec * g
-        AT = A.T.tocsr()
-        AtA = AT @ A
-        if m * nz <= _DENSE_OPERATOR:  # small problems: dense products have less overhead
-            A, AT = A.toarray(), AT.toarray()
+        A0, c0 = self._assemble(built)
+        scaled = self.scaled
+        a_rms = np.sqrt(float(A0.data @ A0.data) / max(nz, 1)) if scaled else 0.0  # RMS column norm of 𝒜
+        if opt.equilibrate:
+            self._equilibrate(A0)
+        A, AT, AtA, c, H, Dm, g = self._scaled(A0, c0)
+        ec = self.e_cols
         a_rms_s = np.sqrt(float(AtA.diagonal().sum()) / max(nz, 1))  # (of the equilibrated 𝒜 if scaled)
         if not scaled:
             a_rms = a_rms_s
@@ -515,6 +577,25 @@ class ADMMBackend:
                             return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
                         tm["factor"] += time.perf_counter() - t
                         last_change = it
+                if self.lmi_adapt and it - last_change >= opt.adapt_every:
+                    ratio = self._lmi_ratios(A, az, y_new, y, a_rms_s)
+                    kappa = self.kappa.copy()
+                    lmi = kappa[self._lmi_first:]
+                    change = (ratio < 0.2) | (ratio > 5.0)
+                    lmi[change] = np.clip(lmi[change] * ratio[change], _KAPPA[0], _KAPPA[1])
+                    if np.any(kappa != self.kappa):  # (not when every change is held at a bound)
+                        t = time.perf_counter()
+                        d_old = self.d_rows
+                        self.kappa = kappa
+                        self._set_d()
+                        y_new = y_new * (self.d_rows / d_old)  # ŷ = D y in the new factors
+                        A, AT, AtA, c, H, Dm, g = self._scaled(A0, c0)
+                        try:
+                            kkt, delta = self._factor(AtA, H, Dm)
+                        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
+                            return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
+                        tm["factor"] += time.perf_counter() - t
+                        last_change = it
             y = y_new
         if scaled:
             z = z * self.e_cols
@@ -526,6 +607,8 @@ class ADMMBackend:
         tm["primal_residual"] = float(rp)
         tm["dual_residual"] = float(rd)
         tm["rho"] = self.rho
+        if self.lmi_adapt:
+            tm["lmi_kappa_min"] = float(self.kappa[self._lmi_first:].min())
         if not np.all(np.isfinite(z)):
             return z0, False, "ADMM diverged (non-finite iterate)", tm
         tm["time_limit"] = timed_out
