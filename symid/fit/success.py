@@ -43,10 +43,9 @@ estimate's φ·(N − l)/N, so a correct fit is within a factor (N − l)/(N −
 rule is applied only when b ≤ N/2 (that factor at most 2), since with fewer data the
 black box fits the noise itself. The vector fit weighs each line's error relative to its
 level: with noise proportional to |H|, a black box fitted in the judged (absolute)
-misfit chases the noise of the few resonance lines that dominate it, and lands far below
-what any grey box of that order reaches (measured on the population benchmark's 1 %
-noise: up to 45 times below the best grey-box misfit, an 8-mass chain with two sensors),
-which would refuse correct fits; relative weights do not do that.
+misfit can chase the noise of the few resonance lines that dominate it (its b
+parameters against few effective data) and land far below what a grey box of that order
+reaches, which would refuse correct fits; relative weights do not do that.
 
 The floor used and the statistic are reported in the outcome's ``fit`` text.
 
