@@ -118,8 +118,8 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         Wall-time budget of one run in seconds, checked after every solve of the
         noise-weighted iteration (status ``"time_limit"``; the last solve's estimate is
         kept, not weighted to its fixed point, so the run is not finished; it is a success
-        only if that estimate fits the data). Default: none (one solve without a variance; with one, 3–6 measured,
-        at most 50).
+        only if that estimate fits the data). Default: none (one solve without a variance;
+        with one, 3–6 measured, at most 50).
     callback : callable, optional
         Called after every solve with a :class:`symid.engine.scr.ScrProgress` (solve,
         residual ‖Jθ + r₀‖ / ‖|r₀| + |J| |θ|‖ of the (weighted) linear equations relative
@@ -291,8 +291,9 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
 
         Without a variance, one solve; with one, the noise-weighted iteration (class text),
         which ``time_limit`` and ``callback`` may stop after any solve (status
-        ``"time_limit"`` or ``"stopped"``, not finished; a success only if the estimate fits). The bounded least
-        squares of ``positivity`` is applied to the estimate kept in every case.
+        ``"time_limit"`` or ``"stopped"``, not finished; a success only if the estimate
+        fits). The bounded least squares of ``positivity`` is applied to the estimate kept
+        in every case.
         """
         t0 = time.perf_counter()
         deadline = None if self.time_limit is None else t0 + self.time_limit
