@@ -37,3 +37,14 @@ def test_compare_counts_by_the_chosen_error():
     assert "largest relative parameter error" in largest.criterion and "‖θ − θ*‖₂" in l2.criterion
     with pytest.raises(OptionError, match="param_error"):
         si.compare(model, frf, methods=("ipopt",), starts=1, truth=truth, param_error="rms")
+
+
+def test_options_not_keyed_by_method_are_explained():
+    # a new-user trial passed options={"time_limit": 10}: the error says how options are keyed
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    frf = si.simulate_frf(model, {"m": 2.0, "c": 5.0, "k": 4e4}, np.logspace(1.5, 2.5, 30))
+    with pytest.raises(si.ModelError, match=r"options are keyed by method, e\.g\. options=\{'ipopt'.*\(ipopt, "
+                                            r"scr\+polish\): time_limit"):
+        si.compare(model, frf, methods=("ipopt", "scr+polish"), starts=1, options={"time_limit": 10},
+                   progress=False)

@@ -136,6 +136,21 @@ def test_a_start_of_the_wrong_length_is_named():
         prepare(model, frf, "lm", {}).run(np.array([1.0, np.nan, 1.0, 1.0, 1.0, 1.0]))
 
 
+def test_a_negative_start_of_a_positive_parameter_is_named():
+    # θ = s·exp(φ) cannot start below 0 (IPOPT refuses a start outside its bounds θ ≥ 0 the same way); 0 takes
+    # the scale. Reference: TRUTH, the values the exact data are simulated from.
+    model = chain2()
+    frf = si.simulate_frf(model, TRUTH, grid(TRUTH))
+    start = model.theta_vector(TRUTH).copy()
+    start[2] = -start[2]
+    for method in ("auto", "lm"):
+        with pytest.raises(si.OptionError, match=rf"the start {model.parameter_names[2]} = .* is negative.*{method}"):
+            si.identify(model, frf, method=method, x0=start, identifiability_check=False)
+    start[2] = 0.0
+    res = si.identify(model, frf, method="auto", x0=start, identifiability_check=False)
+    assert res.success and relative_parameter_error(res.theta_vector, model.theta_vector(TRUTH)) <= 1e-6
+
+
 def test_noise_weighting_uses_the_data_variance():
     model = chain2()
     w = grid(TRUTH)

@@ -278,7 +278,9 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     options = dict(options or {})
     unknown = set(options) - {m.removesuffix("+polish") for m in methods}
     if unknown:
-        raise ModelError(f"options given for methods not compared: {', '.join(sorted(unknown))}")
+        raise ModelError(f"options are keyed by method, e.g. options={{'ipopt': {{'time_limit': 10}}}} (a "
+                         f"'+polish' method takes its base method's options); these keys are not methods "
+                         f"compared here ({', '.join(methods)}): {', '.join(sorted(map(str, unknown)))}")
     param_tol = check_float("param_tol", param_tol, low=0, strict_low=True)
     error_of = _ERRORS[check_choice("param_error", param_error, tuple(_ERRORS))]
     truth_vec = None if truth is None else model.theta_vector(truth)

@@ -335,6 +335,21 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         return self._theta(phi, centre, unit), nfev, False
 
     # -- a start ------------------------------------------------------------------------------
+    def check_start(self, x0: np.ndarray) -> None:
+        """Refuse a start of the wrong length, or negative in a parameter kept positive (an :class:`OptionError`
+        naming it): θₖ = sₖ·exp(φₖ) cannot start below 0. A start of 0 takes the parameter's ``scale``."""
+        x = np.asarray(x0, dtype=float).reshape(-1)
+        names = self.model.parameter_names
+        if x.size != len(names):
+            raise OptionError(f"the start has {x.size} values; the model has {len(names)} parameters "
+                              f"({', '.join(names)})")
+        bad = [k for k in range(x.size) if self._positive[k] and x[k] < 0]
+        if bad:
+            k = bad[0]
+            raise OptionError(f"the start {names[k]} = {x[k]:g} is negative, but {names[k]} is declared positive and "
+                              f"{self.method!r} keeps it so; give a positive start (0 takes its scale), or "
+                              f"positivity=False")
+
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Passes from ``x0`` (and restarts around it) until the estimate fits or the budget is spent."""
         t0 = time.perf_counter()
