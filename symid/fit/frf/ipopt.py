@@ -168,7 +168,7 @@ class IpoptFRF(NoiseWeighted, FrfEstimator):
             max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         time_limit = check_time_limit("time_limit", time_limit)
         run = self._solver.solve(x0, max_iter=max_iter, time_limit=time_limit)
-        message = run.status + moved_onto_bounds(x0, self.lower, self.upper, self.model.parameter_names)
+        message = run.status + run.note + moved_onto_bounds(x0, self.lower, self.upper, self.model.parameter_names)
         return self.outcome(x0, run.z, finished=run.finished, status=run.status, message=message,
                             iterations=run.iterations, wall_time=run.seconds)
 

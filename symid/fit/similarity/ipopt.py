@@ -112,7 +112,7 @@ class IpoptSimilarity(SimilarityEstimator):
         theta0, T0, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
         run = self._solver.solve(self.misfit_F.join(theta0, T0), scale=unknown_scale(theta0, T0, self._lower))
         theta, T = self.misfit_F.split(run.z)
-        message = f"IPOPT: {run.status}"
+        message = f"IPOPT: {run.status}{run.note}"
         if run.status == "Maximum_WallTime_Exceeded":
             message += "; " + budget_message(self.options["time_limit"], run.iterations)
         return self.transform_outcome(x0, theta, T, finished=run.finished, status=run.status,
