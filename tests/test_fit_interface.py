@@ -265,3 +265,18 @@ def test_the_polish_is_judged_with_the_same_noise_floor():
     res = si.identify(model, noisy, method="scr", seed=0, polish=True, identifiability_check=False,
                       noise_floor=1e-6)  # 100 times too small: nothing may count as a success
     assert not res.success and not res.polished.success and "noise floor" in res.polished.fit
+
+
+def test_a_failed_estimate_says_what_to_try_next():
+    # a new-user trial: failure texts named the rule but never a next step
+    warnings.simplefilter("ignore", si.IdentifiabilityWarning)
+    belt = si.load_model("belt_drive")
+    res = si.identify(belt.model, belt.data(), method="ipopt", x0=np.zeros(4), identifiability_check=False)
+    assert not res.success and "NEXT: far from a fit: try more starts" in res.summary()
+    noisy = si.simulate_frf(belt.model, belt.truth, belt.data().w, noise=1e-4, seed=1)
+    res = si.identify(belt.model, noisy, method="scr", x0=np.zeros(4), identifiability_check=False, polish=True)
+    assert not res.success and res.polished.success  # SCR's equation-error estimate; polished, a fit
+    assert "NEXT: the polished estimate fits the data: use .polished" in res.summary()
+    good = si.identify(belt.model, belt.data(), method="ipopt", x0=list(belt.truth.values()),
+                       identifiability_check=False)
+    assert good.success and "NEXT" not in good.summary()

@@ -22,6 +22,39 @@ def _relative_difference(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.divide(np.abs(a - b), top, out=np.zeros_like(top), where=top > 0)
 
 
+_NEXT_STEPS = (
+    ("not physical", "the estimate breaks what the model declares (the fit line says what): try other starts "
+                     "(starts=20) or bounds that keep it admissible"),
+    ("black box", "a model of this order fits the data far better than this estimate, which is a local minimum or "
+                  "stopped short: try more starts (starts=20), method='auto' with scale= your typical values, or "
+                  "polish=True"),
+    ("structured", "the residual is smooth across frequency: a local minimum, or noise that grows with |H|; with "
+                   "noisy data give variance= (si.estimate_frf returns it) or noise_floor= (1e-4 for 1 % noise), "
+                   "otherwise try more starts or method='auto' with scale="),
+    ("over 10 %", "far from a fit: try more starts (starts=20), method='auto' with scale= your typical values, and "
+                  "check the model's structure and the data's units"),
+    ("χ²", "the misfit exceeds what the declared noise explains: a local minimum (more starts, "
+           "method='auto'), or a noise_floor/variance smaller than the data's noise"),
+    ("pass noise_floor=", "without a noise level only an exact fit counts: give noise_floor= (the relative misfit "
+                          "the noise leaves, 1e-4 for 1 % noise) to judge a fit of noisy data"),
+)
+
+
+def next_step(fit: str) -> str | None:
+    """What to try when an estimate does not fit, from its ``fit`` text (``None`` when there is no advice).
+
+    Examples
+    --------
+    >>> from symid.fit.result import next_step
+    >>> next_step("misfit 9.87e-01 > 0.01 (over 10 % rms) and no noise floor given").startswith("far from a fit")
+    True
+    """
+    for key, advice in _NEXT_STEPS:
+        if key in fit:
+            return advice
+    return None
+
+
 def _best_index(starts: tuple[StartOutcome, ...] | list[StartOutcome]) -> int:
     """Index of the lowest data misfit (non-finite costs rank last; the first on ties)."""
     return int(np.argmin([s.cost if np.isfinite(s.cost) else np.inf for s in starts]))
@@ -300,6 +333,11 @@ class IdentificationResult:
                  f"total time {self.wall_time:.3f} s"]
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
+        if not self.success:
+            if self.polished is not None and self.polished.success:
+                lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
+            elif (advice := next_step(self.fit)) is not None:
+                lines.append(f"NEXT: {advice}")
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")
