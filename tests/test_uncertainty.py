@@ -224,3 +224,20 @@ def test_monte_carlo_spectra_two_dof():
     make = lambda i: si.simulate_spectra(model, T2, w, Phi_uu=1.0, noise=0.01, seed=1000 + i)  # noqa: E731
     _monte_carlo(model, T2, make, "ipopt")
     _monte_carlo(model, T2, make, "ipopt", weighting="frequency")
+
+
+def test_a_singular_fisher_information_leaves_the_determined_parameters_finite():
+    """H = c/(jω + a + b): a and b only as a + b, c on its own. The linearised least squares determines c, and
+    a + b, but not a or b: c's standard error is that of the same fit with a + b as one parameter, a's and b's
+    are inf (a new-user trial found inf for every parameter whenever the information was singular)."""
+    a, b, c = si.parameters("a b c", positive=True)
+    model = si.StateSpaceModel(A=[[-a - b]], B=[[1]], C=[[c]])
+    frf = si.simulate_frf(model, [0.3, 0.2, 2.0], W20, noise=0.01, seed=0)
+    res = si.identify(model, frf, method="ipopt", x0=[0.3, 0.2, 2.0], identifiability_check=False)
+    unc = res.uncertainty
+    assert unc.near_singular and np.isinf(unc.standard_errors[0]) and np.isinf(unc.standard_errors[1])
+    s, cc = si.parameters("s cc", positive=True)
+    merged = si.StateSpaceModel(A=[[-s]], B=[[1]], C=[[cc]])
+    ref = si.identify(merged, frf, method="ipopt", x0=[0.5, 2.0], identifiability_check=False).uncertainty
+    np.testing.assert_allclose(unc.standard_errors[2], ref.standard_errors[1], rtol=1e-3)
+    assert np.isfinite(unc.intervals[2]).all()

@@ -39,7 +39,10 @@ A Fisher information that is near-singular means the data hardly determine some
 combination of the parameters — practically non-identifiable even when structurally
 identifiable: the flag ``near_singular`` is set when the smallest eigenvalue of the
 correlation-scaled F (unit diagonal) is below 1e-8 of its largest; the weakest
-direction is reported.
+direction is reported. Where F is singular (to 1e-15), a parameter whose unit vector lies
+in the row space of J is still determined to first order and gets the standard error of
+the pseudo-inverse; one with a part in the null space gets ``inf`` (before, every
+parameter got ``inf``, the well-determined ones too).
 
 An estimator offers this by inheriting :class:`FisherInformation` (declared, never
 probed for); :func:`symid.identify` then fills ``result.uncertainty``.
@@ -60,6 +63,9 @@ __all__ = ["NEAR_SINGULAR", "SHIFT_LIMIT", "FisherInformation", "Uncertainty", "
 
 NEAR_SINGULAR = 1e-8
 """Smallest/largest eigenvalue of the correlation-scaled Fisher information below which it is near-singular."""
+
+_NULL_PART = 1e-6
+"""A parameter whose unit vector (scaled) has more than this part in the null space of J is not determined."""
 
 SHIFT_LIMIT = 0.5
 """Largest distance (in standard errors) from θ̂ to the least-squares estimate at which intervals centred on θ̂
@@ -388,9 +394,20 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
             cov = cov_all[:l, :l]
         cov = 0.5 * (cov + cov.T)
     else:
-        result = singular(cond)
-        return Uncertainty(names, result.covariance, result.standard_errors, result.intervals, level, dof, cond,
-                           True, weakest, units, result.noise_source, ratio, note)
+        # singular: a parameter whose unit vector has no part in the null space of J (scaled) is still
+        # determined to first order, its variance that of the pseudo-inverse; the others are not (inf)
+        null = gev <= gev[-1] * 1e-15
+        if not np.any(~null):
+            result = singular(cond)
+            return Uncertainty(names, result.covariance, result.standard_errors, result.intervals, level, dof,
+                               cond, True, weakest, units, result.noise_source, ratio, note)
+        Gpinv = (gvec[:, ~null] / gev[~null]) @ gvec[:, ~null].T
+        cov_all = Gpinv @ (Js.T @ (Js * vn[:, None])) @ Gpinv / np.outer(safe, safe)
+        free = np.linalg.norm(gvec[:, null], axis=1) > _NULL_PART
+        cov = 0.5 * (cov_all + cov_all.T)[:l, :l]
+        cov[free[:l], :] = np.inf
+        cov[:, free[:l]] = np.inf
+        near = True
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
     ci = np.column_stack([theta - quantile * se, theta + quantile * se])
     return Uncertainty(names, cov, se, ci, level, dof, cond, near, weakest, units,
