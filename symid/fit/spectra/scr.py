@@ -163,10 +163,12 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         self._setup_engine(self._build(None), solve_opts, normalize=self._normalize)
 
     def polisher(self) -> Any:
-        """IPOPT on (5-13) (:class:`~symid.fit.spectra.ipopt.IpoptPSD`)."""
+        """IPOPT on (5-13) (:class:`~symid.fit.spectra.ipopt.IpoptPSD`), with the same positivity and time limit
+        (a polish is bounded as a start is)."""
         from symid.fit.spectra.ipopt import IpoptPSD
 
-        return IpoptPSD(self.model, self.data, positivity=self.options["positivity"])
+        return IpoptPSD(self.model, self.data, positivity=self.options["positivity"],
+                        time_limit=self.options["time_limit"])
 
     # -- problem construction ---------------------------------------------------------------
     def _compress(self, rank_tol: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
