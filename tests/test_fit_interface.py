@@ -280,3 +280,14 @@ def test_a_failed_estimate_says_what_to_try_next():
     good = si.identify(belt.model, belt.data(), method="ipopt", x0=list(belt.truth.values()),
                        identifiability_check=False)
     assert good.success and "NEXT" not in good.summary()
+
+
+def test_identify_takes_a_polished_method_as_compare_names_it():
+    # a new-user trial: method="scr+polish" worked in si.compare but was an unknown method in si.identify
+    warnings.simplefilter("ignore", si.IdentifiabilityWarning)
+    belt = si.load_model("belt_drive")
+    noisy = si.simulate_frf(belt.model, belt.truth, belt.data().w, noise=1e-4, seed=1)
+    res = si.identify(belt.model, noisy, method="scr+polish", x0=np.zeros(4), identifiability_check=False)
+    assert res.method == "scr" and res.polished is not None and res.polished.method == "scr+polish"
+    with pytest.raises(si.OptionError, match="no polish step"):
+        si.identify(belt.model, noisy, method="ipopt+polish", identifiability_check=False)

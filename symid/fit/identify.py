@@ -46,7 +46,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         with CasADi/IPOPT), ``"ls"`` (a linear special case, where it applies), and for
         black-box data ``"als"``, ``"gb"``. ``"scr"`` on a second-order model whose C or
         B is known, square and invertible runs the exact linear least squares instead
-        (reported as method ``"ls"``; ``force_scr=True`` runs SCR anyway).
+        (reported as method ``"ls"``; ``force_scr=True`` runs SCR anyway). ``"<method>+polish"``
+        (as :func:`symid.compare` names it) is ``method`` with ``polish=True``.
     x0 : dict or sequence, optional
         A start; it becomes the first of ``starts``.
     starts : int
@@ -130,6 +131,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
 
         method = data_kind(data).default_method
     polish = check_bool("polish", polish)
+    if isinstance(method, str) and method.endswith("+polish"):  # as si.compare names it: the method, polished
+        method, polish = method.removesuffix("+polish"), True
     identifiability_check = check_bool("identifiability_check", identifiability_check)
     if progress is not None:
         progress = check_bool("progress", progress)
