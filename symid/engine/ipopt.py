@@ -7,6 +7,7 @@ start per call of :meth:`IpoptSolver.solve`.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -442,16 +443,21 @@ class ScaledIpopt:
         opts.update({f"ipopt.{k}": v for k, v in self.ipopt_options.items()})
         return opts
 
-    def _solver(self, decade: int, mu: int, max_iter: int, time_limit: float | None) -> Any:
+    def _solver(self, decade: int, mu: int, max_iter: int, time_limit: float | None, keep: bool = True) -> Any:
+        """The IPOPT solver for these caps, built once and kept (``keep=False``: a one-off cap, built and not
+        kept, such as a rerun from the best iterate with the time left)."""
         key = (decade, mu, max_iter, time_limit)
-        if key not in self._solvers:
-            z = ca.MX.sym("z", self.l)
-            s = ca.MX.sym("s", self.l)
-            q = ca.MX.sym("q", self.n_values)
-            nlp = {"x": z, "p": ca.vertcat(s, q), "f": self.objective(z * s, q) / 10.0**decade}
-            self._solvers[key] = ca.nlpsol(f"{self.name}_{len(self._solvers)}", "ipopt", nlp,
-                                           self._options(decade, mu, max_iter, time_limit))
-        return self._solvers[key]
+        if key in self._solvers:
+            return self._solvers[key]
+        z = ca.MX.sym("z", self.l)
+        s = ca.MX.sym("s", self.l)
+        q = ca.MX.sym("q", self.n_values)
+        nlp = {"x": z, "p": ca.vertcat(s, q), "f": self.objective(z * s, q) / 10.0**decade}
+        solver = ca.nlpsol(f"{self.name}_{len(self._solvers)}", "ipopt", nlp,
+                           self._options(decade, mu, max_iter, time_limit))
+        if keep:
+            self._solvers[key] = solver
+        return solver
 
     def _report(self, z: np.ndarray, f: float) -> bool:
         ctx = self._context
@@ -487,10 +493,13 @@ class ScaledIpopt:
         return run
 
     def _run(self, theta0: np.ndarray, s: np.ndarray, q: np.ndarray, decade: int, mu: int, iters: int,
-             limit: float | None, t0: float, first: int = 0) -> IpoptRun:
+             limit: float | None, t0: float, first: int = 0,
+             left: tuple[int, float | None] | None = None) -> IpoptRun:
         """One IPOPT solve from θ₀, its iterations numbered from ``first`` for the callback (the best iterate it
-        visits is left in ``self._context["best"]``)."""
-        solver = self._solver(decade, mu, iters, limit)
+        visits is left in ``self._context["best"]``); ``left`` = (iterations, seconds) caps it below ``iters``
+        and ``limit``, with a solver built for these caps and not kept."""
+        solver = self._solver(decade, mu, iters, limit) if left is None else self._solver(decade, mu, *left,
+                                                                                          keep=False)
         self._context = {"iteration": first, "c": 10.0**decade, "s": s, "t0": t0, "best": (np.inf, None)}
         try:
             with native_interrupts(raise_now=True):
@@ -530,8 +539,10 @@ class ScaledIpopt:
         if left is not None and left <= 0:
             return IpoptRun(best, run.status, run.iterations, False, time.perf_counter() - t0,
                             f"; its best iterate kept (objective {f_best:.6g} against {f_end:.6g} at its end)")
-        again = self._run(best, s, q, decade, -9, max(iters - run.iterations, 1), left, t0,
-                          first=self._context["iteration"])
+        # the caps of the first run (whole seconds: one solver per cap is built and kept, see _solver); the
+        # iterations left and the time left bound what the rerun adds
+        again = self._run(best, s, q, decade, -9, iters, limit, t0, first=self._context["iteration"],
+                          left=(max(iters - run.iterations, 1), None if left is None else math.ceil(left)))
         f_again = self._f(again.z, q) if not again.status.startswith("IPOPT failed") else np.inf
         how = f"ended at objective {f_end:.6g} above its best iterate's {f_best:.6g}"
         if f_again <= f_best:
