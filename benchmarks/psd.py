@@ -9,7 +9,8 @@ for SCR the start θ₀ only seeds the §5-6 draws Yᵢ = ±ZᵢZᵢᵀ, Zᵢ wi
 
 - ``scr-cvxpy``: Algorithm 5.1 with M, V, K ⪰ 0, Clarabel sub-problems (the default);
 - ``scr-admm``: the same on the ADMM back end with its default options (40 SCR
-  iterations; with 20× longer inner caps a start did not finish in 6 minutes);
+  iterations; every LMI block with a penalty of its own, ``ADMMOptions.lmi_rho``: with
+  one penalty for all blocks no start converged, ``benchmarks/admm_scaling.py``);
 - ``scr-printed-sign``: Yᵢ = +ZᵢZᵢᵀ as printed in §5-6 (symid defaults to −ZᵢZᵢᵀ, see
   :mod:`symid.fit.spectra.scr`);
 - ``scr-no-lmi``: Algorithm 5.1 without the LMIs and bounds (§5-7: "no success");
