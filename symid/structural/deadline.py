@@ -83,6 +83,9 @@ def _kill_own_group() -> None:  # pragma: no cover - runs in the child process
 
 
 def _child(conn, fn, kwargs, parent, scratch):  # pragma: no cover - runs in the child process
+    # first of all: a Ctrl-C that reaches this process before it leads its own group must not end it between
+    # creating its directory and watching for its parent (the parent decides, and stops this process)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _lead_own_group()
     try:  # created here, not by the parent: a parent killed before the fork leaves no directory behind
         os.mkdir(scratch, 0o700)
@@ -92,7 +95,6 @@ def _child(conn, fn, kwargs, parent, scratch):  # pragma: no cover - runs in the
         conn.close()
         return
     tempfile.tempdir = scratch  # this process's temporary files go where the parent removes them
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the parent decides, and stops this process
     _exit_when_orphaned(parent, scratch)
     try:
         outcome = ("ok", fn(**kwargs))
@@ -144,8 +146,11 @@ class Running:
         self.started = time.monotonic()
         try:
             self._proc.start()
-        except BaseException:
+        except BaseException:  # e.g. Ctrl-C during the start: a child already forked is stopped first
             self._recv.close()
+            if self._proc.pid is not None:
+                self._proc.kill()
+                self._proc.join(5)
             shutil.rmtree(self._scratch, ignore_errors=True)
             raise
         finally:
