@@ -470,6 +470,17 @@ class ADMMBackend:
         delta = 1e-10 * max(1.0, float(N.diagonal().max(initial=0.0)))
         return _KKT(N + delta * sps.identity(nz, format="csr"), D), delta
 
+    def _refactor(self, AtA: sps.csr_matrix, H: sps.spmatrix, D: sps.spmatrix, tm: dict[str, float],
+                  t: float) -> tuple[_KKT, float] | str:
+        """:meth:`_factor` after a change of the penalties, its time (from ``t``) added to ``tm["factor"]``; the
+        reason as a message when the KKT matrix cannot be factorised."""
+        try:
+            fac = self._factor(AtA, H, D)
+        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
+            return f"ADMM: the KKT matrix could not be factorised ({exc})"
+        tm["factor"] += time.perf_counter() - t
+        return fac
+
     def _set_rho(self, rho: float) -> None:
         self.u *= self.rho / rho  # the scaled dual u = Λ/ρ
         self.rho = rho
@@ -629,11 +640,10 @@ class ADMMBackend:
                     if not 0.2 <= ratio <= 5.0:
                         t = time.perf_counter()
                         self._set_rho(float(np.clip(rho * ratio, 1e-6, 1e6)))
-                        try:
-                            kkt, delta = self._factor(AtA, H, Dm)
-                        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
-                            return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
-                        tm["factor"] += time.perf_counter() - t
+                        fac = self._refactor(AtA, H, Dm, tm, t)
+                        if isinstance(fac, str):
+                            return z0, False, fac, tm
+                        kkt, delta = fac
                         last_change = it
                 if self.lmi_adapt and it - last_change >= opt.adapt_every:
                     ratio = self._lmi_ratios(A, az, y_new, y, a_rms_s)
@@ -648,11 +658,10 @@ class ADMMBackend:
                         self._set_d()
                         y_new = y_new * (self.d_rows / d_old)  # ŷ = D y in the new factors
                         A, AT, AtA, c, H, Dm, g = self._scaled(A0, c0)
-                        try:
-                            kkt, delta = self._factor(AtA, H, Dm)
-                        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
-                            return z0, False, f"ADMM: the KKT matrix could not be factorised ({exc})", tm
-                        tm["factor"] += time.perf_counter() - t
+                        fac = self._refactor(AtA, H, Dm, tm, t)
+                        if isinstance(fac, str):
+                            return z0, False, fac, tm
+                        kkt, delta = fac
                         last_change = it
             y = y_new
         if scaled:
