@@ -91,6 +91,7 @@ from sympy.polys.polyerrors import NotInvertible
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
 from symid.errors import ModelError, SolverError
+from symid.structural.ladder import proves_global
 from symid.structural.local import rank_at
 from symid.structural.modp import BadPrime, compile_poly, residue, value_mod_p
 from symid.structural.msolve import MsolveCancelled, MsolveError, input_text, parse_output, run_msolve
@@ -173,7 +174,9 @@ class GlobalResult:
         ``"sympy"`` or ``"msolve"`` (:mod:`~symid.structural.msolve`): which computed the
         solutions (the result is the same either way, up to the float rounding of
         ``solutions``); ``"formula"`` when no solution was computed because every verdict
-        came from checked formulas (:mod:`~symid.structural.rational_formulas`).
+        came from checked formulas (:mod:`~symid.structural.rational_formulas`);
+        ``"ladder"`` when a chain driven and measured at an end mass was inverted by
+        continued fractions (:mod:`~symid.structural.ladder`: one solution, no Gröbner basis).
     slice_values : dict of str to sympy.Rational
         For a model that is not locally identifiable, solved on a slice
         (:mod:`~symid.structural.slicing`): the random values given to the parameters
@@ -598,6 +601,8 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
     params, star, _, summ, rng = star_and_summary(model, known, seed=seed, draw=draw, rank=rank, summary=summary)
     names = [p.name for p in params]
     theta2 = {n: str(v) for n, v in zip(names, star, strict=True)}
+    if proves_global(model, known, star):  # an end-driven chain: one solution, by continued fractions
+        return True, 1, dict.fromkeys(names, True), theta2
     pt = [QQ.from_sympy(v) for v in star]
     exact = [Fraction(int(v.p), int(v.q)) for v in star]
     for _ in range(10):  # a prime that divides a denominator of the system cannot reduce it: take another
@@ -744,7 +749,8 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     pt = [QQ.from_sympy(v) for v in star]
     exact_star = [Fraction(int(v.p), int(v.q)) for v in star]
     crossed = [_cross_terms(e, params, exact_star) for e in extra_candidates]
-    degree = _degree_mod_p(msolve, summ, params, exact_star, rng) \
+    ladder = proves_global(model, known, star)  # an end-driven chain: one solution, by continued fractions
+    degree = 1 if ladder else _degree_mod_p(msolve, summ, params, exact_star, rng) \
         if msolve is not None and all(c is not None for c in crossed) else None
     if degree is not None and 1 < degree <= MAX_QUOTIENT:
         points = orbit(exact_star, symmetries(model, known, summ), degree)
@@ -768,12 +774,16 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     if degree == 1:
         # one solution, θ*: every parameter and every candidate is single-valued
         times["groebner"] = time.perf_counter() - t1
+        if ladder:
+            notes.append("a mass chain driven and measured at an end mass: its continued fraction gives every "
+                         "parameter as a rational function of the transfer function (symid.structural.ladder), so "
+                         "no Gröbner basis was needed")
         sol = {n: float(v) for n, v in theta_star.items()}
         every = dict.fromkeys(names, True)
         k_forms = range(len(linear_forms))
         return GlobalResult(summ.kind, summ.labels, tuple(summ.expressions()) if expressions else (), theta_star,
                             True, 1, 1, 1, (sol,), (sol,), every, dict(every), dict(every), (),
-                            (True,) * len(crossed), 0, times, tuple(notes), engine="msolve",
+                            (True,) * len(crossed), 0, times, tuple(notes), engine="ladder" if ladder else "msolve",
                             linear_global=tuple(tuple(Fraction(int(i == k)) for i in k_forms) for k in k_forms))
     R, eqs, aux = _system(summ, params, pt)
     if msolve is not None and all(c is not None for c in crossed):
@@ -1390,7 +1400,7 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
     known values at each; default ``known``): two admissible solutions that differ in it
     there prove it not global (``local_elsewhere``; only the parameters named in
     ``local_only``, when given). ``settle``: as for :func:`global_analysis`.
-    ``spare_core``: an event (``threading`` or ``multiprocessing``) set when a processor
+    ``spare_core``: a flag (``threading.Event`` or :class:`~symid.structural.steps.SpareFlag`) set when a processor
     core is free; with msolve, the confirmation at θ** then starts beside the step at θ*
     (its msolve in a process of its own), and is used when θ* claims anything global
     (otherwise stopped). The result is the same as without it, only sooner.
@@ -1435,7 +1445,8 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
             return replace(res, notes=(*res.notes, *notes), draws=draws)
         # the run started beside θ* had the same arguments as this call when θ* was the first draw and msolve
         # decided there; otherwise (or when it never started for want of a spare core) the confirmation runs now
-        found = ahead.take(wanted=True) if ahead is not None and draws == 1 and res.engine == "msolve" else None
+        # (a run not wanted is always closed here: its thread must not outlive this call in a child process)
+        found = ahead.take(wanted=draws == 1 and res.engine == "msolve") if ahead is not None else None
         ahead = None
         if found is None:
             found = confirm_mod_p(model, **confirm_args, msolve=msolve if res.engine == "msolve" else None,

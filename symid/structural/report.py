@@ -141,7 +141,10 @@ class IdentifiabilityReport:
         it was not computed.
     engine : str
         Which program solved summary(θ) = summary(θ*): ``"msolve"`` or ``"sympy"``
-        (empty when the exact step did not finish). Like ``timing``, a record of how the
+        (empty when the exact step did not finish), ``"ladder"`` for a mass chain driven and
+        measured at an end mass, inverted by continued fractions with no Gröbner basis
+        (:mod:`symid.structural.ladder`), ``"formula"`` when checked rational formulas
+        decided every verdict. Like ``timing``, a record of how the
         report was made: the rest of the report is the same whichever ran (the floats of
         ``solutions`` agree to rounding).
     """
@@ -229,7 +232,10 @@ class IdentifiabilityReport:
             else:
                 sol = (f"{self.n_solutions} admissible of {self.n_solutions_real} real, "
                        f"{self.n_solutions_complex} complex")
-            L.append(f"global (Gröbner)   : summary(θ) = summary(θ*): {sol}")
+            if self.engine == "ladder":
+                L.append(f"global (chain)     : summary(θ) = summary(θ*): {sol} (continued-fraction inversion)")
+            else:
+                L.append(f"global (Gröbner)   : summary(θ) = summary(θ*): {sol}")
             L.append(f"summary            : {self.n_summary} {self.summary_kind}")
             if self.theta_confirm:
                 L.append("confirmed          : at an independent point θ**")

@@ -69,15 +69,45 @@ def _global_step(model, known, positive, seed, extra_candidates, expressions, ra
                           expressions=expressions, msolve=msolve, spare_core=spare_core)
 
 
-def _spare_core_event() -> Any:
-    """An event shared with child processes, or None on a machine with one usable core (nothing to spare)."""
+class SpareFlag:
+    """A flag the parent sets once a core is free, read by its child processes: ``set``, ``is_set``, ``wait``.
+
+    One byte of shared memory, with no lock on purpose. A ``multiprocessing.Event`` waited
+    on in a child that exits or is killed mid-wait leaves its condition counting a sleeper
+    that never wakes, and the parent's next ``set()`` then blocks forever (seen: a report
+    that hung when its global step ended within the head start while the child's
+    confirmation thread was still polling the event).
+    """
+
+    def __init__(self, ctx: Any):
+        self._value = ctx.RawValue("b", 0)
+
+    def set(self) -> None:
+        self._value.value = 1
+
+    def is_set(self) -> bool:
+        return bool(self._value.value)
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Whether the flag is set, after waiting up to ``timeout`` s for it (None: as long as it takes)."""
+        end = None if timeout is None else time.monotonic() + timeout
+        while not self._value.value:
+            rest = None if end is None else end - time.monotonic()
+            if rest is not None and rest <= 0:
+                return False
+            time.sleep(0.005 if rest is None else min(0.005, rest))
+        return True
+
+
+def _spare_core_event() -> SpareFlag | None:
+    """A flag shared with child processes, or None on a machine with one usable core (nothing to spare)."""
     try:
         cores = len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not on Linux
         cores = os.cpu_count() or 1
     if cores < 2:
         return None
-    return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn").Event()
+    return SpareFlag(mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn"))
 
 
 def _witness_step(model, known, positive, seed, rank):
