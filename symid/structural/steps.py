@@ -95,7 +95,7 @@ class SpareFlag:
             rest = None if end is None else end - time.monotonic()
             if rest is not None and rest <= 0:
                 return False
-            time.sleep(0.005 if rest is None else min(0.005, rest))
+            time.sleep(0.02 if rest is None else min(0.02, rest))  # as often as a polling Event.wait(0.02) woke
         return True
 
 
