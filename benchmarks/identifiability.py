@@ -11,7 +11,7 @@ Run ``python benchmarks/identifiability.py`` (options: ``--timeout S``, the budg
 :func:`symid.identifiability`, default 30 s as there; ``--models a b``). Prints a table
 and writes ``benchmarks/results/identifiability.json``. Target: each under 2 s.
 
-``--families [chain shear rlc catenary mammillary cycle]`` runs the model families of
+``--families [chain chain_mid shear rlc catenary mammillary cycle]`` runs the model families of
 ``benchmarks/identifiability_models.py`` instead (issue 17: the structures users write,
 up to 24 parameters; ``--max-parameters``), each cold with ``--timeout`` (default there
 10 s), and writes ``benchmarks/results/identifiability_families.json``: per model the

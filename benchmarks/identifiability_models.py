@@ -7,6 +7,9 @@ positive; inputs and sensors are unit vectors (known gains). Names: ``family-n-v
   mass i − 1 (the ground for i = 1) and mass i. 3n parameters (m, c, k). Variants:
   ``11`` force on mass 1, position of mass 1 (driving point at the grounded end);
   ``nn`` force and position at the free end; ``1n`` force on mass 1, position of mass n.
+- ``chain_mid``: the same chains driven or measured at an interior mass k = ⌈n/2⌉ (n ≥ 3).
+  Variants ``mm`` force and position of mass k; ``1m`` force on mass 1, position of
+  mass k.
 - ``shear``: a shear building of n storeys (the same topology as the chain, storey 1 on
   the ground), force on the roof, acceleration of the roof measured. 3n parameters.
 - ``rlc``: an RLC ladder of n meshes (mesh charges q): inductance and series resistance
@@ -60,6 +63,14 @@ def chain(n: int, variant: str = "11"):
                                C=_unit(n, s, False), output="position", name=f"chain-{n}-{variant}")
 
 
+def chain_mid(n: int, variant: str = "mm"):
+    m, c, k = _names("m", n), _names("c", n), _names("k", n)
+    mid = (n + 1) // 2 - 1
+    a, s = {"mm": (mid, mid), "1m": (0, mid)}[variant]
+    return si.SecondOrderModel(M=sp.diag(*m), V=_ground_chain(c), K=_ground_chain(k), B=_unit(n, a, True),
+                               C=_unit(n, s, False), output="position", name=f"chain_mid-{n}-{variant}")
+
+
 def shear(n: int, variant: str = "roof"):
     m, c, k = _names("m", n), _names("c", n), _names("k", n)
     return si.SecondOrderModel(M=sp.diag(*m), V=_ground_chain(c), K=_ground_chain(k), B=_unit(n, n - 1, True),
@@ -100,6 +111,7 @@ def _compartments(kind: str, n: int, variant: str):
 
 FAMILIES = {
     "chain": (chain, range(2, 9), ("11", "nn", "1n")),
+    "chain_mid": (chain_mid, range(3, 9), ("mm", "1m")),
     "shear": (shear, range(2, 9), ("roof",)),
     "rlc": (rlc, range(2, 9), ("ladder",)),
     "catenary": (lambda n, v: _compartments("catenary", n, v), range(2, 7), ("leak1", "leak12")),
