@@ -274,7 +274,8 @@ def redo_references(log: RunLog, timeout: float) -> None:
         log.forget(key)
         t0 = time.perf_counter()
         new = _reference(log, p, noise, p.data(noise=noise, seed=0))
-        print(f"[{i + 1}/{len(keys)}] {key}: error {old['error']:.3g} -> {new['error']:.3g}, misfit "
+        before = parameter_error(old["theta"], p.truth)  # recomputed: old records may hold another definition
+        print(f"[{i + 1}/{len(keys)}] {key}: error {before:.3g} -> {new['error']:.3g}, misfit "
               f"{old['cost']:.4g} -> {new['cost']:.4g} ({new['status']}, {time.perf_counter() - t0:.1f} s)",
               flush=True)
 

@@ -64,8 +64,9 @@ coefficients do not vanish there):
   and the gcd of step 3 has degree 1;
 - at a grounded node 0, det(K_sub + k₀ E₁₁) ≠ 0 at θ*.
 
-Each recovered value is compared with θ*'s, and D_0 from the recursion with the model's
-own transfer function at two rational frequencies: a structure misread returns False,
+Each recovered value is compared with θ*'s, and γ / D_0 from the recursion with the
+model's own transfer function, exactly, at 4n + 1 frequencies (more than two different
+rational functions of these degrees can share): a structure misread returns False,
 never a wrong verdict. This is the classical synthesis of a driving-point function as a
 ladder (Cauer's continued fraction; for an undamped string of beads, Krein's inverse
 problem: Gladwell, *Inverse Problems in Vibration*, 2nd ed., Kluwer 2004, ch. 4).
@@ -75,6 +76,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from fractions import Fraction
 from itertools import pairwise
 
 import sympy as sp
@@ -358,16 +360,54 @@ def _series_regular(ladder: Ladder, subs: Mapping) -> bool:
     return Ks.det() != 0
 
 
+def _solve(A: list[list[Fraction]], b: list[Fraction]) -> list[Fraction] | None:
+    """A x = b exactly (Gaussian elimination on fractions), or None when A is singular."""
+    n = len(b)
+    M = [[*row, rhs] for row, rhs in zip(A, b, strict=True)]
+    for c in range(n):
+        piv = next((r for r in range(c, n) if M[r][c] != 0), None)
+        if piv is None:
+            return None
+        M[c], M[piv] = M[piv], M[c]
+        for r in range(c + 1, n):
+            f = M[r][c] / M[c][c]
+            if f:
+                M[r] = [x - f * y for x, y in zip(M[r], M[c], strict=True)]
+    x = [Fraction(0)] * n
+    for r in range(n - 1, -1, -1):
+        x[r] = (M[r][n] - sum(M[r][j] * x[j] for j in range(r + 1, n))) / M[r][r]
+    return x
+
+
 def _matches_model(D: _RF, ladder: Ladder, model, known, subs: Mapping) -> bool:
-    """γ s^r / D_0(s) equals the model's C (M s² + V s + K)⁻¹ B s^r at two rational frequencies."""
+    """γ / D_0(s) equals the model's C (M s² + V s + K)⁻¹ B as rational functions of s.
+
+    Both sides have numerators and denominators of degree at most 2n, so their difference,
+    cross-multiplied, has degree at most 4n: equal values at 4n + 1 frequencies prove them
+    equal (exact arithmetic).
+    """
     mats = model_matrices(model, known)
-    M, V, K, B, C = (mats[k].xreplace(subs) for k in "MVKBC")
-    for s0 in (sp.Rational(7, 3), sp.Rational(-5, 11)):
-        Z = M * s0**2 + V * s0 + K
-        if Z.det() == 0 or D.den.eval(s0) == 0 or D.num.eval(s0) == 0:
-            return False
-        h = (C * Z.LUsolve(B))[0, 0]
-        if h != ladder.gain / D.at(s0):
+    M, V, K, B, C = ([[Fraction(int(x.p), int(x.q)) for x in row] for row in mats[k].xreplace(subs).tolist()]
+                     for k in "MVKBC")
+    n = len(M)
+    gain = Fraction(int(ladder.gain.p), int(ladder.gain.q))
+    dnum = [Fraction(int(x.p), int(x.q)) for x in D.num.all_coeffs()]
+    dden = [Fraction(int(x.p), int(x.q)) for x in D.den.all_coeffs()]
+
+    def horner(coeffs: list[Fraction], x: Fraction) -> Fraction:
+        out = Fraction(0)
+        for a in coeffs:
+            out = out * x + a
+        return out
+
+    for i in range(4 * n + 1):
+        s0 = Fraction(2 * i + 3, 7)  # distinct frequencies (positive: poles of passive chains lie left of 0)
+        Z = [[M[r][c] * s0 * s0 + V[r][c] * s0 + K[r][c] for c in range(n)] for r in range(n)]
+        x = _solve(Z, [row[0] for row in B])
+        num, den = horner(dnum, s0), horner(dden, s0)
+        if x is None or num == 0:
+            return False  # a pole of either side here: no conclusion, so no claim
+        if sum(C[0][j] * x[j] for j in range(n)) != gain * den / num:
             return False
     return True
 
