@@ -241,3 +241,23 @@ def test_a_singular_fisher_information_leaves_the_determined_parameters_finite()
     ref = si.identify(merged, frf, method="ipopt", x0=[0.5, 2.0], identifiability_check=False).uncertainty
     np.testing.assert_allclose(unc.standard_errors[2], ref.standard_errors[1], rtol=1e-3)
     assert np.isfinite(unc.intervals[2]).all()
+
+
+@pytest.mark.parametrize("method", ["lm", "auto", "ipopt"])
+@pytest.mark.parametrize("C", [[[1, 0]], [[1, 0], [0, 1]]], ids=["one output", "two outputs"])
+def test_a_fit_with_zero_residual_has_zero_standard_errors(method, C):
+    # Started at the truth on noise-free data, these methods return the truth with every residual exactly 0.
+    # The noise level estimated from the residuals is then 0, and so is the covariance. Before the fix, two
+    # output channels raised "SVD did not converge" from numpy (the channel levels divided the residual by 0),
+    # and one channel reported infinite standard errors. Reference: the sandwich covariance scales with the
+    # noise variance (Ljung, System Identification, 2nd ed., §9.2), here 0.
+    model = two_dof(C)
+    frf = si.simulate_frf(model, T2, np.linspace(0.2, 3.0, 40))
+    res = si.identify(model, frf, method=method, x0=T2, identifiability_check=False)
+    assert res.success
+    assert res.cost == 0.0
+    np.testing.assert_allclose(res.theta_vector, list(T2.values()), rtol=0, atol=0)
+    unc = res.uncertainty
+    np.testing.assert_allclose(unc.standard_errors, 0.0, atol=0)
+    np.testing.assert_allclose(unc.intervals, np.column_stack([res.theta_vector] * 2), atol=0)
+    assert np.isfinite(unc.condition)

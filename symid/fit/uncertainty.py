@@ -292,15 +292,18 @@ def _noise_levels(r: np.ndarray, J: np.ndarray, channels: np.ndarray, s: np.ndar
     present = np.array([np.any(channels == c) for c in range(p)])
     for _ in range(1 if p == 1 else 3):
         sd = level[channels] * s
-        Jt, rt = J / sd[:, None], r / sd
+        live = sd > 0  # a channel whose residual is exactly 0 (a fit to rounding) has level 0: no noise to scale by
+        if not np.any(live):
+            break
+        Jt, rt, ch = J[live] / sd[live, None], r[live] / sd[live], channels[live]
         d = np.linalg.norm(Jt, axis=0)
         U, sv, _ = np.linalg.svd(Jt / np.where(d > 0, d, 1.0)[None, :], full_matrices=False)
         U = U[:, sv > sv.max() * 1e-12] if sv.size and sv.max() > 0 else U[:, :0]
         e = rt - U @ (U.T @ rt)
         lev = np.sum(U**2, axis=1)
         for c in range(p):
-            rows = channels == c
-            if present[c]:
+            rows = ch == c
+            if present[c] and level[c] > 0:
                 level[c] *= np.sqrt(float(np.sum(e[rows] ** 2)) / max(float(np.sum(1 - lev[rows])), 1e-300))
     return level
 
@@ -366,6 +369,11 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
                            level, dof, cond, True, {}, units, "residuals" if given_std is None else "given",
                            ratio, note)
 
+    # residuals exactly 0 (a fit to rounding of noise-free data): the noise level estimated from them is 0, so
+    # is the covariance; the information's shape (conditioning, weakest direction) is that of unit noise
+    silent = given_std is None and N > 0 and bool(np.all(var == 0)) and bool(np.all(s > 0))
+    if silent:
+        var = s**2
     if N == 0 or not np.any(var > 0) or not np.all(np.isfinite(J)) or not np.all(np.isfinite(var)):
         return singular()
     # Fisher information F = Jᵀ V⁻¹ J; entries with no noise estimate (var = 0) carry no information here
@@ -408,6 +416,8 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
         cov[free[:l], :] = np.inf
         cov[:, free[:l]] = np.inf
         near = True
+    if silent:
+        cov = np.where(np.isinf(cov), cov, 0.0)
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
     ci = np.column_stack([theta - quantile * se, theta + quantile * se])
     return Uncertainty(names, cov, se, ci, level, dof, cond, near, weakest, units,
