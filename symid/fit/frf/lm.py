@@ -156,6 +156,12 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     callback : callable, optional
         ``callback(pass_index, info)`` after every pass, with ``info`` holding ``theta``,
         ``misfit``, ``fits``, ``elapsed``; a true return stops the restarts.
+    chain_start : bool, optional
+        For a chain of masses driven and measured at one end, one pass starts from the
+        chain's values read off the response by continued fractions
+        (:func:`symid.fit.frf.chain.chain_start`): the first pass when they fit the data
+        better than the start, else the second (default ``True`` for ``"auto"``,
+        ``False`` for ``"lm"``). Other models are not affected.
     {variance}
 
     Examples
@@ -174,12 +180,13 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     default_restarts: ClassVar[int] = 0
     default_bands: ClassVar[int] = 1
     default_time_limit: ClassVar[float | None] = None
+    default_chain_start: ClassVar[bool] = False
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, restarts: int | None = None,
                  spread: float = 10.0, max_iter: int = 300, positivity: bool = True, tol: float = 1e-12,
                  time_limit: float | None = None, bands: int | None = None, seed: int = 0,
                  variance: Any = "data", verbose: bool = False,
-                 callback: Callable[[int, dict[str, Any]], Any] | None = None):
+                 callback: Callable[[int, dict[str, Any]], Any] | None = None, chain_start: bool | None = None):
         self.model, self.data = model, data
         l = model.n_parameters
         self.scale = None if scale is None else check_scale("scale", scale, l)
@@ -195,6 +202,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         time_limit = check_time_limit("time_limit", time_limit)
         seed = check_seed("seed", seed)
         verbose = check_bool("verbose", verbose)
+        chain_start = self.default_chain_start if chain_start is None else check_bool("chain_start", chain_start)
         if callback is not None and not callable(callback):
             raise OptionError(f"callback must be callable (pass_index, info) -> bool; got {type(callback).__name__}")
         label = self.set_variance(variance)  # weights, the given noise and the noise floor it declares
@@ -205,7 +213,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                         "spread": spread, "max_iter": max_iter,
                         "positivity": positivity, "tol": tol, "time_limit": time_limit, "seed": seed,
                         "variance": label,
-                        "verbose": verbose}
+                        "verbose": verbose, "chain_start": chain_start}
         H = np.asarray(data.H)
         self._H = H
         self._mask = np.abs(H) > 0
@@ -214,6 +222,8 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         self._hnorm = float(np.sqrt(np.sum(wts * np.abs(H) ** 2)))
         self._positive = np.asarray(model.positive, dtype=bool) & positivity
         self._w = np.asarray(data.w, dtype=float)
+        self._chain: Any = None  # the chain's values (chain_start), read once per estimator
+        self._chain_read = False
 
     # -- parametrisation ------------------------------------------------------------------------
     def _units(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -350,6 +360,21 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                               f"{self.method!r} keeps it so; give a positive start (0 takes its scale), or "
                               f"positivity=False")
 
+    def _chain_theta(self, x0: np.ndarray) -> np.ndarray | None:
+        """x0 with the chain's values read off the response (chain_start), or None where there are none."""
+        if not self._chain_read:
+            from symid.fit.frf.chain import chain_start
+
+            self._chain, self._chain_read = chain_start(self.model, self.data), True
+        if self._chain is None:
+            return None
+        theta = x0.copy()
+        for k, name in enumerate(self.model.parameter_names):
+            v = self._chain.values.get(name)
+            if v is not None and np.isfinite(v) and (v > 0 or not self._positive[k]):
+                theta[k] = v
+        return theta
+
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Passes from ``x0`` (and restarts around it) until the estimate fits or the budget is spent."""
         t0 = time.perf_counter()
@@ -370,8 +395,21 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         repeats = 0
         polished = math.nan  # the misfit of the last loose fit a pass was continued from
         visited: list[StartOutcome] = []  # every pass's outcome: other local solutions for alternatives()
+        chain_note = ""
+        pending = None  # the chain's values, for the second pass when they fit worse than the start
+        chain = self._chain_theta(x0) if opts["chain_start"] else None
+        if chain is not None:
+            if self.misfit(chain) < self.misfit(x0):
+                phi, chain_note = self._phi(chain, centre, unit), "; pass 0 from the chain's continued fraction"
+            else:
+                pending = self._phi(chain, centre, unit)
         for k in range(opts["restarts"] + 1):
-            if k > 0:
+            if k == 1 and pending is not None:
+                if deadline is not None and time.perf_counter() >= deadline:
+                    status = "time_limit"
+                    break
+                phi, pending, chain_note = pending, None, "; pass 1 from the chain's continued fraction"
+            elif k > 0:
                 if deadline is not None and time.perf_counter() >= deadline:
                     status = "time_limit"
                     break
@@ -439,7 +477,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 "stopped": f"stopped by the callback after {passes} pass(es)",
                 "repeated": f"{_REPEATS} of {passes} passes ended at the same best misfit"}[status]
         out = self.outcome(x0, best.theta, finished=status not in ("time_limit", "stopped"), status=status,
-                           message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}",
+                           message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}{chain_note}",
                            iterations=total_nfev, wall_time=wall)
         others = tuple(c for c in visited if c is not best)
         return dataclasses.replace(out, passes=others) if others else out
@@ -460,6 +498,7 @@ class AutoFRF(LmFRF):
     default_restarts: ClassVar[int] = 30
     default_bands: ClassVar[int] = 8
     default_time_limit: ClassVar[float | None] = 120.0
+    default_chain_start: ClassVar[bool] = True
 
 
 LmFRF.__doc__ = (LmFRF.__doc__ or "").format(variance=VARIANCE_OPTION_DOC)

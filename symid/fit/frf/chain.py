@@ -1,0 +1,303 @@
+"""A start for mass-spring-damper chains measured at the driven end: the continued fraction of the response.
+
+A chain of masses driven and measured at one end mass (position, velocity or
+acceleration) has a driving-point dynamic stiffness that is a continued fraction of its
+elements (Cauer's ladder form; the structure and the algebra are those of
+:mod:`symid.structural.ladder`, which proves such chains globally identifiable). Writing
+D_j(s) for the dynamic stiffness seen at node j of the sub-chain j … n − 1 (path order
+from the driven mass), e_j(s) = c_j s + k_j for the element joining nodes j and j + 1 and
+g_j(s) for node j's ground element,
+
+    D_j = m_j s² + g_j + e_j D_{j+1} / (e_j + D_{j+1}),   1 / (D_j − m_j s² − g_j) = 1/e_j + 1/D_{j+1}.
+
+So the elements can be read off the measured response node by node, with no search:
+
+1. **Black box.** The response divided by the known gains and by (jω)^d for a sensor of
+   derivative order d is the compliance 1/D_0; a vector fit with 2n poles and no
+   constant term (:func:`symid.signal.vectfit.vector_fit`, frequencies scaled by their
+   geometric mean) gives it as poles and residues.
+2. **Peeling.** Each function is kept as γ s² + α s + β + Σ ρᵢ / (s − zᵢ). Its reciprocal
+   has the zeros as poles: the eigenvalues of a (balanced) pencil, then three Newton steps
+   on the function itself (the pencil loses digits, the function does not); residues
+   1 / f′(ζ); the polynomial part by least squares at 40 points spread over the poles'
+   magnitudes (the moment formulas cancel). At node j: m_j = γ; a ground element at the
+   driven end is R(0) + R′(0) s of R = D_0 − m_0 s² (the rest of the chain is free, so the
+   series term is O(s²) there); c_j = α of what is left (the series term tends to e_j);
+   k_j from the pole of 1/e_j at −k_j/c_j, the pole of the reciprocal whose residue matches
+   that of 1/e_j; D_{j+1} is the reciprocal of what remains. Where the sub-chain beyond is
+   free, D_{j+1} has a double zero at s = 0, so the step divides by s² first (exactly, in
+   partial fractions) and multiplies back after. The last node's γ, α, β are its mass and
+   its ground element.
+
+On noise-free responses of generated chains (``benchmarks/chain_start.py``) the values
+agree with the truth to 1e-6 or better at five masses; at eight, the parameters deep in
+the chain lose digits where the grid hardly resolves them. The values are a start, not an
+estimate: :class:`symid.fit.frf.lm.AutoFRF` runs a pass from them, and keeps it only by the
+same success rule as every other pass.
+
+Only chains that :func:`symid.structural.ladder.ladder_of` recognises are handled (one
+input and one output at the same end mass, known gains, path Laplacians, grounds at one
+end only); for a model with several inputs or outputs, each pair of one input and one
+output is tried as a model of its own, and the first that is a chain gives the start
+(its other parameters stay at the caller's start).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+import sympy as sp
+
+from symid.errors import DataError, ModelError, OptionError
+
+__all__ = ["ChainStart", "chain_start"]
+
+_NEWTON = 3  # Newton steps on each zero
+_POINTS = 40  # points of the least-squares fit of a polynomial part
+
+
+@dataclass(frozen=True)
+class ChainStart:
+    """Values of a chain's parameters read off its driving-point response (:func:`chain_start`).
+
+    Attributes
+    ----------
+    values : dict
+        Parameter name → value, for every free parameter of the chain.
+    output, input : int
+        The output and input whose response gave them.
+    black_box_error : float
+        Relative rms error of the vector fit of the compliance.
+    """
+
+    values: dict[str, float]
+    output: int
+    input: int
+    black_box_error: float
+
+
+class _Rational:
+    """f(s) = γ s² + α s + β + Σ ρᵢ / (s − zᵢ)."""
+
+    def __init__(self, g: complex, a: complex, b: complex, z: np.ndarray, rho: np.ndarray):
+        self.g, self.a, self.b = complex(g), complex(a), complex(b)
+        self.z, self.rho = np.asarray(z, dtype=complex), np.asarray(rho, dtype=complex)
+
+    def __call__(self, s: np.ndarray) -> np.ndarray:
+        s = np.asarray(s, dtype=complex)
+        return self.g * s**2 + self.a * s + self.b + np.sum(self.rho / (s[..., None] - self.z), axis=-1)
+
+    def slope(self, s: np.ndarray) -> np.ndarray:
+        s = np.asarray(s, dtype=complex)
+        return 2 * self.g * s + self.a - np.sum(self.rho / (s[..., None] - self.z) ** 2, axis=-1)
+
+    def _degree(self) -> int:
+        return 2 if self.g != 0 else (1 if self.a != 0 else 0)
+
+    def zeros(self, count: int) -> np.ndarray:
+        """The ``count`` zeros of smallest magnitude, from a balanced pencil, refined by Newton's method."""
+        N = self.z.size
+        root = np.sqrt(np.abs(self.rho))
+        root = np.where(root > 0, root, 1.0)
+        bcol = root[:, None].astype(complex)
+        crow = (self.rho / root)[None, :]
+        if self.g != 0:  # unknowns (x, u, v = s u): (sI − Z) x = b u, s u = v, c x + β u + α v + γ s v = 0
+            A = np.block([[-np.diag(self.z), -bcol, np.zeros((N, 1))],
+                          [np.zeros((1, N + 1)), -np.ones((1, 1))],
+                          [crow, np.array([[self.b, self.a]])]])
+            E = np.zeros((N + 2, N + 2), dtype=complex)
+            E[:N, :N] = np.eye(N)
+            E[N, N] = 1.0
+            E[N + 1, N + 1] = self.g
+        else:
+            A = np.block([[-np.diag(self.z), -bcol], [crow, np.array([[self.b]])]])
+            E = np.zeros((N + 1, N + 1), dtype=complex)
+            E[:N, :N] = np.eye(N)
+            E[N, N] = self.a
+        with np.errstate(all="ignore"):
+            ev = sla.eigvals(A, -E)
+        ev = ev[np.isfinite(ev)]
+        zz = ev[np.argsort(np.abs(ev))][:count]
+        if zz.size < count:
+            raise np.linalg.LinAlgError("fewer zeros than the degrees say")
+        for _ in range(_NEWTON):
+            with np.errstate(all="ignore"):
+                step = self(zz) / self.slope(zz)
+            ok = np.isfinite(step) & (np.abs(step) < 0.1 * np.abs(zz) + 1e-300)
+            zz = np.where(ok, zz - step, zz)
+        return zz
+
+    def reciprocal(self, tail: int) -> _Rational:
+        """1/f; ``tail`` is the degree of its polynomial part (0 where f has one of its own, or a constant)."""
+        deg = self._degree()
+        count = self.z.size + deg if deg else self.z.size - tail
+        zz = self.zeros(count)
+        with np.errstate(all="ignore"):
+            res = 1.0 / self.slope(zz)
+        if deg:
+            return _Rational(0, 0, 0, zz, res)
+        if tail == 0:  # f tends to its constant β ≠ 0
+            return _Rational(0, 0, 1.0 / self.b, zz, res)
+        # the polynomial part by least squares at points spread over the poles' magnitudes
+        mag = np.abs(np.concatenate([self.z, zz]))
+        mag = mag[mag > 0] if np.any(mag > 0) else np.ones(1)
+        pts = 1j * np.geomspace(0.3 * mag.min(), 3 * mag.max(), _POINTS)
+        with np.errstate(all="ignore"):
+            lhs = 1.0 / self(pts) - np.sum(res / (pts[:, None] - zz), axis=1)
+        V = np.stack([pts**q for q in range(tail + 1)], axis=1)
+        A = np.vstack([V.real, V.imag])
+        norm = np.linalg.norm(A, axis=0)
+        coef = np.linalg.lstsq(A / norm, np.concatenate([lhs.real, lhs.imag]), rcond=None)[0] / norm
+        coef = np.concatenate([coef, np.zeros(3 - coef.size)])
+        return _Rational(coef[2], coef[1], coef[0], zz, res)
+
+    def over_s2(self) -> _Rational:
+        """f / s² for f = α s + β + Σ ρ/(s − z) with f(0) = f′(0) = 0: Σ (ρ/z²)/(s − z)."""
+        return _Rational(0, 0, 0, self.z, self.rho / self.z**2)
+
+    def times_s2(self) -> _Rational:
+        """s² f for f = β + Σ ρ/(s − z)."""
+        return _Rational(self.b, np.sum(self.rho), np.sum(self.rho * self.z), self.z, self.rho * self.z**2)
+
+
+def _peel(compliance: _Rational, n: int, grounded: set[int]) -> tuple[list, list, list]:
+    """Masses, (damper, spring) of the elements and of the grounds, node by node from the driven end."""
+    D = compliance.reciprocal(2)
+    masses: list[float] = []
+    edges: list[tuple[float, float]] = []
+    grounds: list[tuple[float, float]] = [(0.0, 0.0)] * n
+    free_beyond = (n - 1) not in grounded
+    zero = np.zeros(1, dtype=complex)
+    for j in range(n):
+        masses.append(D.g.real)
+        R = _Rational(0, D.a, D.b, D.z, D.rho)
+        if j == n - 1:
+            grounds[j] = (R.a.real, R.b.real)
+            break
+        if j in grounded:  # the driven end's ground: R(0) + R'(0) s, the free rest being O(s²) there
+            r0, r1 = complex(R(zero)[0]), complex(R.slope(zero)[0])
+            grounds[j] = (r1.real, r0.real)
+            R = _Rational(0, R.a - r1, R.b - r0, R.z, R.rho)
+        c = R.a.real
+        if free_beyond:  # s²/R = s²/e + s²/D', and s²/e = s/c − k/c² + (k²/c³)/(s + k/c)
+            T = R.over_s2().reciprocal(1)
+            want = T.z**2 / c
+            i = int(np.argmin(np.abs(T.rho - want) / np.abs(want)))
+            k = -(c * T.z[i]).real
+            keep = np.arange(T.z.size) != i
+            D = _Rational(0, 0, T.b + k / c**2, T.z[keep], T.rho[keep]).reciprocal(0).times_s2()
+        else:  # 1/R = 1/e + 1/D', 1/e = (1/c)/(s + k/c)
+            Ri = R.reciprocal(0)
+            i = int(np.argmin(np.abs(Ri.rho * c - 1)))
+            k = -(c * Ri.z[i]).real
+            keep = np.arange(Ri.z.size) != i
+            D = _Rational(0, 0, 0, Ri.z[keep], Ri.rho[keep]).reciprocal(2)
+        edges.append((c, k))
+    return masses, edges, grounds
+
+
+def _siso(model: Any, i: int, j: int) -> Any:
+    """Output i, input j of a second-order model as a model of its own (None if it has no parameter)."""
+    from symid.model.secondorder import SecondOrderModel
+
+    sym = model.symbolic
+    mats = {"M": sym["M"], "V": sym["V"], "K": sym["K"], "B": sym["B"][:, j], "C": sym["C"][i, :]}
+    present = set().union(*(m.free_symbols for m in mats.values()))
+    params = [p for p in model.parameters if p in present]
+    if not params:
+        return None
+    return SecondOrderModel(**mats, output=model.output, parameters=params)
+
+
+def chain_start(model: Any, data: Any) -> ChainStart | None:
+    """A chain's parameters read off the measured response (module docstring), or ``None``.
+
+    Parameters
+    ----------
+    model : SecondOrderModel
+    data : FrequencyData
+
+    Returns
+    -------
+    ChainStart or None
+        ``None`` when no input-output pair of the model is a chain driven and measured at
+        one end (:func:`symid.structural.ladder.ladder_of`), when the data have fewer than
+        2n + 2 lines, or when the numbers cannot be read (a black box or a reciprocal
+        that fails, values that are not finite).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.frf.chain import chain_start
+    >>> m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+    >>> chain = si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
+    ...                             K=[[k1 + k2, -k2], [-k2, k2]], B=[[1], [0]], C=[[1, 0]])
+    >>> truth = {"m1": 2.0, "m2": 0.5, "c1": 3.0, "c2": 1.0, "k1": 4e4, "k2": 1e4}
+    >>> frf = si.simulate_frf(chain, truth, np.logspace(1.5, 3, 60))
+    >>> start = chain_start(chain, frf)
+    >>> {k: float(f"{v:.6g}") for k, v in start.values.items()}
+    {'m1': 2.0, 'm2': 0.5, 'c2': 1.0, 'k2': 10000.0, 'c1': 3.0, 'k1': 40000.0}
+    """
+    from symid.structural.ladder import ladder_of
+
+    if not hasattr(model, "n_dof") or not hasattr(model, "output"):
+        return None
+    w = np.asarray(data.w, dtype=float)
+    H = np.asarray(data.H)
+    n = int(model.n_dof)
+    if w.size < 2 * n + 2:
+        return None
+    p, m = H.shape[1], H.shape[2]
+    sym = model.symbolic
+    for i in range(p):
+        for j in range(m):
+            # cheap test first: the input and the output on the same single mass, by known gains
+            b_at = [r for r in range(n) if sym["B"][r, j] != 0]
+            c_at = [r for r in range(n) if sym["C"][i, r] != 0]
+            if len(b_at) != 1 or b_at != c_at or not (sym["B"][b_at[0], j].is_number
+                                                     and sym["C"][i, c_at[0]].is_number):
+                continue
+            try:
+                sub = _siso(model, i, j)
+                lad = None if sub is None else ladder_of(sub)
+            except (ModelError, sp.SympifyError):
+                continue
+            if lad is None:
+                continue
+            try:
+                return _read(lad, w, H[:, i, j], n, i, j)
+            except (np.linalg.LinAlgError, ValueError, DataError, OptionError, ZeroDivisionError):
+                continue
+    return None
+
+
+def _read(lad: Any, w: np.ndarray, h: np.ndarray, n: int, i: int, j: int) -> ChainStart | None:
+    from symid.signal.vectfit import vector_fit
+
+    s = 1j * w
+    with np.errstate(all="ignore"):
+        compliance = h / s**lad.shift / float(lad.gain)
+    if not np.all(np.isfinite(compliance)) or not np.any(compliance != 0):
+        return None
+    w0 = float(np.sqrt(w[0] * w[-1]))
+    bb = vector_fit(w / w0, compliance, 2 * n, weight="relative", D=False)
+    poles = np.asarray(bb.poles) * w0
+    residues = np.asarray(bb.residues).reshape(poles.size, -1)[:, 0] * w0
+    grounded = {k for k, g in enumerate(lad.grounds) if any(v != 0 for v in g)}
+    masses, edges, grounds = _peel(_Rational(0, 0, 0, poles, residues), n, grounded)
+    values: dict[str, float] = {}
+    slots = [*zip(lad.masses, masses, strict=True),
+             *((sym, val) for pair, vals in zip(lad.edges, edges, strict=True)
+               for sym, val in zip(pair, vals, strict=True)),
+             *((sym, val) for pair, vals in zip(lad.grounds, grounds, strict=True)
+               for sym, val in zip(pair, vals, strict=True))]
+    for sym, val in slots:
+        if isinstance(sym, sp.Symbol):
+            values[sym.name] = float(val)
+    if not all(np.isfinite(v) for v in values.values()):
+        return None
+    return ChainStart(values=values, output=i, input=j, black_box_error=float(bb.rms))
