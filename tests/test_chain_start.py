@@ -63,11 +63,20 @@ def test_a_second_sensor_is_left_to_the_fit():
         assert start.values[name] == pytest.approx(value, rel=1e-6), name
 
 
-@pytest.mark.parametrize("case", ["interior drive", "not collocated", "unknown gain", "state space"])
+@pytest.mark.parametrize("output", ["position", "velocity", "acceleration"])
+@pytest.mark.parametrize("drive", [2, 3], ids=["mass 2 of 4", "mass 3 of 4"])
+def test_a_chain_driven_at_an_interior_mass_is_read_by_splitting_its_poles(drive, output):
+    truth = {**TRUTH3, "m4": 1.2, "c4": 6.0, "k4": 2e4}
+    model = chain(4, drive, [drive], output)
+    start = chain_start(model, si.simulate_frf(model, truth, W3))
+    assert start is not None
+    for name, value in truth.items():
+        assert start.values[name] == pytest.approx(value, rel=1e-6), name
+
+
+@pytest.mark.parametrize("case", ["not collocated", "unknown gain", "state space"])
 def test_other_structures_have_no_chain_start(case):
-    if case == "interior drive":
-        model = chain(3, 2, [2])
-    elif case == "not collocated":
+    if case == "not collocated":
         model = chain(3, 1, [3])
     elif case == "unknown gain":
         g = si.parameters("g", positive=True)

@@ -110,6 +110,9 @@ class Ladder:
         0, 1 or 2: the sensor measures position, velocity or acceleration.
     gain : sympy.Rational
         b c, the product of the input and sensor gains.
+    at : int
+        Position of the driven mass in ``order``: 0 (an end) unless ``ladder_of`` was asked
+        for chains driven anywhere; then the path runs from its grounded end (if any).
     """
 
     order: tuple
@@ -118,6 +121,7 @@ class Ladder:
     grounds: tuple
     shift: int
     gain: sp.Rational
+    at: int = 0
 
 
 def _slot(expr: sp.Expr, params: set) -> sp.Expr | None:
@@ -135,8 +139,13 @@ def _unit(vec: sp.Matrix) -> tuple[int, sp.Rational] | None:
     return nz[0]
 
 
-def ladder_of(model, known: Mapping[str, object] | None = None) -> Ladder | None:
+def ladder_of(model, known: Mapping[str, object] | None = None, *, driven_anywhere: bool = False) -> Ladder | None:
     """The chain structure of ``model`` (see the module notes), or None when it is not one.
+
+    ``driven_anywhere=True`` also recognises a chain driven and measured at an interior
+    mass (for :mod:`symid.fit.frf.chain`; the inversion of this module needs an end):
+    ``order`` then runs from the end that has the ground element (ground elements at one
+    end only, never at the driven mass) and ``at`` says where the driven mass is.
 
     Examples
     --------
@@ -192,6 +201,9 @@ def ladder_of(model, known: Mapping[str, object] | None = None) -> Ladder | None
         ground.append(pair)
     # the path from the driven mass
     start = b[0]
+    around = [j for j in range(n) if (start, j) in edge]
+    if driven_anywhere and len(around) == 2:
+        return _interior(start, around, edge, ground, masses, params, shift, b[1] * c[1])
     order, prev = [start], None
     while True:
         nxt = [j for j in range(n) if (order[-1], j) in edge and j != prev]
@@ -216,6 +228,40 @@ def ladder_of(model, known: Mapping[str, object] | None = None) -> Ladder | None
     return Ladder(tuple(order), tuple(masses[i] for i in order),
                   tuple(edge[i, j] for i, j in pairwise(order)),
                   tuple(ground[i] for i in order), shift, b[1] * c[1])
+
+
+def _interior(start: int, around: list[int], edge: dict, ground: list, masses: list, params: set, shift: int,
+              gain: sp.Rational) -> Ladder | None:
+    """A chain driven at an interior mass (``ladder_of(..., driven_anywhere=True)``), or None."""
+    sides = []
+    for first in around:
+        path, prev = [first], start
+        while True:
+            nxt = [j for j in range(len(masses)) if (path[-1], j) in edge and j != prev]
+            if len(nxt) > 1:
+                return None
+            if not nxt:
+                break
+            prev = path[-1]
+            if nxt[0] in path or nxt[0] == start:
+                return None
+            path.append(nxt[0])
+        sides.append(path)
+    if ground[sides[1][-1]] != (0, 0):  # the grounded end first
+        sides.reverse()
+    order = [*reversed(sides[0]), start, *sides[1]]
+    n = len(masses)
+    if len(order) != n:
+        return None
+    grounded = [j for j, i in enumerate(order) if ground[i] != (0, 0)]
+    if grounded and grounded != [0]:
+        return None
+    slots = [*masses, *(v for i, j in pairwise(order) for v in edge[i, j]), *(v for g in ground for v in g)]
+    used = [v for v in slots if v in params]
+    if len(used) != len(set(used)) or set(used) != params:
+        return None
+    return Ladder(tuple(order), tuple(masses[i] for i in order), tuple(edge[i, j] for i, j in pairwise(order)),
+                  tuple(ground[i] for i in order), shift, gain, at=len(sides[0]))
 
 
 class _RF:

@@ -1,4 +1,4 @@
-"""A start for mass-spring-damper chains measured at the driven end: the continued fraction of the response.
+"""A start for mass-spring-damper chains measured at the driven mass: continued fractions of the response.
 
 A chain of masses driven and measured at one end mass (position, velocity or
 acceleration) has a driving-point dynamic stiffness that is a continued fraction of its
@@ -35,16 +35,26 @@ the chain lose digits where the grid hardly resolves them. The values are a star
 estimate: :class:`symid.fit.frf.lm.AutoFRF` runs a pass from them, and keeps it only by the
 same success rule as every other pass.
 
-Only chains that :func:`symid.structural.ladder.ladder_of` recognises are handled (one
-input and one output at the same end mass, known gains, path Laplacians, grounds at one
-end only); for a model with several inputs or outputs, each pair of one input and one
-output is tried as a model of its own, and the first that is a chain gives the start
-(its other parameters stay at the caller's start).
+**Driven at an interior mass.** Then D = m s² + S_L + S_R, the stiffness of the two sides
+seen through their connecting elements, and the poles of D − m s² belong to one side or
+the other (2L of them to a side of L masses). Each split of the conjugate pairs is tried
+(at most 5000; 35 at eight masses driven at the fourth): the side away from the ground is
+free, so S_R(0) = S_R′(0) = 0 fixes how the polynomial part splits, and each side is
+peeled as above. A wrong split leaves residues that do not match a chain's, negative
+values or a ground element at the free end; the split that matches best is kept.
+
+Only chains that :func:`symid.structural.ladder.ladder_of` recognises (with
+``driven_anywhere=True``) are handled: one input and one output at the same mass, known
+gains, path Laplacians, ground elements at one end only and not at the driven mass. For a
+model with several inputs or outputs, each pair of one input and one output is tried as a
+model of its own, and the first that is a chain gives the start (its other parameters
+stay at the caller's start).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import combinations
 from typing import Any
 
 import numpy as np
@@ -163,40 +173,133 @@ class _Rational:
         return _Rational(self.b, np.sum(self.rho), np.sum(self.rho * self.z), self.z, self.rho * self.z**2)
 
 
+def _step(R: _Rational, free_beyond: bool) -> tuple[float, float, _Rational, float]:
+    """From R = e ∥ D′ (e = c s + k in series with the sub-chain's D′): (c, k, D′, mismatch of the pole's residue)."""
+    c = R.a.real
+    if free_beyond:  # s²/R = s²/e + s²/D′, and s²/e = s/c − k/c² + (k²/c³)/(s + k/c)
+        T = R.over_s2().reciprocal(1)
+        want = T.z**2 / c
+        miss = np.abs(T.rho - want) / np.abs(want)
+        i = int(np.argmin(miss))
+        k = -(c * T.z[i]).real
+        keep = np.arange(T.z.size) != i
+        D = _Rational(0, 0, T.b + k / c**2, T.z[keep], T.rho[keep]).reciprocal(0).times_s2()
+    else:  # 1/R = 1/e + 1/D′, 1/e = (1/c)/(s + k/c)
+        Ri = R.reciprocal(0)
+        miss = np.abs(Ri.rho * c - 1)
+        i = int(np.argmin(miss))
+        k = -(c * Ri.z[i]).real
+        keep = np.arange(Ri.z.size) != i
+        D = _Rational(0, 0, 0, Ri.z[keep], Ri.rho[keep]).reciprocal(2)
+    return c, k, D, float(miss[i])
+
+
+def _side(R: _Rational, count: int, far_grounded: bool) -> tuple[list, list, tuple, float]:
+    """A sub-chain of ``count`` masses seen through the element joining it: R = e₀ ∥ D₁.
+
+    Returns its masses, its elements e₀ … e_{count−1} as (damper, spring), the far end's
+    ground element and the largest residue mismatch of the steps (0 for a true chain)."""
+    masses, edges, worst = [], [], 0.0
+    for _ in range(count):
+        c, k, D, miss = _step(R, not far_grounded)
+        edges.append((c, k))
+        masses.append(D.g.real)
+        worst = max(worst, miss)
+        R = _Rational(0, D.a, D.b, D.z, D.rho)
+    return masses, edges, (R.a.real, R.b.real), worst
+
+
 def _peel(compliance: _Rational, n: int, grounded: set[int]) -> tuple[list, list, list]:
     """Masses, (damper, spring) of the elements and of the grounds, node by node from the driven end."""
     D = compliance.reciprocal(2)
-    masses: list[float] = []
-    edges: list[tuple[float, float]] = []
+    R = _Rational(0, D.a, D.b, D.z, D.rho)
     grounds: list[tuple[float, float]] = [(0.0, 0.0)] * n
-    free_beyond = (n - 1) not in grounded
-    zero = np.zeros(1, dtype=complex)
-    for j in range(n):
-        masses.append(D.g.real)
-        R = _Rational(0, D.a, D.b, D.z, D.rho)
-        if j == n - 1:
-            grounds[j] = (R.a.real, R.b.real)
-            break
-        if j in grounded:  # the driven end's ground: R(0) + R'(0) s, the free rest being O(s²) there
-            r0, r1 = complex(R(zero)[0]), complex(R.slope(zero)[0])
-            grounds[j] = (r1.real, r0.real)
-            R = _Rational(0, R.a - r1, R.b - r0, R.z, R.rho)
-        c = R.a.real
-        if free_beyond:  # s²/R = s²/e + s²/D', and s²/e = s/c − k/c² + (k²/c³)/(s + k/c)
-            T = R.over_s2().reciprocal(1)
-            want = T.z**2 / c
-            i = int(np.argmin(np.abs(T.rho - want) / np.abs(want)))
-            k = -(c * T.z[i]).real
-            keep = np.arange(T.z.size) != i
-            D = _Rational(0, 0, T.b + k / c**2, T.z[keep], T.rho[keep]).reciprocal(0).times_s2()
-        else:  # 1/R = 1/e + 1/D', 1/e = (1/c)/(s + k/c)
-            Ri = R.reciprocal(0)
-            i = int(np.argmin(np.abs(Ri.rho * c - 1)))
-            k = -(c * Ri.z[i]).real
-            keep = np.arange(Ri.z.size) != i
-            D = _Rational(0, 0, 0, Ri.z[keep], Ri.rho[keep]).reciprocal(2)
-        edges.append((c, k))
-    return masses, edges, grounds
+    if n == 1:
+        grounds[0] = (R.a.real, R.b.real)
+        return [D.g.real], [], grounds
+    if 0 in grounded:  # the driven end's ground: R(0) + R'(0) s, the free rest being O(s²) there
+        zero = np.zeros(1, dtype=complex)
+        r0, r1 = complex(R(zero)[0]), complex(R.slope(zero)[0])
+        grounds[0] = (r1.real, r0.real)
+        R = _Rational(0, R.a - r1, R.b - r0, R.z, R.rho)
+    masses, edges, far, _ = _side(R, n - 1, (n - 1) in grounded)
+    grounds[n - 1] = far
+    return [D.g.real, *masses], edges, grounds
+
+
+def _units(z: np.ndarray) -> list[list[int]]:
+    """Indices of the poles grouped into conjugate pairs and single real poles."""
+    left = list(range(z.size))
+    out = []
+    while left:
+        i = left.pop(0)
+        if abs(z[i].imag) <= 1e-9 * abs(z[i]):
+            out.append([i])
+            continue
+        j = min(left, key=lambda q: abs(z[q] - np.conj(z[i])), default=None)
+        if j is None:
+            out.append([i])
+            continue
+        left.remove(j)
+        out.append([i, j])
+    return out
+
+
+_SPLITS = 5000  # partitions of the poles tried at most for a chain driven at an interior mass
+
+
+def _peel_interior(compliance: _Rational, n: int, at: int, left_grounded: bool) -> tuple[list, list, list]:
+    """A chain driven at node ``at`` (0 < at < n − 1, the ground, if any, at node 0), by splitting the poles.
+
+    D = m s² + S_L + S_R with S_X the stiffness of side X seen through its connecting
+    element. The poles of D − m s² split between the sides (2·at on the left); the free
+    right side has S_R(0) = S_R′(0) = 0, which fixes the split of the polynomial part. Every
+    split is peeled; the one whose steps match best (residues as a chain's, values positive) wins.
+    """
+    D = compliance.reciprocal(2)
+    P = _Rational(0, D.a, D.b, D.z, D.rho)
+    units = _units(P.z)
+    size_left = 2 * at
+    best: tuple[float, list, list, list] | None = None
+    tried = 0
+    for r in range(len(units) + 1):
+        for pick in combinations(range(len(units)), r):
+            idx = [i for u in pick for i in units[u]]
+            if len(idx) != size_left:
+                continue
+            tried += 1
+            if tried > _SPLITS:
+                break
+            mask = np.zeros(P.z.size, dtype=bool)
+            mask[idx] = True
+            zL, rL, zR, rR = P.z[mask], P.rho[mask], P.z[~mask], P.rho[~mask]
+            cR, bR = np.sum(rR / zR**2), np.sum(rR / zR)
+            SL = _Rational(0, P.a - cR, P.b - bR, zL, rL)
+            SR = _Rational(0, cR, bR, zR, rR)
+            try:
+                with np.errstate(all="ignore"):
+                    mL, eL, gL, missL = _side(SL, at, left_grounded)
+                    mR, eR, gR, missR = _side(SR, n - 1 - at, False)
+            except (np.linalg.LinAlgError, ValueError, ZeroDivisionError):
+                continue
+            values = np.array([*mL, *mR, *(v for e in (*eL, *eR) for v in e)])
+            # the right side's far end is free: what is left there must be no ground element
+            scale_c = np.mean([abs(e[0]) for e in eR]) or 1.0
+            scale_k = np.mean([abs(e[1]) for e in eR]) or 1.0
+            free_end = abs(gR[0]) / scale_c + abs(gR[1]) / scale_k
+            positive = bool(np.all(np.isfinite(values)) and np.all(values > 0))
+            score = max(missL, missR, free_end) + (0.0 if positive else 1.0)
+            if not np.isfinite(score):
+                continue
+            if best is None or score < best[0]:
+                masses = [*reversed(mL), D.g.real, *mR]
+                edges = [*reversed(eL), *eR]
+                grounds = [(0.0, 0.0)] * n
+                grounds[0] = gL
+                best = (score, masses, edges, grounds)
+    if best is None:
+        raise np.linalg.LinAlgError("no split of the poles gives a chain")
+    return best[1], best[2], best[3]
 
 
 def _siso(model: Any, i: int, j: int) -> Any:
@@ -263,7 +366,7 @@ def chain_start(model: Any, data: Any) -> ChainStart | None:
                 continue
             try:
                 sub = _siso(model, i, j)
-                lad = None if sub is None else ladder_of(sub)
+                lad = None if sub is None else ladder_of(sub, driven_anywhere=True)
             except (ModelError, sp.SympifyError):
                 continue
             if lad is None:
@@ -288,7 +391,10 @@ def _read(lad: Any, w: np.ndarray, h: np.ndarray, n: int, i: int, j: int) -> Cha
     poles = np.asarray(bb.poles) * w0
     residues = np.asarray(bb.residues).reshape(poles.size, -1)[:, 0] * w0
     grounded = {k for k, g in enumerate(lad.grounds) if any(v != 0 for v in g)}
-    masses, edges, grounds = _peel(_Rational(0, 0, 0, poles, residues), n, grounded)
+    if lad.at == 0:
+        masses, edges, grounds = _peel(_Rational(0, 0, 0, poles, residues), n, grounded)
+    else:
+        masses, edges, grounds = _peel_interior(_Rational(0, 0, 0, poles, residues), n, lad.at, 0 in grounded)
     values: dict[str, float] = {}
     slots = [*zip(lad.masses, masses, strict=True),
              *((sym, val) for pair, vals in zip(lad.edges, edges, strict=True)
