@@ -74,11 +74,28 @@ def test_a_chain_driven_at_an_interior_mass_is_read_by_splitting_its_poles(drive
         assert start.values[name] == pytest.approx(value, rel=1e-6), name
 
 
+def test_an_actuator_gain_is_read_from_the_known_masses():
+    # the population benchmark's "gains" class: known masses, unknown dampers and springs, B = b e_a with b unknown;
+    # the response is b times the chain's, i.e. the chain's with every element divided by b, so the known masses give b
+    c = si.parameters("c1 c2 c3", positive=True)
+    k = si.parameters("k1 k2 k3", positive=True)
+    b = si.parameters("b", positive=True)
+    base = chain(3, 2, [2]).symbolic
+    subs = {sp.Symbol(f"m{i + 1}", positive=True): v for i, v in enumerate((2.0, 0.7, 5.0))}
+    model = si.SecondOrderModel(M=base["M"].subs(subs), V=base["V"], K=base["K"], B=base["B"] * b, C=base["C"],
+                                parameters=[*c, *k, b])
+    truth = {name: TRUTH3[name] for name in ("c1", "c2", "c3", "k1", "k2", "k3")} | {"b": 3.5}
+    start = chain_start(model, si.simulate_frf(model, truth, W3))
+    assert start is not None
+    for name, value in truth.items():
+        assert start.values[name] == pytest.approx(value, rel=1e-6), name
+
+
 @pytest.mark.parametrize("case", ["not collocated", "unknown gain", "state space"])
 def test_other_structures_have_no_chain_start(case):
     if case == "not collocated":
         model = chain(3, 1, [3])
-    elif case == "unknown gain":
+    elif case == "unknown gain":  # and no known mass to tell it from a common factor of M, V, K
         g = si.parameters("g", positive=True)
         base = chain(3, 1, [1])
         sym = base.symbolic

@@ -302,12 +302,15 @@ def _peel_interior(compliance: _Rational, n: int, at: int, left_grounded: bool) 
     return best[1], best[2], best[3]
 
 
-def _siso(model: Any, i: int, j: int) -> Any:
-    """Output i, input j of a second-order model as a model of its own (None if it has no parameter)."""
+def _siso(model: Any, i: int, j: int, gain: sp.Symbol | None = None) -> Any:
+    """Output i, input j of a second-order model as a model of its own (None if it has no parameter);
+    ``gain``, a parameter of B or C, set to 1."""
     from symid.model.secondorder import SecondOrderModel
 
     sym = model.symbolic
     mats = {"M": sym["M"], "V": sym["V"], "K": sym["K"], "B": sym["B"][:, j], "C": sym["C"][i, :]}
+    if gain is not None:
+        mats["B"], mats["C"] = mats["B"].subs(gain, 1), mats["C"].subs(gain, 1)
     present = set().union(*(m.free_symbols for m in mats.values()))
     params = [p for p in model.parameters if p in present]
     if not params:
@@ -358,27 +361,46 @@ def chain_start(model: Any, data: Any) -> ChainStart | None:
     sym = model.symbolic
     for i in range(p):
         for j in range(m):
-            # cheap test first: the input and the output on the same single mass, by known gains
+            # cheap test first: the input and the output on the same single mass, the gains known or one of
+            # them a number times a parameter found nowhere else in M, V, K (an actuator or sensor gain)
             b_at = [r for r in range(n) if sym["B"][r, j] != 0]
             c_at = [r for r in range(n) if sym["C"][i, r] != 0]
-            if len(b_at) != 1 or b_at != c_at or not (sym["B"][b_at[0], j].is_number
-                                                     and sym["C"][i, c_at[0]].is_number):
+            if len(b_at) != 1 or b_at != c_at:
+                continue
+            gain = _gain_parameter(sym["B"][b_at[0], j] * sym["C"][i, c_at[0]], model, sym)
+            if gain is False:
                 continue
             try:
-                sub = _siso(model, i, j)
+                sub = _siso(model, i, j, gain)
                 lad = None if sub is None else ladder_of(sub, driven_anywhere=True)
             except (ModelError, sp.SympifyError):
                 continue
             if lad is None:
                 continue
             try:
-                return _read(lad, w, H[:, i, j], n, i, j)
+                start = _read(lad, w, H[:, i, j], n, i, j, gain)
+                if start is not None:
+                    return start
             except (np.linalg.LinAlgError, ValueError, DataError, OptionError, ZeroDivisionError):
                 continue
     return None
 
 
-def _read(lad: Any, w: np.ndarray, h: np.ndarray, n: int, i: int, j: int) -> ChainStart | None:
+def _gain_parameter(product: sp.Expr, model: Any, sym: dict) -> sp.Symbol | bool | None:
+    """None for a known gain; the parameter p of a gain q·p (p in no mass, damper or spring); False otherwise."""
+    if product.is_number:
+        return None
+    free = product.free_symbols & set(model.parameters)
+    if len(free) != 1:
+        return False
+    p = next(iter(free))
+    if not (product / p).is_number or any(p in sym[k].free_symbols for k in ("M", "V", "K")):
+        return False
+    return p
+
+
+def _read(lad: Any, w: np.ndarray, h: np.ndarray, n: int, i: int, j: int, gain: sp.Symbol | None = None
+          ) -> ChainStart | None:
     from symid.signal.vectfit import vector_fit
 
     s = 1j * w
@@ -404,6 +426,16 @@ def _read(lad: Any, w: np.ndarray, h: np.ndarray, n: int, i: int, j: int) -> Cha
     for sym, val in slots:
         if isinstance(sym, sp.Symbol):
             values[sym.name] = float(val)
+    if gain is not None:
+        # the response is p times that of the chain, i.e. that of the chain with every element divided by p:
+        # the masses that are known numbers give p
+        ratios = [float(sym) / val for sym, val in zip(lad.masses, masses, strict=True)
+                  if not isinstance(sym, sp.Symbol) and val != 0]
+        if not ratios:
+            return None
+        p = float(np.median(ratios))
+        values = {name: v * p for name, v in values.items()}
+        values[gain.name] = p
     if not all(np.isfinite(v) for v in values.values()):
         return None
     return ChainStart(values=values, output=i, input=j, black_box_error=float(bb.rms))
