@@ -154,9 +154,9 @@ def summary(rows: list[dict[str, Any]], args: argparse.Namespace) -> list[dict[s
 def table(summ: list[dict[str, Any]], args: argparse.Namespace) -> str:
     """The summary as a Markdown table (counts over the draws whose grid resolves the tolerance)."""
     noisy = next((lv for lv in args.noise if lv > 0), None)
+    noisy_head = f"within 10 % at {noisy:g} noise" if noisy is not None else "noisy data not run"
     lines = ["| n | driven mass | draws (resolved) | values within 1e-3 | median error | read s | lm pass from them "
-             f"reaches the truth | within 10 % at {noisy:g} noise | auto with / without: truth, s |"
-             if noisy is not None else "",
+             f"reaches the truth | {noisy_head} | auto with / without: truth, s |",
              "|---|---|---|---|---|---|---|---|---|"]
     for s in summ:
         r = s["resolved"]
@@ -205,7 +205,7 @@ def main(argv: list[str] | None = None) -> int:
     summ = summary(rows, args)
     print()
     print(table(summ, args))
-    result = {"benchmark": "chain_start", "command": "benchmarks/chain_start.py " + " ".join(argv or sys.argv[1:]),
+    result = {"benchmark": "chain_start", "noise": args.noise, "command": "benchmarks/chain_start.py " + " ".join(argv or sys.argv[1:]),
               "python": platform.python_version(), "seconds": time.perf_counter() - t_all,
               "time_limit": args.time_limit, "summary": summ, "rows": rows}
     Path(args.out).write_text(json.dumps(result, indent=1, default=float))

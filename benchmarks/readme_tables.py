@@ -213,7 +213,20 @@ def population_table(doc: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def chain_start_table(doc: dict) -> str:
+    """``benchmarks/chain_start.py``: the table it prints (per size and driven mass)."""
+    from types import SimpleNamespace
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from chain_start import table
+
+    first = doc["summary"][0]
+    noise = sorted({float(k.removeprefix("read_")) for k in first if k.startswith("read_") and "_s_" not in k})
+    return table(doc["summary"], SimpleNamespace(noise=noise)) + "\n"
+
+
 TABLES: dict[str, Callable[[dict], str]] = {
+    "benchmarks/results/chain_start.json": chain_start_table,
     "benchmarks/results/population.json": population_table,
     "benchmarks/results/n4sid_oversampling.json": n4sid_oversampling_table,
     "benchmarks/results/psd.json": psd_table,
