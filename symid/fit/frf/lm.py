@@ -415,6 +415,9 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 phi, chain_note = self._phi(chain, centre, unit), "; pass 0 from the chain's continued fraction"
             else:
                 pending = self._phi(chain, centre, unit)
+            if opts["verbose"]:
+                print(f"{self.method}: the chain's values read off the response "
+                      f"(pass {0 if pending is None else 1} starts there)", flush=True)
         for k in range(opts["restarts"] + 1):
             if k == 1 and pending is not None:
                 if deadline is not None and time.perf_counter() >= deadline:
