@@ -419,7 +419,14 @@ def _spectral_data(draw):
     bounded = st.floats(min_value=-1e150, max_value=1e150, allow_nan=False)  # X + Xᴴ stays finite
     parts = [draw(hnp.arrays(np.float64, (len(w), k, k), elements=bounded)) for k in (p, p, m, m)]
     Xy, Xu = parts[0] + 1j * parts[1], parts[2] + 1j * parts[3]
-    return SpectralData(np.array(w), Xy + np.conj(np.swapaxes(Xy, 1, 2)), Xu + np.conj(np.swapaxes(Xu, 1, 2)))
+
+    def spectrum(X):  # Hermitian, and its diagonal a power (≥ 0): SpectralData refuses a negative one
+        S = X + np.conj(np.swapaxes(X, 1, 2))
+        k = np.arange(S.shape[1])
+        S[:, k, k] = np.abs(S[:, k, k].real)
+        return S
+
+    return SpectralData(np.array(w), spectrum(Xy), spectrum(Xu))
 
 
 @st.composite

@@ -294,3 +294,21 @@ def test_numpy_integer_seed_is_accepted(siso):
     model, th = siso
     assert si.simulate_frf(model, th, W, noise=0.1, seed=np.int64(4)) == si.simulate_frf(model, th, W, noise=0.1,
                                                                                           seed=4)
+
+
+def test_a_negative_power_is_a_data_error(siso):
+    # The diagonal of a power spectrum is a power. A negative input spectrum used to be accepted, and IPOPT then
+    # "fitted" the negative output spectra it implied with success True (found trying symid as a new user).
+    model, th = siso
+    with pytest.raises(DataError, match=r"Phi_uu\[0, 0, 0\] = -1 at frequency line 0: the diagonal of a power"):
+        si.simulate_spectra(model, th, W, -1.0)
+    with pytest.raises(DataError, match=r"Phi_uu\[2, 0, 0\] = -0.5"):
+        si.SpectralData(W, np.ones(W.size), np.where(np.arange(W.size) == 2, -0.5, 1.0))
+    with pytest.raises(DataError, match=r"Phi_yy\[0, 0, 0\] = -2"):
+        si.SpectralData(W, -2 * np.ones(W.size), np.ones(W.size))
+
+
+def test_heavy_noise_keeps_the_output_power_non_negative(siso):
+    model, th = siso
+    spec = si.simulate_spectra(model, th, np.linspace(0.5, 3.0, 400), 1.0, noise=0.5, seed=3)
+    assert spec.Phi_yy.real.min() >= 0.0

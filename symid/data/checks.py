@@ -155,3 +155,16 @@ def check_positive_scalar(x: Any, name: str) -> float:
     if not math.isfinite(val) or val <= 0:
         raise DataError(f"{name} must be a finite number > 0; got {val!r}")
     return val
+
+
+def check_power_diagonal(arr: np.ndarray, name: str) -> None:
+    """Refuse a spectrum (s, k, k) with a diagonal entry below −1e-8 times the largest: an auto-spectrum is a
+    power, ≥ 0 to rounding however noisy the estimate."""
+    diag = np.real(np.diagonal(arr, axis1=1, axis2=2))
+    floor = -1e-8 * float(np.max(np.abs(diag))) if diag.size else 0.0
+    bad = np.argwhere(diag < floor)
+    if bad.size:
+        i, j = (int(v) for v in bad[0])
+        many = f" ({bad.shape[0]} negative diagonal entries)" if bad.shape[0] > 1 else ""
+        raise DataError(f"{name}[{i}, {j}, {j}] = {diag[i, j]:.6g} at frequency line {i}: the diagonal of a power "
+                        f"spectrum is a power, ≥ 0{many}")

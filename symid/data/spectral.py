@@ -29,6 +29,7 @@ def _spectrum(x: Any, name: str, s: int, size: str) -> np.ndarray:
                         f"got shape {checks.shape_text(arr.shape)}")
     checks.check_finite(arr, name)
     checks.check_hermitian(arr, name)
+    checks.check_power_diagonal(arr, name)
     return checks.frozen(arr)
 
 
@@ -37,8 +38,9 @@ class SpectralData(DataContainer):
     """Output and input power spectra at angular frequencies ω_1 < ... < ω_s (rad/s).
 
     For a system H(ω) driven by a stationary input, ``Φyy(ω) = H(ω) Φuu(ω) H(ω)ᴴ``
-    (thesis (5-3)). Both spectra are Hermitian at every frequency. Positive
-    semidefiniteness is not enforced (noisy estimates may violate it slightly).
+    (thesis (5-3)). Both spectra are Hermitian at every frequency, and their diagonals
+    (auto-spectra, powers) are ≥ 0. Positive semidefiniteness beyond that is not enforced
+    (noisy estimates may violate it slightly).
 
     Parameters
     ----------
@@ -54,7 +56,8 @@ class SpectralData(DataContainer):
     DataError
         On NaN or inf, wrong shapes, a length mismatch with ``w``, bad frequencies, or a
         spectrum that is not Hermitian to 1e-8 relative to its Frobenius norm
-        (``max |Φ − Φᴴ| <= 1e-8 ||Φ||_F`` at each frequency).
+        (``max |Φ − Φᴴ| <= 1e-8 ||Φ||_F`` at each frequency), or a diagonal entry below
+        −1e-8 times the largest diagonal entry (a negative power).
 
     Notes
     -----

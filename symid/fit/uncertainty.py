@@ -352,7 +352,9 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     ratio = None
     if given_std is None:
         dof: int | None = max(N - k, 1)
-        level = _noise_levels(r, J, channels, s, p)
+        # residuals or sensitivities that are not finite (an estimate where the model blows up) tell nothing
+        finite = bool(np.all(np.isfinite(r)) and np.all(np.isfinite(J)))
+        level = _noise_levels(r, J, channels, s, p) if finite else np.full(p, np.nan)
         var = (level[channels] * s) ** 2
         quantile = float(student_t.ppf(0.975, dof))
     else:
@@ -372,6 +374,12 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     # residuals exactly 0 (a fit to rounding of noise-free data): the noise level estimated from them is 0, so
     # is the covariance; the information's shape (conditioning, weakest direction) is that of unit noise
     silent = given_std is None and N > 0 and bool(np.all(var == 0)) and bool(np.all(s > 0))
+    if given_std is None and not finite:
+        result = singular()
+        return Uncertainty(names, result.covariance, result.standard_errors, result.intervals, level, dof,
+                           float("inf"), False, {}, units, "residuals", ratio,
+                           (note + "; " if note else "") + "the residuals or their sensitivities are not finite at "
+                           "the estimate")
     if silent:
         var = s**2
     if N == 0 or not np.any(var > 0) or not np.all(np.isfinite(J)) or not np.all(np.isfinite(var)):

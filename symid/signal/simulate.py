@@ -160,6 +160,7 @@ def _input_spectrum(Phi_uu: Any, w: np.ndarray, m: int) -> np.ndarray:
     out = _input_spectrum_array(Phi_uu, w, m)
     checks.check_finite(out, "Phi_uu")
     checks.check_hermitian(out, "Phi_uu")
+    checks.check_power_diagonal(out, "Phi_uu")
     return out
 
 
@@ -207,7 +208,8 @@ def simulate_spectra(model: Model, theta: Theta | None, w: Any, Phi_uu: Any, *, 
     w : array_like, shape (s,)
         Angular frequencies in rad/s, strictly positive and strictly increasing.
     Phi_uu : float, array_like or callable
-        The input spectrum, Hermitian (and positive semidefinite to make physical sense):
+        The input spectrum, Hermitian with a diagonal ≥ 0 (and positive semidefinite to
+        make physical sense; a negative power is a :class:`~symid.errors.DataError`):
 
         * a scalar φ: white noise of intensity φ on every input, Φuu = φ·I;
         * an array of shape (s, m, m); or (s,), a scalar per frequency times I; or
@@ -219,8 +221,10 @@ def simulate_spectra(model: Model, theta: Theta | None, w: Any, Phi_uu: Any, *, 
         statistics). Hermitian noise is added: each diagonal entry gets real Gaussian
         noise of standard deviation ε·|Φyy_ii|, each off-diagonal pair complex Gaussian
         noise of standard deviation ε·|Φyy_ij| with E_ji = conj(E_ij), so Φyy stays
-        exactly Hermitian and every entry's rms relative error is ε. ``None`` or 0
-        gives exact data.
+        exactly Hermitian and every entry's rms relative error is ε. A diagonal entry
+        that the noise would make negative is set to 0 (a power is ≥ 0; with ε = 0.1 that
+        takes a 10-sigma draw, with ε = 0.5 one entry in 44). ``None`` or 0 gives exact
+        data.
     seed : int or numpy.random.Generator, optional
         Seed of :func:`numpy.random.default_rng`.
 
@@ -248,6 +252,8 @@ def simulate_spectra(model: Model, theta: Theta | None, w: Any, Phi_uu: Any, *, 
     Pyy = 0.5 * (Pyy + np.conj(np.swapaxes(Pyy, -1, -2)))
     if level > 0:
         Pyy = Pyy + _hermitian_noise(rng, Pyy, level)
+        idx = np.arange(Pyy.shape[1])
+        Pyy[:, idx, idx] = np.maximum(Pyy[:, idx, idx].real, 0.0)  # a power stays ≥ 0
     return SpectralData(w_, Pyy, Puu)
 
 
