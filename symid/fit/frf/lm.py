@@ -59,8 +59,9 @@ in physical units, whatever their scale (measured on the generated population of
    and measured at one mass is a continued fraction of its elements (two of them, one per
    side, for an interior mass), so its masses,
    dampers and springs can be read off the measured response node by node
-   (:func:`symid.fit.frf.chain.chain_start`, tens of milliseconds). A pass starts from them
-   first when they fit the data better than the start, else second. On noise-free data of
+   (:func:`symid.fit.frf.chain.chain_start`, tens of milliseconds). The first pass starts
+   from them (from the start only when it already fits exactly and no worse), the second
+   from the other unless the first fits to rounding. On noise-free data of
    chains whose grid resolves the tolerance they are the truth to 1e-5 or better up to
    eight masses, and ``auto`` fits in one pass (a fraction of a second) where its restarts
    had spent 45 s in vain; at 1 % noise the deeper elements come out far off (the
@@ -171,9 +172,10 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     chain_start : bool, optional
         For a chain of masses driven and measured at one mass, one pass starts from the
         chain's values read off the response by continued fractions
-        (:func:`symid.fit.frf.chain.chain_start`): the first pass when they fit the data
-        better than the start, else the second (default ``True`` for ``"auto"``,
-        ``False`` for ``"lm"``). Other models are not affected.
+        (:func:`symid.fit.frf.chain.chain_start`): the first pass, unless the start
+        already fits the data exactly and no worse; the other start gets the second pass
+        unless the first fits to rounding (default ``True`` for ``"auto"``, ``False`` for
+        ``"lm"``). Other models are not affected.
     {variance}
 
     Examples
@@ -408,14 +410,18 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         polished = math.nan  # the misfit of the last loose fit a pass was continued from
         visited: list[StartOutcome] = []  # every pass's outcome: other local solutions for alternatives()
         chain_note = ""
-        # with the chain's values (chain_start), passes 0 and 1 start from them and from x0, the better fit first;
-        # the second is skipped only when the first fits to rounding (noisy data: the first fit may be a worse
-        # minimum that the whiteness rule accepts; measured on an 8-mass chain at 1 % noise)
+        # with the chain's values (chain_start), passes 0 and 1 start from them and from x0: from x0 first only
+        # when it fits exactly and no worse than they do (a start at the truth stays there); the misfit of the
+        # values is no guide otherwise (an 8-mass chain whose deepest spring came out 3500 times too large
+        # fitted worse than the start, yet one pass from them reached the truth). The second pass is skipped
+        # only when the first fits to rounding (noisy data: the first fit may be a worse minimum that the
+        # whiteness rule accepts; measured on an 8-mass chain at 1 % noise)
         pending, pending_note = None, ""
         chain = self._chain_theta(x0) if opts["chain_start"] else None
         if chain is not None:
             chain_phi = self._phi(chain, centre, unit)
-            if self.misfit(chain) < self.misfit(x0):
+            at_start = self.misfit(x0)
+            if not (at_start <= EXACT_FIT and at_start <= self.misfit(chain)):
                 phi, pending, chain_note = chain_phi, phi.copy(), "; pass 0 from the chain's continued fraction"
             else:
                 pending, pending_note = chain_phi, "; pass 1 from the chain's continued fraction"
