@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 import symid as si
-from symid.errors import OptionError
 from symid.fit.registry import all_methods, data_kind, data_kinds
 from symid.fit.starts import make_starts
 from symid.fit.success import CEILING, EXACT_FIT, fit_test, whiteness
@@ -292,18 +291,3 @@ def test_identify_takes_a_polished_method_as_compare_names_it():
     assert res.method == "scr" and res.polished is not None and res.polished.method == "scr+polish"
     with pytest.raises(si.OptionError, match="no polish step"):
         si.identify(belt.model, noisy, method="ipopt+polish", identifiability_check=False)
-
-
-def test_scr_refuses_a_negative_start_of_a_positive_parameter_as_the_other_methods_do():
-    # found by a new-user sweep: lm, auto and ipopt named the parameter; scr ran from it and failed
-    m, c, k = si.parameters("m c k", positive=True)
-    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
-    w = np.linspace(1.0, 3.0, 30)
-    frf = si.simulate_frf(model, [1.0, 0.2, 4.0], w)
-    spec = si.simulate_spectra(model, [1.0, 0.2, 4.0], w, 1.0)
-    for data, extra in ((frf, {"force_scr": True}), (spec, {})):
-        with pytest.raises(OptionError, match=r"the start c = -0.2 is negative, but c is declared positive"):
-            si.identify(model, data, method="scr", x0=[1.0, -0.2, 4.0], identifiability_check=False, **extra)
-    res = si.identify(model, frf, method="scr", x0=[1.0, -0.2, 4.0], identifiability_check=False, force_scr=True,
-                      positivity=False, max_iter=5)
-    assert res.theta_vector.shape == (3,)

@@ -256,20 +256,6 @@ class ScrEstimator(Estimator):
 
     method: ClassVar[str] = "scr"
 
-    def check_start(self, x0: np.ndarray) -> None:
-        """Refuse a start below 0 in a parameter declared positive when ``positivity`` constrains it there (an
-        :class:`OptionError` naming it, as ``lm``, ``auto`` and ``ipopt`` do): the LMI θₖ ≥ 0 cannot hold at it."""
-        if not getattr(self, "options", {}).get("positivity", False):
-            return
-        x = np.asarray(x0, dtype=float).reshape(-1)
-        names = self.model.parameter_names
-        bad = [k for k in range(min(x.size, len(names))) if self.model.positive[k] and x[k] < 0]
-        if bad:
-            k = bad[0]
-            raise OptionError(f"the start {names[k]} = {x[k]:g} is negative, but {names[k]} is declared positive and "
-                              f"{self.method!r} keeps it >= 0 (positivity=True); give a start >= 0, or "
-                              f"positivity=False")
-
     def _engine_options(self, *, backend: Any, max_iter: Any, tol: Any, heuristic: Any = "nuclear",
                         truncate_after: Any = 0, admm: Any = None, time_limit: Any = None) -> dict[str, Any]:
         """Validated options of :func:`symid.engine.scr.solve`."""
