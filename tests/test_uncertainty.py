@@ -276,3 +276,17 @@ def test_residuals_that_are_not_finite_give_no_intervals_and_say_why():
     unc = fisher_uncertainty(np.array([1.0, 2.0]), ("a", "b"), r, J, np.arange(40) % 2)
     assert np.all(np.isinf(unc.standard_errors))
     assert "not finite" in unc.note
+
+
+def test_a_failed_fit_shows_no_intervals():
+    # found by a new-user sweep: a failed fit (IPOPT 'Solve_Succeeded' at a zero response) printed "relative noise
+    # 3.89e+14 %" and standard errors of 1e26 in its summary; intervals describe an estimate that fits the data
+    model = one_dof()
+    frf = si.simulate_frf(model, T1, W20)
+    res = si.identify(model, frf, method="ipopt", x0={"m": 1e4, "c": 1e-4, "k": 1e-3}, max_iter=3,
+                      identifiability_check=False)
+    assert not res.success
+    text = res.summary()
+    assert "uncertainty: not shown, the estimate does not fit the data" in text
+    assert "std. error" not in text
+    assert res.uncertainty is not None

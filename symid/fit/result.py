@@ -342,6 +342,11 @@ class IdentificationResult:
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")
         unc = self.uncertainty
+        if unc is not None and not self.success:
+            # intervals describe an estimate that fits the data; around one that does not they mean nothing
+            lines.append("uncertainty: not shown, the estimate does not fit the data (.uncertainty still holds "
+                         "the Fisher information at it)")
+            unc = None
         if unc is not None:
             lines.append(unc.summary())
         head = f"{'parameter':>12s} {'estimate':>14s}"
