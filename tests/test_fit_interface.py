@@ -291,3 +291,21 @@ def test_identify_takes_a_polished_method_as_compare_names_it():
     assert res.method == "scr" and res.polished is not None and res.polished.method == "scr+polish"
     with pytest.raises(si.OptionError, match="no polish step"):
         si.identify(belt.model, noisy, method="ipopt+polish", identifiability_check=False)
+
+
+def test_advice_after_a_failed_fit_names_only_what_the_data_kind_offers():
+    # found by a new-user sweep: a failed fit of I/O records advised "method='auto' with scale=", but 'auto' is a
+    # method for frequency responses only
+    from symid.fit.result import next_step
+
+    fit = "misfit 9.87e-01 > 0.01 (over 10 % rms) and no noise floor given"
+    assert "method='auto'" in next_step(fit)
+    for key in ("over 10 %", "black box", "structured", "χ²"):
+        advice = next_step(key, frf=False)
+        assert "auto" not in advice and "estimate_frf" not in advice, advice
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    io = si.simulate_io(model, [1.0, 0.4, 4.0], np.sin(0.7 * np.arange(300) * 0.05), 0.05)
+    res = si.identify(model, io, method="oe", x0=[30.0, 0.01, 0.2], max_iter=1, identifiability_check=False)
+    assert not res.success
+    assert "NEXT:" in res.summary() and "method='auto'" not in res.summary()

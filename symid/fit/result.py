@@ -40,17 +40,31 @@ _NEXT_STEPS = (
 )
 
 
-def next_step(fit: str) -> str | None:
-    """What to try when an estimate does not fit, from its ``fit`` text (``None`` when there is no advice).
+_FRF_ONLY = {  # advice that only a frequency response can follow, and what to say for other data instead
+    "method='auto' with scale= your typical values": "other methods (si.compare) or starts nearer your typical values",
+    "method='auto' with scale=": "other methods (si.compare)",
+    "method='auto'": "other methods",
+    "give variance= (si.estimate_frf returns it) or noise_floor=": "give noise_floor=",
+}
+
+
+def next_step(fit: str, frf: bool = True) -> str | None:
+    """What to try when an estimate does not fit, from its ``fit`` text (``None`` when there is no advice);
+    ``frf=False`` for data other than a frequency response (no ``method='auto'``, no ``variance=``).
 
     Examples
     --------
     >>> from symid.fit.result import next_step
     >>> next_step("misfit 9.87e-01 > 0.01 (over 10 % rms) and no noise floor given").startswith("far from a fit")
     True
+    >>> "auto" in next_step("misfit 9.87e-01 > 0.01 (over 10 % rms) and no noise floor given", frf=False)
+    False
     """
     for key, advice in _NEXT_STEPS:
         if key in fit:
+            if not frf:
+                for text, other in _FRF_ONLY.items():
+                    advice = advice.replace(text, other)
             return advice
     return None
 
@@ -336,7 +350,7 @@ class IdentificationResult:
         if not self.success:
             if self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
-            elif (advice := next_step(self.fit)) is not None:
+            elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
         ambiguity = self.ambiguity()
         if ambiguity is not None:
