@@ -150,13 +150,18 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"), black_box=not linear)
     if x0 is not None:
         estimator.check_start(x0s[0])  # the user's own start: refused with a reason (e.g. outside the bounds)
+    check_s = None
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
 
+        t_check = time.perf_counter()
         warn_if_not_identifiable(model, stacklevel=2)
+        check_s = time.perf_counter() - t_check
     if linear:  # one start says it all
         x0s = x0s[:1]
     options_used = dict(estimator.options)
+    if check_s is not None:  # reported beside the starts' time (summary), not in it
+        options_used["identifiability_check_s"] = check_s
     outcomes: list[StartOutcome] = []
     try:
         for x in progress_bar(x0s, desc=f"{estimator.method} starts", enabled=progress):

@@ -344,7 +344,9 @@ class IdentificationResult:
                  f"best: success {self.success}   cost {self.cost:.3e} ({self.cost_kind})",
                  f"  fit: {self.fit}",
                  f"  solver: {self.status}, {self.iterations} iterations; {self.message}",
-                 f"total time {self.wall_time:.3f} s"]
+                 f"total time {self.wall_time:.3f} s" + (
+                     f" (and {self.options['identifiability_check_s']:.2f} s for the identifiability check before)"
+                     if self.options.get("identifiability_check_s") is not None else "")]
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
         if not self.success:
