@@ -312,3 +312,13 @@ def test_heavy_noise_keeps_the_output_power_non_negative(siso):
     model, th = siso
     spec = si.simulate_spectra(model, th, np.linspace(0.5, 3.0, 400), 1.0, noise=0.5, seed=3)
     assert spec.Phi_yy.real.min() >= 0.0
+
+
+def test_a_model_without_parameters_needs_no_theta():
+    # found by a new-user sweep: simulate_frf(model, None, w) said "theta is required: values for no parameters"
+    model = si.SecondOrderModel(M=[[1]], V=[[0.2]], K=[[4]], B=[[1]], C=[[1]])
+    a, b = si.simulate_frf(model, None, W), si.simulate_frf(model, {}, W)
+    np.testing.assert_array_equal(a.H, b.H)
+    m = si.parameters("m", positive=True)
+    with pytest.raises(ModelError, match="theta is required: values for m"):
+        si.simulate_frf(si.SecondOrderModel(M=[[m]], V=[[0.2]], K=[[4]], B=[[1]], C=[[1]]), None, W)

@@ -41,8 +41,10 @@ def _system(model: Any, theta: Theta | None) -> tuple[ParametricModel | BlackBox
             raise ModelError("a BlackBox has no parameters; pass theta=None")
         return model, None
     if isinstance(model, ParametricModel):
+        if theta is None and model.n_parameters == 0:  # nothing to give
+            theta = ()
         if theta is None:
-            raise ModelError(f"theta is required: values for {', '.join(model.parameter_names) or 'no parameters'} "
+            raise ModelError(f"theta is required: values for {', '.join(model.parameter_names)} "
                              f"(a dict by name or a sequence in model.parameter_names order)")
         return model, model.theta_vector(theta)
     raise ModelError(f"model must be a StateSpaceModel, a SecondOrderModel (any symid model) or a BlackBox; "
