@@ -417,8 +417,10 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         # only when the first fits to rounding (noisy data: the first fit may be a worse minimum that the
         # whiteness rule accepts; measured on an 8-mass chain at 1 % noise)
         pending, pending_note = None, ""
+        specials = 1  # passes before the random restarts: from x0, and from the chain's values
         chain = self._chain_theta(x0) if opts["chain_start"] else None
         if chain is not None:
+            specials = 2
             chain_phi = self._phi(chain, centre, unit)
             at_start = self.misfit(x0)
             if not (at_start <= EXACT_FIT and at_start <= self.misfit(chain)):
@@ -441,7 +443,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                     break
                 half = math.log(opts["spread"])
                 phi = np.where(self._positive, rng.uniform(-half, half, x0.size), rng.uniform(-1.0, 1.0, x0.size))
-                if k % 2 == 1 and self.scale is not None:  # every other restart around the typical values
+                if (k - specials) % 2 == 0 and self.scale is not None:  # every other restart around the typical values
                     phi = phi + np.where(self._positive, np.log(self.scale / centre), 0.0)
             theta, nfev, spent = self._pass(phi, centre, unit, deadline)
             total_nfev += nfev
