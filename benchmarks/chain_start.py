@@ -205,7 +205,9 @@ def main(argv: list[str] | None = None) -> int:
     summ = summary(rows, args)
     print()
     print(table(summ, args))
-    result = {"benchmark": "chain_start", "noise": args.noise,
+    from _study import git_commit
+
+    result = {"benchmark": "chain_start", "commit": git_commit(), "noise": args.noise,
               "command": "benchmarks/chain_start.py " + " ".join(argv or sys.argv[1:]),
               "python": platform.python_version(), "seconds": time.perf_counter() - t_all,
               "time_limit": args.time_limit, "summary": summ, "rows": rows}
