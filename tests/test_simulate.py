@@ -322,3 +322,12 @@ def test_a_model_without_parameters_needs_no_theta():
     m = si.parameters("m", positive=True)
     with pytest.raises(ModelError, match="theta is required: values for m"):
         si.simulate_frf(si.SecondOrderModel(M=[[m]], V=[[0.2]], K=[[4]], B=[[1]], C=[[1]]), None, W)
+
+
+def test_a_text_theta_is_named_as_text(siso):
+    # found by a new-user sweep: x0="truth" said "theta has 1 value(s)"
+    model, th = siso
+    with pytest.raises(ModelError, match="theta is the text 'truth'; give a dict by name or a sequence of 3"):
+        si.simulate_frf(model, "truth", W)
+    with pytest.raises(si.OptionError, match="x0: theta is the text 'truth'"):
+        si.identify(model, si.simulate_frf(model, th, W), x0="truth", identifiability_check=False)

@@ -151,6 +151,9 @@ class ParametricModel:
                 raise ModelError(f"theta is missing parameter(s) {', '.join(missing)}")
             vals = [given[n] for n in names]
         else:
+            if isinstance(theta, (str, bytes)):
+                raise ModelError(f"theta is the text {theta!r}; give a dict by name or a sequence of {len(names)} "
+                                 f"number(s) ({', '.join(names)})")
             vals = list(np.asarray(theta, dtype=object).reshape(-1)) if np.ndim(theta) else [theta]
             if len(vals) != len(names):
                 raise ModelError(f"theta has {len(vals)} value(s); the model has {len(names)} parameter(s) "
