@@ -329,9 +329,31 @@ class ScrEstimator(Estimator):
 
     def solved_outcome(self, x0: np.ndarray, theta: np.ndarray, sol: Any, t0: float, *, message: str | None = None,
                        history: tuple[ScrIteration, ...] | None = None) -> StartOutcome:
-        """The outcome of one SCR start whose engine solution is ``sol`` (started at ``t0``)."""
-        return self.outcome(x0, theta, finished=self.engine_finished(sol), status=sol.status,
-                            message=sol.message if message is None else message,
+        """The outcome of one SCR start whose engine solution is ``sol`` (started at ``t0``).
+
+        When ``history`` holds the iterates' θ and one of them fits the data better than the
+        last (a relative misfit below 0.999 of it), that one is the estimate, and the message
+        says so: the engine's last iterate minimises its relaxation, not the data misfit, and
+        a run that does not converge can end far above where it passed (found on a quarter car
+        at 1 % noise: best iterate 5.0 at iteration 3, last 25.5 after 500). The engine's own
+        status is kept.
+        """
+        text = sol.message if message is None else message
+        if history is not None:
+            theta = np.asarray(theta, dtype=float).reshape(-1)
+            last = self.misfit(theta) if np.all(np.isfinite(theta)) else float("inf")
+            best_k, best = -1, last
+            for k, it in enumerate(history):
+                if it.theta is None or it.theta.shape != theta.shape or not np.all(np.isfinite(it.theta)):
+                    continue
+                cost = self.misfit(it.theta)
+                if cost < 0.999 * best:
+                    best_k, best = k, cost
+            if best_k >= 0:
+                theta = history[best_k].theta
+                text = (f"{text}; the estimate is iteration {history[best_k].iteration}'s, whose misfit {best:.3e} is "
+                        f"below the last iterate's {last:.3e}")
+        return self.outcome(x0, theta, finished=self.engine_finished(sol), status=sol.status, message=text,
                             iterations=sol.iterations if history is None else len(history),
                             wall_time=time.perf_counter() - t0,
                             history=self.engine_history(sol) if history is None else history)
