@@ -162,7 +162,21 @@ class Comparison:
         widths = [max(len(r[i]) for r in rows) for i in range(len(self._HEAD))]
         lines = ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
         lines.insert(1, "  ".join("-" * w for w in widths))
-        return "\n".join([f"{self.n_starts} identical starts (seed {self.seed}); success: {self.criterion}", *lines])
+        out = [f"{self.n_starts} identical starts (seed {self.seed}); success: {self.criterion}", *lines]
+        if (hint := self._noise_hint()) is not None:
+            out.append(hint)
+        return "\n".join(out)
+
+    def _noise_hint(self) -> str | None:
+        """A line for a comparison against the truth where no start is near it but some fit the data."""
+        if self.truth is None or any(s.n_success for s in self.stats):
+            return None
+        fits = sum(st.success for s in self.stats for st in s.result.starts)
+        if not fits:
+            return None
+        return (f"NOTE: no start is within the tolerance of the truth, but {fits} fit the data (their own success "
+                "rule): on noisy data the best fit lies off the truth by what the noise allows; compare with a "
+                "param_tol near the estimates' standard errors (.result.uncertainty), or without truth=")
 
     def to_markdown(self) -> str:
         """A Markdown table."""
