@@ -45,17 +45,13 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from population_models import RESOLUTION_FLOOR, _chain, _grid, resolution  # noqa: E402
+from population import parameter_error  # noqa: E402
+from population_models import RESOLUTION_FLOOR, _chain, _grid, relative_noise, resolution  # noqa: E402
 
 import symid as si  # noqa: E402
 from symid.fit.frf.chain import chain_start  # noqa: E402
 
 SEED = 20261127  # not a seed of population_models.make_problem
-
-
-def parameter_error(theta: Any, truth: Any) -> float:
-    theta, truth = np.asarray(theta, dtype=float), np.asarray(truth, dtype=float)
-    return float(np.max(np.abs(theta - truth) / np.abs(truth)))
 
 
 WHERE = ("grounded", "free", "interior")
@@ -74,15 +70,6 @@ def draw(cls: str, n: int, end: str, index: int) -> tuple[Any, np.ndarray, np.nd
     raise RuntimeError("no such draw")  # pragma: no cover
 
 
-def noisy(frf: Any, level: float, seed: int) -> Any:
-    if level == 0:
-        return frf
-    rng = np.random.default_rng([seed, 7919])
-    H = np.asarray(frf.H)
-    e = (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape)) / np.sqrt(2)
-    return si.FrequencyData(frf.w, H * (1 + level * e))
-
-
 def one(cls: str, n: int, end: str, index: int, args: argparse.Namespace, compare: bool) -> dict[str, Any]:
     model, truth, typical, info = draw(cls, n, end, index)
     w = _grid(model, truth)
@@ -91,7 +78,7 @@ def one(cls: str, n: int, end: str, index: int, args: argparse.Namespace, compar
     row: dict[str, Any] = {"class": cls, "n": n, "end": end, "index": index, "output": info["output"],
                            "sensors": info["sensors"], "resolution": res, "resolved": bool(res >= RESOLUTION_FLOOR)}
     for level in args.noise:
-        data = noisy(exact, level, index)
+        data = relative_noise(exact, level, index)
         t0 = time.perf_counter()
         st = chain_start(model, data)
         row[f"read_s_{level:g}"] = time.perf_counter() - t0

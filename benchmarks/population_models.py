@@ -60,7 +60,7 @@ import numpy as np
 
 import symid as si
 
-__all__ = ["CLASSES", "RESOLUTION_FLOOR", "Problem", "make_problem", "resolution"]
+__all__ = ["CLASSES", "RESOLUTION_FLOOR", "Problem", "make_problem", "relative_noise", "resolution"]
 
 CLASSES = ("chain", "chain_sensors", "gains", "state_space", "compartment")
 RESOLUTION_FLOOR = 1e-20  # module docstring: below it the data cannot tell a 1e-3 error from the truth
@@ -90,13 +90,7 @@ class Problem:
 
     def data(self, noise: float = 0.0, seed: int = 0) -> Any:
         """The frequency response at the truth, with relative complex Gaussian noise of level ``noise``."""
-        frf = si.simulate_frf(self.model, self.truth, self.w)
-        if noise == 0:
-            return frf
-        rng = np.random.default_rng([seed, 7919])
-        H = np.asarray(frf.H)
-        e = (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape)) / math.sqrt(2)
-        return si.FrequencyData(self.w, H * (1 + noise * e))
+        return relative_noise(si.simulate_frf(self.model, self.truth, self.w), noise, seed)
 
     def starts(self, kind: str, count: int, seed: int = 0) -> np.ndarray:
         """``count`` starts: ``"informed"`` within a factor 3 of the truth, ``"uninformed"`` over
@@ -108,6 +102,16 @@ class Problem:
         if kind == "uninformed":
             return self.typical * 10.0 ** u
         raise ValueError(f"kind must be 'informed' or 'uninformed', got {kind!r}")
+
+
+def relative_noise(frf: Any, level: float, seed: int) -> Any:
+    """``frf`` with relative complex Gaussian noise, H·(1 + level·e), E|e|² = 1 (seeded by ``seed``)."""
+    if level == 0:
+        return frf
+    rng = np.random.default_rng([seed, 7919])
+    H = np.asarray(frf.H)
+    e = (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape)) / math.sqrt(2)
+    return si.FrequencyData(frf.w, H * (1 + level * e))
 
 
 def _logu(rng: np.random.Generator, lo_hi: tuple[float, float], size: int | None = None) -> Any:

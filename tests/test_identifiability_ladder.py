@@ -20,18 +20,6 @@ from symid.structural.msolve import msolve_binary
 MSOLVE = msolve_binary()
 
 
-def _grounded(v):
-    n = len(v)
-    X = sp.zeros(n, n)
-    for i in range(n):
-        X[i, i] += v[i]
-        if i:
-            X[i - 1, i - 1] += v[i]
-            X[i - 1, i] -= v[i]
-            X[i, i - 1] -= v[i]
-    return X
-
-
 def _gröbner(model, monkeypatch):
     """generic_global with the inversion turned off: the reference."""
     with monkeypatch.context() as mp:
@@ -64,12 +52,12 @@ def test_every_chain_size_inverts_at_theta_star_and_theta_2(n, variant, families
         assert invert(lad, model, None, star)
 
 
-def test_undamped_chain_with_known_mass_and_velocity_sensor(monkeypatch):
+def test_undamped_chain_with_known_mass_and_velocity_sensor(monkeypatch, families):
     """Springs only between the masses (a string of beads), a damper-only ground, one mass known."""
     m2, m3, k1, k2, k3, c1 = si.parameters("m2 m3 k1 k2 k3 c1", positive=True)
     model = si.SecondOrderModel(M=sp.diag(2, m2, m3), V=sp.Matrix([[c1, 0, 0], [0, 0, 0], [0, 0, 0]]),
-                                K=_grounded([k1, k2, k3]), B=[[3], [0], [0]], C=[[sp.Rational(1, 2), 0, 0]],
-                                output="velocity")
+                                K=families._ground_chain([k1, k2, k3]), B=[[3], [0], [0]],
+                                C=[[sp.Rational(1, 2), 0, 0]], output="velocity")
     lad = ladder_of(model)
     assert lad is not None and lad.masses == (2, m2, m3) and lad.grounds[0] == (c1, k1)
     fast = generic_global(model, rank=6, msolve=MSOLVE)
@@ -82,7 +70,7 @@ def test_undamped_chain_with_known_mass_and_velocity_sensor(monkeypatch):
                                   "coupled masses", "middle mass driven", "rlc", "compartments"])
 def test_structures_it_does_not_cover_are_left_to_the_groebner_step(case, families):
     m1, m2, m3, c1, c2, c3, k1, k2, k3, k4, b = si.parameters("m1 m2 m3 c1 c2 c3 k1 k2 k3 k4 b", positive=True)
-    M, V, K = sp.diag(m1, m2, m3), _grounded([c1, c2, c3]), _grounded([k1, k2, k3])
+    M, V, K = sp.diag(m1, m2, m3), families._ground_chain([c1, c2, c3]), families._ground_chain([k1, k2, k3])
     e1, e2 = sp.Matrix([[1], [0], [0]]), sp.Matrix([[0], [1], [0]])
     kwargs = {"M": M, "V": V, "K": K, "B": e1, "C": e1.T}
     if case == "opposite ends":
@@ -95,7 +83,7 @@ def test_structures_it_does_not_cover_are_left_to_the_groebner_step(case, famili
         if case == "grounded at both ends":
             kwargs["K"] = K + sp.diag(0, 0, k4)
         elif case == "shared spring":
-            kwargs["K"] = _grounded([k1, k2, k2])
+            kwargs["K"] = families._ground_chain([k1, k2, k2])
         elif case == "gain unknown":
             kwargs["B"] = b * e1
         elif case == "coupled masses":
