@@ -5,21 +5,30 @@ start logged in ``benchmarks/results/population.jsonl`` (its estimate θ̂, as t
 returned it) and judges θ̂ with two rules, on the same data (the problem rebuilt from its
 logged draw, the same noise seed):
 
-* **before**: the rule up to this study — the solver finished *and* the estimate fits
-  (exact fit, noise floor or whiteness), and nothing the model declares rules it out;
-* **now**: today's :meth:`symid.fit.base.Estimator.outcome` — the estimate fits, whether
-  or not the solver finished, and a fit that is not exact is refused when a black box of
-  the model's order fits ten times better.
+* **before**: the rule up to 2026-11-27 — exact fit, noise floor, or a white residual when
+  each line's residual is divided by that line's own level (the lag-one autocorrelation
+  scaled by √(s − 1)); refused when a black box of the model's order fits ten times better;
+* **now**: today's :meth:`symid.fit.base.Estimator.outcome` — the whiteness test in the
+  misfit's own weighting (self-normalised statistic), the black box's margin
+  2·(N − l)/(N − b).
 
-The benchmark's own verdict — the parameters are right (noise-free: largest relative
-error ≤ 1e-3, or an exact fit of a problem not proven globally identifiable; 1 % noise:
-within twice the error of IPOPT started at the truth) — says which verdicts are correct.
-Tabulated per noise level and method: estimates the benchmark counts right or wrong,
-against both rules; and every estimate whose verdict changed, with today's reason. A
-wrong estimate flagged a success is a plausible wrong answer; a right one flagged a
-failure sends a user to restart.
+Both require nothing the model declares to rule the estimate out. Two references say
+which verdicts are correct:
 
-Run (seconds; nothing is estimated again)::
+* the benchmark's own — the parameters are right (noise-free: largest relative error
+  ≤ 1e-3, or an exact fit of a problem not proven globally identifiable; 1 % noise: within
+  twice the error of IPOPT started at the truth);
+* at 1 % noise, **fits**: the misfit is within a likelihood-ratio bound of the
+  least-squares estimate's (IPOPT started at the truth), cost ≤ ref·(1 + χ²₀.₉₉₉(l)/N) —
+  what ``success`` promises: the estimate fits the data as well as the data allow. The
+  least-squares estimates themselves are judged too.
+
+Tabulated per noise level and method: estimates the benchmark counts right or wrong, against
+both rules; and every estimate whose verdict changed, with today's reason. A wrong estimate
+flagged a success is a plausible wrong answer; a right one flagged a failure sends a user to
+restart.
+
+Run (a minute; nothing is estimated again)::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/success_rule.py
 
@@ -43,7 +52,8 @@ from population import start_success
 from population_models import make_problem
 
 from symid.fit.frf.ipopt import IpoptFRF
-from symid.fit.success import fit_test, physical_check
+from symid.fit.frf.misfit import relative_residuals
+from symid.fit.success import CEILING, EXACT_FIT, WHITENESS_LIMIT, physical_check
 from symid.runlog import write_json_atomic
 
 
@@ -58,13 +68,41 @@ def _latest(path: Path) -> dict[str, dict[str, Any]]:
     return latest
 
 
+def _old_whiteness(residuals: np.ndarray) -> float:
+    """The statistic before: lag-one autocorrelation of the residuals, scaled by √((s − 1)·c) (·√2 if complex)."""
+    r = np.nan_to_num(np.asarray(residuals, dtype=complex))
+    s = r.shape[0]
+    if s < 3:
+        return 0.0
+    r = r.reshape(s, -1)
+    den = float(np.sum(np.abs(r) ** 2))
+    if den == 0.0:
+        return 0.0
+    num = float(np.real(np.sum(np.conj(r[:-1]) * r[1:])))
+    return float(num / den * np.sqrt((s - 1) * r.shape[1] * (2 if np.iscomplexobj(residuals) else 1)))
+
+
 def _before(est: Any, theta: np.ndarray) -> bool:
-    """The fit part of the rule before this study: exact, noise floor or whiteness, no black box; physical."""
+    """The rule before: relative residuals (each line by its level), the old statistic, a black box ten times better."""
     cost = est.misfit(theta) if np.all(np.isfinite(theta)) else float("inf")
-    res = est.residuals(theta) if np.isfinite(cost) else None
-    fits = fit_test(cost, n_data=est.n_data(), n_parameters=int(theta.size), residuals=res,
-                    noise_floor=est.noise_floor).fits
-    return fits and physical_check(est.model, theta) is None
+    if not np.isfinite(cost) or physical_check(est.model, theta) is not None:
+        return False
+    if cost <= EXACT_FIT:
+        return True
+    res = relative_residuals(est.model, est.data, theta)
+    if res is None or cost > CEILING or _old_whiteness(res) > WHITENESS_LIMIT:
+        return False
+    bb = est.black_box()
+    return bb is None or bb[1] > est.n_data() / 2 or cost <= 10.0 * bb[0]
+
+
+def _fits(cost: float, ref_cost: float | None, n_data: int, n_parameters: int) -> bool | None:
+    """Within the likelihood-ratio bound of the least-squares estimate's misfit (None without a reference)."""
+    if ref_cost is None:
+        return None
+    from scipy.stats import chi2
+
+    return bool(cost <= ref_cost * (1 + chi2.ppf(0.999, n_parameters) / n_data))
 
 
 def rejudge(log_path: Path) -> dict[str, Any]:
@@ -90,38 +128,53 @@ def rejudge(log_path: Path) -> dict[str, Any]:
         globally = bool(pr["info"].get("global", True))
         ref = None if noise == 0 else references.get((name, noise_key))
         positive = np.asarray(p.model.positive, dtype=bool)
+        ref_cost = None if ref is None else est.misfit(np.asarray(ref["theta"], dtype=float))
+        n_data, n_par = est.n_data(), p.model.n_parameters
+        if ref is not None:  # the least-squares estimate itself (IPOPT from the truth), judged by both rules
+            theta = np.asarray(ref["theta"], dtype=float)
+            out = est.outcome(theta, theta, finished=True, status="", message="", iterations=0, wall_time=0.0)
+            tally[(noise_key, "reference", True, True, _before(est, theta), out.success)] += 1
         for key, rec in recs:
             theta = np.asarray(rec["theta"], dtype=float)
             right = start_success(theta, rec["cost"], np.asarray(p.truth), positive, globally, ref)
             out = est.outcome(np.asarray(rec["start"], dtype=float), theta, finished=rec["finished"],
                               status=rec["status"], message="", iterations=0, wall_time=0.0)
-            before = bool(rec["finished"]) and _before(est, theta)
+            before = _before(est, theta)
+            fits = _fits(out.cost, ref_cost, n_data, n_par)
             method = key.split("/")[3]
-            tally[(noise_key, method, right, before, out.success)] += 1
+            tally[(noise_key, method, right, fits, before, out.success)] += 1
             if out.success != before:
-                changed.append({"key": key, "right": right, "before": before, "now": out.success,
+                changed.append({"key": key, "right": right, "fits": fits, "before": before, "now": out.success,
                                 "finished": bool(rec["finished"]), "cost": rec["cost"], "fit": out.fit})
-    rows = [{"noise": float(nk.removeprefix("noise")), "method": m, "right": r, "success_before": old,
-             "success_now": new, "estimates": n} for (nk, m, r, old, new), n in sorted(tally.items(), key=str)]
+    rows = [{"noise": float(nk.removeprefix("noise")), "method": m, "right": r, "fits": f, "success_before": old,
+             "success_now": new, "estimates": n} for (nk, m, r, f, old, new), n in sorted(tally.items(), key=str)]
     return {"rows": rows, "changed": changed, "black_box_floors": floors}
 
 
+_COUNTS = ("estimates", "right", "wrong_success_before", "wrong_success_now", "right_failure_before",
+           "right_failure_now", "fit", "fit_refused_before", "fit_refused_now", "unfit_accepted_before",
+           "unfit_accepted_now")
+
+
 def summary_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per noise level and method: wrong estimates flagged a success, right ones flagged a failure (before, now)."""
+    """Per noise level and method: wrong estimates flagged a success, right ones flagged a failure; at 1 % noise
+    also against ``fits`` (the likelihood-ratio bound): fits refused, misfits accepted (before, now)."""
     cells: dict[tuple[float, str], Counter] = defaultdict(Counter)
     for r in rows:
         c = cells[(r["noise"], r["method"])]
         c["estimates"] += r["estimates"]
         c["right"] += r["estimates"] if r["right"] else 0
+        c["fit"] += r["estimates"] if r["fits"] else 0
         for when, flag in (("before", r["success_before"]), ("now", r["success_now"])):
             if flag and not r["right"]:
                 c[f"wrong_success_{when}"] += r["estimates"]
             if r["right"] and not flag:
                 c[f"right_failure_{when}"] += r["estimates"]
-    return [{"noise": nz, "method": m, **{k: int(c[k]) for k in ("estimates", "right", "wrong_success_before",
-                                                                  "wrong_success_now", "right_failure_before",
-                                                                  "right_failure_now")}}
-            for (nz, m), c in sorted(cells.items())]
+            if r["fits"] is True and not flag:
+                c[f"fit_refused_{when}"] += r["estimates"]
+            if r["fits"] is False and flag:
+                c[f"unfit_accepted_{when}"] += r["estimates"]
+    return [{"noise": nz, "method": m, **{k: int(c[k]) for k in _COUNTS}} for (nz, m), c in sorted(cells.items())]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -133,16 +186,21 @@ def main(argv: list[str] | None = None) -> int:
     result = rejudge(Path(args.log))
     table = summary_table(result["rows"])
     print("noise | method | estimates | right | wrong flagged success: before -> now | right flagged failure: "
-          "before -> now")
+          "before -> now | fit (LR bound) | fit refused: before -> now | no fit accepted: before -> now")
     for r in table:
         print(f"{r['noise']:g} | {r['method']} | {r['estimates']} | {r['right']} | {r['wrong_success_before']} -> "
-              f"{r['wrong_success_now']} | {r['right_failure_before']} -> {r['right_failure_now']}")
+              f"{r['wrong_success_now']} | {r['right_failure_before']} -> {r['right_failure_now']} | {r['fit']} | "
+              f"{r['fit_refused_before']} -> {r['fit_refused_now']} | {r['unfit_accepted_before']} -> "
+              f"{r['unfit_accepted_now']}")
     for noise in sorted({r["noise"] for r in table}):
-        rows = [r for r in table if r["noise"] == noise]
-        print(f"noise {noise:g}, every method: {sum(r['right'] for r in rows)} of {sum(r['estimates'] for r in rows)} "
-              f"right; wrong flagged success {sum(r['wrong_success_before'] for r in rows)} -> "
-              f"{sum(r['wrong_success_now'] for r in rows)}; right flagged failure "
-              f"{sum(r['right_failure_before'] for r in rows)} -> {sum(r['right_failure_now'] for r in rows)}")
+        rows = [r for r in table if r["noise"] == noise and r["method"] != "reference"]
+        tot = {k: sum(r[k] for r in rows) for k in _COUNTS}
+        print(f"noise {noise:g}, every method: {tot['right']} of {tot['estimates']} right; wrong flagged success "
+              f"{tot['wrong_success_before']} -> {tot['wrong_success_now']}; right flagged failure "
+              f"{tot['right_failure_before']} -> {tot['right_failure_now']}"
+              + ("" if noise == 0 else f"; {tot['fit']} fit (LR bound): refused {tot['fit_refused_before']} -> "
+                 f"{tot['fit_refused_now']}; {tot['estimates'] - tot['fit']} do not: accepted "
+                 f"{tot['unfit_accepted_before']} -> {tot['unfit_accepted_now']}"))
     print(f"\n{len(result['changed'])} verdicts changed:")
     for c in result["changed"]:
         print(f"  {c['key']}: {'right' if c['right'] else 'wrong'} estimate, success {c['before']} -> {c['now']}"

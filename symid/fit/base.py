@@ -110,7 +110,8 @@ class Estimator(abc.ABC):
         """The data misfit (``cost``) of the model at θ; ``inf`` where it cannot be evaluated."""
 
     def residuals(self, theta: np.ndarray) -> np.ndarray | None:
-        """Relative residuals ordered by frequency for the whiteness test, or ``None`` (no such test)."""
+        """Residuals ordered by frequency (or time) in the misfit's own weighting, for the whiteness test, or
+        ``None`` (no such test)."""
         return None
 
     def n_data(self) -> int:
@@ -120,7 +121,7 @@ class Estimator(abc.ABC):
     def black_box(self) -> tuple[float, int] | None:
         """``(misfit, b)`` of a black box of the model's order fitted to the data, in the same misfit, with its
         number of real parameters b; ``None`` (default) when the data kind has none. The success rule refuses a
-        fit that is not exact when this black box fits more than ten times better (:mod:`symid.fit.success`)."""
+        fit that is not exact when this black box fits better than noise explains (:mod:`symid.fit.success`)."""
         return None
 
     # -- the method's part ------------------------------------------------------------------

@@ -18,35 +18,42 @@ order:
 3. **whiteness** (no φ given; frequency-ordered residuals available) — the
    residual left by a correct model is noise, which does not repeat from one frequency
    to the next, while the residual of a wrong estimate (a local minimum) is a smooth
-   function of frequency. The estimate fits when the residual is white (the lag-one
-   autocorrelation of the relative residuals across frequency, scaled by √(s − 1), is
-   ≤ 3: a correct fit fails this by chance about once in 700 records) and the relative
-   rms residual is at most 10 % (``cost ≤ 0.01``). Measured with IPOPT from the truth and
-   5 seeded starts on 5 noisy records (0.1 % and 1 % noise) each of the thesis belt drive
-   (3-17) and 2-DOF (4-19): local minima give 3.2 and 7.0 (misfits 0.48 and 0.39),
-   correct fits at most 0.67 and 1.31.
+   function of frequency. The estimate fits when the residual is white — the
+   self-normalised lag-one autocorrelation of :func:`whiteness`, about N(0, 1) for
+   independent noise of any level at each frequency, is ≤ 3 (a correct fit fails this by
+   chance about once in 700 records) — and the relative rms residual is at most 10 %
+   (``cost ≤ 0.01``). The residuals are taken **in the weighting of the misfit** the
+   estimate minimises (for a frequency response (Hᵢ − H(ωᵢ, θ))/‖H‖, noise weights
+   included). Dividing each line by its own level instead, as this rule once did, tests
+   a criterion the estimate did not minimise: with noise proportional to |H| over a few
+   decades the least-squares estimate, set by the resonances, leaves at the weak lines a
+   relative residual that is a smooth function of frequency, and that rule refused the
+   least-squares estimate itself (IPOPT started at the truth) on 14 of the 32 noisy
+   problems of ``benchmarks/population.py`` and 136 of the 415 logged estimates whose
+   misfit is within a likelihood-ratio bound (χ²₀.₉₉₉(l)/N) of it; in the misfit's
+   weighting it refuses none of them.
 4. Otherwise (a black box as data, no floor given): only an exact fit counts.
 
 A fit that is not exact and that rule 2 or 3 accepted is refused when **a black box of
-the model's order fits the data more than ten times better** (``black_box=``; for a
+the model's order fits the data better than noise explains** (``black_box=``; for a
 frequency response, a vector fit with as many poles as the model has states, Gustavsen
-& Semlyen 1999). No model of that order can fit the data much better than that black
-box, so a gap of ten says the data are cleaner than the fit: on noise-free data of the
-generated population (``benchmarks/population.py``), the whiteness rule accepted
-estimates at misfits of 2e-9 to 2e-3 and parameter errors of 100 % to 1e6 % (8-mass
-chains, with one or two sensors; gains models); a vector fit reaches 1e-27 on such data.
-``benchmarks/success_rule.py`` judges every estimate that benchmark logged with the rule
-before and after: the black box refuses 5 such noise-free estimates and 1 at 1 % noise
-(23 times the black box's misfit), and one noise-free estimate within 1e-3 of the truth
-but at misfit 5e-10 (SCR stopped short of the data's 1e-27).
-On noisy data the black box, with b parameters, leaves about φ·(N − b)/N against the
-estimate's φ·(N − l)/N, so a correct fit is within a factor (N − l)/(N − b) of it; the
-rule is applied only when b ≤ N/2 (that factor at most 2), since with fewer data the
+& Semlyen 1999). The black box, with b parameters, leaves about φ·(N − b)/N of noise of
+level φ, against a correct estimate's φ·(N − l)/N, so a correct fit is within a factor
+(N − l)/(N − b) of it; the fit is refused above ``BLACK_BOX_MARGIN`` = 2 times that. The
+rule is applied only when b ≤ N/2 (the factor at most 2), since with fewer data the
 black box fits the noise itself. The vector fit weighs each line's error relative to its
 level: with noise proportional to |H|, a black box fitted in the judged (absolute)
 misfit can chase the noise of the few resonance lines that dominate it (its b
 parameters against few effective data) and land far below what a grey box of that order
-reaches, which would refuse correct fits; relative weights do not do that.
+reaches, which would refuse correct fits; relative weights do not do that, and make the
+black box's misfit no tight floor either: the least-squares estimates of the 32 noisy
+problems lie between 0.23 and 1.43 times it, hence the margin 2. On noise-free data
+the whiteness rule alone accepted estimates at misfits of 2e-9 to 2e-3 and parameter
+errors of 100 % to 1e6 % (8-mass chains, with one or two sensors; gains models); a
+vector fit reaches 1e-27 on such data and refuses them.
+``benchmarks/success_rule.py`` judges every estimate that benchmark logged with this rule
+and the one before it (relative residuals, a black box ten times better), and prints
+how many right estimates each calls a failure and how many wrong ones a success.
 
 The floor used and the statistic are reported in the outcome's ``fit`` text.
 
@@ -76,7 +83,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BLACK_BOX_RATIO", "CEILING", "EXACT_FIT", "WHITENESS_LIMIT", "FitTest", "fit_test", "physical_check",
+__all__ = ["BLACK_BOX_MARGIN", "CEILING", "EXACT_FIT", "WHITENESS_LIMIT", "FitTest", "fit_test", "physical_check",
            "whiteness"]
 
 EXACT_FIT = 1e-10
@@ -88,8 +95,9 @@ CEILING = 1e-2
 WHITENESS_LIMIT = 3.0
 """Largest scaled lag-one autocorrelation of the residual across frequency taken for noise."""
 
-BLACK_BOX_RATIO = 10.0
-"""A fit that is not exact is refused when a black box of the model's order fits this many times better."""
+BLACK_BOX_MARGIN = 2.0
+"""A fit that is not exact is refused when its misfit exceeds this margin times the black box's misfit
+scaled by (N − l)/(N − b), what a correct fit is expected to leave against it."""
 
 
 @dataclass(frozen=True)
@@ -111,17 +119,24 @@ class FitTest:
 
 
 def whiteness(residuals: np.ndarray) -> float:
-    """Scaled lag-one autocorrelation of residuals ordered by frequency, about N(0, 1) for noise.
+    """Self-normalised lag-one autocorrelation of residuals ordered by frequency (or time), about N(0, 1) for noise.
 
-    With r of shape (s, c) (c channels per frequency), ρ₁ = Re Σₖ r̄ₖ·rₖ₊₁ / Σₖ ‖rₖ‖² and the
-    statistic is ρ₁·√((s − 1)·c), times √2 for complex residuals (whose real and
-    imaginary parts are two independent samples).
+    With r of shape (s, c) (c channels per frequency) and products pₖ꜀ = r̄ₖ꜀·rₖ₊₁,꜀, the
+    statistic is Re Σ pₖ꜀ / √(Σ |pₖ꜀|² / 2) for complex residuals (Σ pₖ꜀ / √Σ pₖ꜀² for
+    real ones). For independent zero-mean noise, Re pₖ꜀ has mean 0 and variance
+    E|rₖ꜀|²·E|rₖ₊₁,꜀|² / 2, which the denominator estimates term by term, so the
+    statistic is about N(0, 1) **whatever the noise level at each frequency**: the
+    residuals can be given in the weighting of the misfit (dominated by a few resonance
+    lines) without dividing by a noise level nobody knows. A residual that is a smooth
+    function of frequency (a local minimum) makes it large and positive; when a few lines
+    dominate, |statistic| ≤ √(2·(number of dominant products)), so the test then has
+    little power and does not refuse a correct fit.
 
     Parameters
     ----------
     residuals : numpy.ndarray, shape (s, ...)
-        Complex or real residuals, frequency first (each entry divided by the size of
-        the data there, so every frequency counts alike). Non-finite entries count as 0.
+        Complex or real residuals, frequency first, in the weighting of the misfit that
+        the estimate minimises. Non-finite entries count as 0.
 
     Returns
     -------
@@ -136,20 +151,23 @@ def whiteness(residuals: np.ndarray) -> float:
     >>> rng = np.random.default_rng(0)
     >>> bool(abs(whiteness(rng.standard_normal(400))) < 3)          # noise
     True
+    >>> level = np.logspace(-3, 3, 400)                              # noise of very unequal size
+    >>> bool(abs(whiteness(level * rng.standard_normal(400))) < 3)
+    True
     >>> bool(whiteness(np.sin(np.linspace(0, 3, 400))) > 10)        # a smooth misfit
     True
     """
+    is_complex = np.iscomplexobj(residuals)
     r = np.nan_to_num(np.asarray(residuals, dtype=complex))
     s = r.shape[0]
     if s < 3:
         return 0.0
     r = r.reshape(s, -1)
-    den = float(np.sum(np.abs(r) ** 2))
-    if den == 0.0:
+    prod = np.conj(r[:-1]) * r[1:]
+    var = float(np.sum(np.abs(prod) ** 2)) / (2.0 if is_complex else 1.0)
+    if var == 0.0:
         return 0.0
-    num = float(np.real(np.sum(np.conj(r[:-1]) * r[1:])))
-    samples = (s - 1) * r.shape[1] * (2 if np.iscomplexobj(residuals) else 1)
-    return float(num / den * np.sqrt(samples))
+    return float(np.sum(prod.real) / np.sqrt(var))
 
 
 _NEGATIVE_RTOL = 1e-9
@@ -283,11 +301,15 @@ def fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndarr
     if bb is None:
         return test
     floor, b = bb
-    if b > n_data / 2 or not np.isfinite(floor) or cost <= BLACK_BOX_RATIO * floor:
+    if b > n_data / 2 or not np.isfinite(floor):
         return test
-    return FitTest(False, "black box", f"misfit {cost:.2e} > {BLACK_BOX_RATIO:g} × {floor:.2e}, the misfit of a "
-                                       f"black box of the model's order ({b} parameters): the data are cleaner than "
-                                       f"this fit ({test.text})")
+    ratio = BLACK_BOX_MARGIN * max(n_data - n_parameters, 1) / (n_data - b)
+    if cost <= ratio * floor:
+        return test
+    return FitTest(False, "black box", f"misfit {cost:.2e} > {ratio:.3g} × {floor:.2e}, the misfit of a black box "
+                                       f"of the model's order ({b} parameters; {BLACK_BOX_MARGIN:g} × (N − l)/(N − b) "
+                                       f"with N = {n_data} data, l = {n_parameters}): the data are cleaner than this "
+                                       f"fit ({test.text})")
 
 
 def _fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndarray | None,

@@ -11,8 +11,8 @@ from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.frf.fisher import FrfFisher
 
-__all__ = ["FrfEstimator", "NoiseWeighted", "check_frf", "frf_variance", "frf_weights", "relative_misfit",
-           "relative_residuals"]
+__all__ = ["FrfEstimator", "NoiseWeighted", "check_frf", "frf_variance", "frf_weights", "misfit_residuals",
+           "relative_misfit", "relative_residuals"]
 
 VARIANCE_OPTION_DOC = """variance : "data", None or array_like, optional
         Noise weighting of the FRF criterion, Σᵢ Σ_jk |Hᵢ,jk − H(ωᵢ, θ)_jk|² / σ²ᵢ,jk
@@ -188,6 +188,19 @@ def relative_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:
     return np.where(mag > 0, (H - Hm) / np.where(mag > 0, mag, 1.0), 0.0)
 
 
+def misfit_residuals(model: Any, data: Any, theta: Any, weights: np.ndarray | None = None) -> np.ndarray | None:
+    """The residuals whose sum of squares is :func:`relative_misfit`: √w (Hᵢ − H(ωᵢ, θ)) / ‖√w H‖ entry by
+    entry (w = 1 without ``weights``), frequency first; ``None`` if not evaluable. The success rule's
+    whiteness test takes these (:func:`symid.fit.success.whiteness`)."""
+    H = np.asarray(data.H)
+    Hm = _model_response(model, data, theta)
+    if Hm is None:
+        return None
+    sw = np.ones(H.shape) if weights is None else np.sqrt(np.asarray(weights, dtype=float))
+    nrm = float(np.sqrt(np.sum((sw * np.abs(H)) ** 2))) or 1.0
+    return sw * (H - Hm) / nrm
+
+
 class FrfEstimator(Estimator, FrfFisher):
     """Base of the frequency-response methods: their data misfit (relative, squared), and its Fisher
     information for the uncertainty of θ̂ (:mod:`symid.fit.frf.fisher`)."""
@@ -202,8 +215,8 @@ class FrfEstimator(Estimator, FrfFisher):
         return relative_misfit(self.model, self.data, theta, self.line_weights)
 
     def residuals(self, theta: np.ndarray) -> np.ndarray | None:
-        """:func:`relative_residuals` at θ."""
-        return relative_residuals(self.model, self.data, theta)
+        """:func:`misfit_residuals` at θ (in the misfit's own weighting)."""
+        return misfit_residuals(self.model, self.data, theta, self.line_weights)
 
     def n_data(self) -> int:
         """2·s·p·m real values."""

@@ -187,13 +187,15 @@ def spectral_misfit(model: Any, data: Any, theta: Any) -> float:
 
 
 def spectral_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:
-    """(Φyyᵢ − H Φuuᵢ Hᴴ) / ‖Φyyᵢ‖_F per frequency, frequency first; ``None`` if not evaluable."""
+    """The residuals whose sum of squares is :func:`spectral_misfit`: (Φyyᵢ − H Φuuᵢ Hᴴ) / √Σ‖Φyyᵢ‖²_F,
+    frequency first; ``None`` if not evaluable. The success rule's whiteness test takes these
+    (:func:`symid.fit.success.whiteness`)."""
     Phi = np.asarray(data.Phi_yy)
     Pm = _model_spectra_or_none(model, data, theta)
     if Pm is None:
         return None
-    nrm = np.linalg.norm(Phi, axis=(1, 2))[:, None, None]
-    return np.where(nrm > 0, (Phi - Pm) / np.where(nrm > 0, nrm, 1.0), 0.0)
+    scale = float(np.max(np.abs(Phi))) or 1.0  # as in spectral_misfit: no under- or overflow
+    return (Phi - Pm) / scale / (float(np.sqrt(np.sum(np.abs(Phi / scale) ** 2))) or 1.0)
 
 
 class SpectraEstimator(Estimator, SpectraFisher):
