@@ -420,10 +420,10 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         repeats = 0
         polished = math.nan  # the misfit of the last loose fit a pass was continued from
         visited: list[StartOutcome] = []  # every pass's outcome: other local solutions for alternatives()
-        # a statistical fit (accepted by whiteness or a noise floor, not exact) is settled once a later pass does not
-        # beat it by more than noise explains (the likelihood-ratio bound χ²₀.₉₉₉(l)/N of its misfit)
+        # a statistical fit (accepted by whiteness or a noise floor, not exact) is settled once a second pass ends
+        # within what noise explains of the best misfit (the likelihood-ratio bound χ²₀.₉₉₉(l)/N of it): a minimum
+        # found twice; passes that end higher do not confirm it
         noise_gain = _likelihood_ratio_bound(self.n_data(), x0.size)
-        stat_pass, stat_cost = -1, math.inf
         chain_note = ""
         # with the chain's values (chain_start), passes 0 and 1 start from them and from x0: from x0 first only
         # when it fits exactly and no worse than they do (a start at the truth stays there); the misfit of the
@@ -501,10 +501,8 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 # a few more passes look for a fit to rounding before settling for it
                 loose = _EXACT_STOP < best.cost <= EXACT_FIT
                 settled = not loose or k >= first_fit + _EXTRA_PASSES
-                if best.cost > EXACT_FIT:  # statistical: one more pass must fail to beat it beyond noise
-                    if best.cost < stat_cost * (1 - noise_gain):
-                        stat_pass, stat_cost = k, best.cost
-                    settled = k > stat_pass
+                if best.cost > EXACT_FIT:  # statistical: settled once two passes end within noise of the best
+                    settled = sum(c.cost <= best.cost * (1 + noise_gain) for c in visited) >= 2
                 if settled and (pending is None or best.cost <= EXACT_FIT):
                     status = "fits"
                     break
