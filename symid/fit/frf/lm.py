@@ -123,15 +123,6 @@ _LOG_BOX = math.log(1e6)  # |φₖ| ≤ log 1e6 for positive parameters: no esti
 _EXACT_STOP = 1e-20  # a misfit at rounding level: no further pass can do better
 _EXTRA_PASSES = 3  # passes tried after a fit that is exact only at the 1e-10 level
 _PRIOR = 0.1  # weight of φ − φ_pass-start in the band stages: what a partial band cannot see stays put
-
-
-def _likelihood_ratio_bound(n_data: int, n_parameters: int) -> float:
-    """χ²₀.₉₉₉(l)/N: a relative misfit difference that noise alone explains between two fits of l parameters."""
-    from scipy.stats import chi2
-
-    return float(chi2.ppf(0.999, max(n_parameters, 1)) / max(n_data, 1))
-
-
 _REPEATS = 3  # restarts stop once this many passes have ended at the best misfit (to 1e-6): a confirmed minimum
 
 
@@ -420,10 +411,6 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         repeats = 0
         polished = math.nan  # the misfit of the last loose fit a pass was continued from
         visited: list[StartOutcome] = []  # every pass's outcome: other local solutions for alternatives()
-        # a statistical fit (accepted by whiteness or a noise floor, not exact) is settled once a second pass ends
-        # within what noise explains of the best misfit (the likelihood-ratio bound χ²₀.₉₉₉(l)/N of it): a minimum
-        # found twice; passes that end higher do not confirm it
-        noise_gain = _likelihood_ratio_bound(self.n_data(), x0.size)
         chain_note = ""
         # with the chain's values (chain_start), passes 0 and 1 start from them and from x0: from x0 first only
         # when it fits exactly and no worse than they do (a start at the truth stays there); the misfit of the
@@ -501,8 +488,6 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 # a few more passes look for a fit to rounding before settling for it
                 loose = _EXACT_STOP < best.cost <= EXACT_FIT
                 settled = not loose or k >= first_fit + _EXTRA_PASSES
-                if best.cost > EXACT_FIT:  # statistical: settled once two passes end within noise of the best
-                    settled = sum(c.cost <= best.cost * (1 + noise_gain) for c in visited) >= 2
                 if settled and (pending is None or best.cost <= EXACT_FIT):
                     status = "fits"
                     break
