@@ -17,6 +17,7 @@ from symid.fit.similarity.start import (
     least_squares_theta,
     least_squares_transform,
     unknown_scale,
+    working_problem,
 )
 
 __all__ = ["AlsSimilarity"]
@@ -82,7 +83,9 @@ class AlsSimilarity(SimilarityEstimator):
         t0 = time.perf_counter() if t0 is None else t0
         deadline = None if self.time_limit is None else t0 + self.time_limit
         report = self.progress_reporter(t0)
-        maps, bb = self.model.maps, self.data.blackbox
+        work = working_problem(self.model.maps, self.data.blackbox, x0)  # units of time and states of the start
+        maps, bb = work.maps, work.bb
+        objective = SimilarityMisfit(maps, bb)
         theta, T, _ = initial_point(self.init, x0, self.seed, maps, bb)
         s = unknown_scale(theta, T)
         z = np.concatenate([theta, T.ravel()]) / s
@@ -93,15 +96,15 @@ class AlsSimilarity(SimilarityEstimator):
             step = np.linalg.norm(z_new - z) / max(np.linalg.norm(z), 1e-300)
             z = z_new
             if not np.all(np.isfinite(z)):
-                return theta, T, k, "max_iter"
-            asked = report is not None and report(k, self.objective.relative_residual(theta, T), theta)
+                return theta, work.original_T(T), k, "max_iter"
+            asked = report is not None and report(k, objective.relative_residual(theta, T), theta)
             if step <= self.tol:
-                return theta, T, k, "converged"
+                return theta, work.original_T(T), k, "converged"
             if asked:
-                return theta, T, k, "stopped"
+                return theta, work.original_T(T), k, "stopped"
             if deadline is not None and time.perf_counter() >= deadline and k < self.max_iter:
-                return theta, T, k, "time_limit"
-        return theta, T, self.max_iter, "max_iter"
+                return theta, work.original_T(T), k, "time_limit"
+        return theta, work.original_T(T), self.max_iter, "max_iter"
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start x₀; never raises on solver failure."""

@@ -12,7 +12,7 @@ from symid.fit.options import check_choice, check_float, check_int, check_seed, 
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import SimilarityData, SimilarityEstimator, budget_message
 from symid.fit.similarity.objective import SimilarityMisfit
-from symid.fit.similarity.start import INITS, initial_point, unknown_scale
+from symid.fit.similarity.start import INITS, initial_point, unknown_scale, working_problem
 
 __all__ = ["GbSimilarity"]
 
@@ -78,13 +78,15 @@ class GbSimilarity(SimilarityEstimator):
         t0 = time.perf_counter() if t0 is None else t0
         deadline = None if self.time_limit is None else t0 + self.time_limit
         report = self.progress_reporter(t0)
-        theta, T, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
+        work = working_problem(self.model.maps, self.data.blackbox, x0)  # units of time and states of the start
+        objective = SimilarityMisfit(work.maps, work.bb)
+        theta, T, _ = initial_point(self.init, x0, self.seed, work.maps, work.bb)
         s = unknown_scale(theta, T)
         l = theta.size
         state = {"k": 0, "cut": None}
 
         def scaled(y: np.ndarray) -> tuple[float, np.ndarray]:
-            f, g = self.objective.value_and_grad(y * s)
+            f, g = objective.value_and_grad(y * s)
             return f, g * s
 
         def each(intermediate_result: scipy.optimize.OptimizeResult) -> None:
@@ -104,6 +106,8 @@ class GbSimilarity(SimilarityEstimator):
                                           callback=each if report is not None or deadline is not None else None,
                                           options={"gtol": self.gtol, "maxiter": self.max_iter})
         res.x = res.x * s
+        theta, T = objective.split(res.x)
+        res.x = objective.join(theta, work.original_T(T))  # T for the black box as given
         res.cut = state["cut"]
         return res
 

@@ -9,7 +9,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from symid.engine.ipopt import ScaledIpopt, casadi_matrices, iteration_reporter, positivity_bounds
+from symid.engine.ipopt import ScaledIpopt, iteration_reporter, positivity_bounds
 from symid.fit.options import (
     check_bool,
     check_callback,
@@ -22,9 +22,18 @@ from symid.fit.options import (
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import SimilarityData, SimilarityEstimator, budget_message
 from symid.fit.similarity.objective import SimilarityMisfit
-from symid.fit.similarity.start import INITS, initial_point, unknown_scale
+from symid.fit.similarity.start import INITS, initial_point, io_time_normalised, unknown_scale, working_problem
 
 __all__ = ["IpoptSimilarity", "IpoptSimilarityFRF"]
+
+
+def _affine(amap: Any, theta: Any) -> Any:
+    """X0 + Σ θᵢ Xᵢ of an affine map as a CasADi expression in θ."""
+    out = ca.DM(amap.X0)
+    for i in range(amap.Xi.shape[0]):
+        if np.any(amap.Xi[i]):
+            out = out + theta[i] * ca.DM(amap.Xi[i])
+    return out
 
 
 class IpoptSimilarity(SimilarityEstimator):
@@ -78,40 +87,50 @@ class IpoptSimilarity(SimilarityEstimator):
         callback = check_callback("callback", callback, "IpoptIteration")
         verbose = check_bool("verbose", verbose)
         self.model, self.data, self.frf = model, data, data.frf
-        self.misfit_F = SimilarityMisfit(model.maps, data.blackbox)
+        # the problem in the units of working_problem: inputs, outputs and time from the black box (fixed here),
+        # the sizes of the model's states and of T from each start (values q = (sizes, α) given per solve)
+        maps_t, bb = io_time_normalised(model.maps, data.blackbox)
+        self.misfit_F = SimilarityMisfit(maps_t, bb)
         self.options = {"aux_init": aux_init, "seed": seed, "positivity": positivity, "max_iter": max_iter,
                         "tol": tol, "time_limit": time_limit, "callback": None if callback is None else "given",
                         "verbose": verbose, "black_box": data.source}
         report = iteration_reporter(callback, verbose)
-        bb = data.blackbox
         l, n = model.n_parameters, bb.n_states
         z = ca.MX.sym("z", l + n * n)
         theta = z[:l]
         T = ca.reshape(z[l:], n, n).T  # row-major vec T
-        mats = casadi_matrices(model, theta)
-        f = (ca.sumsqr(T @ ca.DM(bb.A) - mats["A"] @ T) + ca.sumsqr(T @ ca.DM(bb.B) - mats["B"])
-             + ca.sumsqr(ca.DM(bb.C) - mats["C"] @ T))
+        mats = {k: _affine(maps_t[k], theta) for k in "ABCD" if k in maps_t}
+        q = ca.MX.sym("q", n + 1)
+        sizes, alpha = q[:n], q[n]
+        w, wi = ca.diag(1 / sizes), ca.diag(sizes)
+        f = (ca.sumsqr(T @ ca.DM(bb.A) - w @ mats["A"] @ wi @ T) + ca.sumsqr(alpha * T @ ca.DM(bb.B) - w @ mats["B"])
+             + ca.sumsqr(ca.DM(bb.C) / alpha - mats["C"] @ wi @ T))
         if self.misfit_F.with_d:
             f = f + ca.sumsqr(ca.DM(bb.D) - mats["D"])
+        f = f / (float(np.sum(bb.A**2)) + alpha**2 * float(np.sum(bb.B**2)) + float(np.sum(bb.C**2)) / alpha**2)
         lb, ub = positivity_bounds(model.positive, positivity, np.ones(l))
         self._lower = lb
 
         def on_iteration(info: Any) -> bool:  # the user sees θ, not z = (θ, vec T)
             return report(dataclasses.replace(info, theta=info.theta[:l].copy()))
 
-        self._solver = ScaledIpopt("symid_ipopt_similarity", z, f / self.misfit_F.scale,
+        self._solver = ScaledIpopt("symid_ipopt_similarity", z, f,
                                    lower=np.concatenate([lb, np.full(n * n, -np.inf)]),
                                    upper=np.concatenate([ub, np.full(n * n, np.inf)]), max_iter=max_iter, tol=tol,
-                                   hessian="exact", time_limit=time_limit,
+                                   hessian="exact", time_limit=time_limit, parameters=q,
                                    callback=None if report is None else on_iteration)
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Solve from the start x₀; never raises on solver failure."""
         x0 = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
-        theta0, T0, _ = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
-        run = self._solver.solve(self.misfit_F.join(theta0, T0), scale=unknown_scale(theta0, T0, self._lower))
+        work = working_problem(self.model.maps, self.data.blackbox, x0)
+        alpha = float(np.linalg.norm(self.misfit_F.bb.C) / np.linalg.norm(work.bb.C)) if np.any(work.bb.C) else 1.0
+        theta0, T0, _ = initial_point(self.init, x0, self.seed, work.maps, work.bb)
+        run = self._solver.solve(self.misfit_F.join(theta0, T0), scale=unknown_scale(theta0, T0, self._lower),
+                                 values=np.append(work.back / alpha, alpha))
         theta, T = self.misfit_F.split(run.z)
+        T = work.original_T(T)
         message = f"IPOPT: {run.status}{run.note}"
         if run.status == "Maximum_WallTime_Exceeded":
             message += "; " + budget_message(self.options["time_limit"], run.iterations)
