@@ -43,10 +43,10 @@ in physical units, whatever their scale (measured on the generated population of
    other side of the truth is up to two decades from the truth, and restarts within a
    factor 10 of it rarely land near the truth in every parameter at once; ``scale`` is
    what the user knows of where the truth lies.
-5. **A fit a black box beats tenfold is no fit.** A fit that is not exact (misfit above
+5. **A fit a black box beats is no fit.** A fit that is not exact (misfit above
    1e-10: the whiteness or noise-floor rule accepted it) counts as no fit, and the restarts go
    on, while a vector fit of the data with as many poles as the model has states fits them
-   more than ten times better (the success rule of :mod:`symid.fit.success`, for every
+   better than noise explains (the success rule of :mod:`symid.fit.success`, for every
    method; :meth:`~symid.fit.frf.misfit.FrfEstimator.black_box`). On noise-free data the
    whiteness rule alone accepted misfits of 2e-9 on an 8-mass chain with two sensors (the
    population benchmark's chain_sensors-n8-1, three of four starts, parameters 280 % to

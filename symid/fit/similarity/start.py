@@ -19,13 +19,10 @@ from x₀, in one of four ways (``aux_init``):
     T₀ = S₀ = 0 or I (thesis §6-6-2 reports that zero fails); θ₀ by (C-8).
 
 F is the similarity misfit (C-1), ‖T𝔸 − A(θ)T‖² + ‖T𝔹 − B(θ)‖² + ‖ℂ − C(θ)T‖²
-(+ ‖𝔻 − D(θ)‖² when D holds parameters), taken on the time-normalised pair of
-:func:`time_normalised` (time in units of τ = 1/ρ(𝔸)): the first two blocks have units
-of a rate and the third not, so with time in other units (𝔸, 𝔹 times c) the plain sum
-weighs them c² apart and the methods find other estimates (measured before τ on a
-two-state model with 𝔸 × 1e6: ALS stopped after one sweep, GB after 4 iterations, IPOPT
-at its iteration limit, 40 % off). With τ, every method's iterations do not depend on
-the unit of time.
+(+ ‖𝔻 − D(θ)‖² when D holds parameters). ALS, GB and IPOPT take it, and these starts,
+on :func:`working_problem`'s pair: the same equations in units where the blocks weigh
+alike (time, inputs, outputs, the model's states and T of size one), so that their
+iterations do not depend on the units the model and data are given in.
 """
 
 from __future__ import annotations
