@@ -20,7 +20,14 @@ keep the sub-problems small and unit-free without changing a single iterate:
   estimate follows the units of θ and ω (tests/test_units_invariance_spectra_scr.py: from
   the start's own Yᵢ, a mass in units of 1e-6 kg gave an estimate 6e-7 off without it,
   the frequency axis × 1e-6 one 100 % off after 40 iterations, × 1e6 a solver error; with
-  it 7e-16). It is not the default: with each start's |θ₀| as the scale, ``msd3_psd``
+  it 7e-16). With a scale the terms are also written X̃ P̃ X̃ᴴ = Qᵢ/max‖Qᵢ‖ with
+  P̃ = Pᵢ/max‖Pᵢ‖ and X̃ = X·√(max‖Pᵢ‖/max‖Qᵢ‖), the same equations, so that outputs in
+  other units (Φyy × β², M, V, K / β) give the same numbers too: the relaxation matrix
+  [[Q + XPRᴴ + …, (X + R)P], [P(Xᴴ + Rᴴ), P]] is not homogeneous under X → X/β, P → β²P,
+  and without it Φyy × 1e6 ended 2e-5 off ('stationary' after 10 iterations instead of
+  'converged' after 6) and × 1e12 in a solver error at iteration 0. Without a scale, P is
+  divided by max‖Qᵢ‖ as Q is, the thesis's own relaxation (the default, measured on its
+  example). It is not the default: with each start's |θ₀| as the scale, ``msd3_psd``
   (§5-6, Clarabel, seed 0) reached the truth from 4 of 5 starts instead of 5 (one stopped
   at its residual tolerance 1e-8 with an entry 2.9e-4 off; the others 1.3e-6–2.2e-8
   against 6.8e-8), and on the 2-DOF with ADMM from 3 of 20 N(0, 1) starts instead of 8.
@@ -155,6 +162,10 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
                                                                                         model.n_parameters).tolist()}
         self._normalize = check_bool("normalize", normalize)
         self.scale = float(np.max(np.linalg.norm(self.eq.Q, ord=2, axis=(1, 2)))) or 1.0
+        # with a scale: P / max‖Pᵢ‖ and X·√(max‖Pᵢ‖ / max‖Qᵢ‖), the same terms in any output unit (module notes)
+        p_size = float(np.max(np.linalg.norm(self.eq.P, ord=2, axis=(1, 2)))) or self.scale
+        self._p_size = p_size if scale is not None else self.scale
+        self._gain = float(np.sqrt(self._p_size / self.scale))
         self._U, self._S = self._compress(rank_tol)
         self.options["ranks"] = sorted({u.shape[1] for u in self._U})
         self.theta_var = scr.Variable("theta", (model.n_parameters,))
@@ -172,7 +183,7 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
 
     # -- problem construction ---------------------------------------------------------------
     def _compress(self, rank_tol: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
-        lam, V = np.linalg.eigh(self.eq.P / self.scale)
+        lam, V = np.linalg.eigh(self.eq.P / self._p_size)
         U, S = [], []
         for i in range(lam.shape[0]):
             big = np.abs(lam[i]).max()
@@ -197,13 +208,13 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         terms = []
         for i in range(eq.w.size):
             U = self._U[i]
-            A0 = eq.X0[i] @ U
-            Ac = np.einsum("abk,bc->ack", eq.Xc[i], U) * self.theta_scale  # coefficients of φ = θ / scale
+            A0 = self._gain * eq.X0[i] @ U
+            Ac = self._gain * np.einsum("abk,bc->ack", eq.Xc[i], U) * self.theta_scale  # coefficients of φ = θ / scale
             coef_a: dict[Any, np.ndarray] = {theta: Ac}
             coef_b: dict[Any, np.ndarray] = {theta: np.conj(np.transpose(Ac, (1, 0, 2)))}
             if t is not None:
-                coef_a[t] = shift[i]
-                coef_b[t] = shift[i].conj().T
+                coef_a[t] = self._gain * shift[i]
+                coef_b[t] = self._gain * shift[i].conj().T
             terms.append(scr.Bilinear(A=scr.Affine(A0, coef_a), P=self._S[i], B=scr.Affine(A0.conj().T, coef_b),
                                       C=eq.Q[i] / self.scale, name=f"spectrum[{i}]"))
         variables = [theta] if t is None else [theta, t]
