@@ -125,10 +125,9 @@ class IpoptSimilarity(SimilarityEstimator):
         x0 = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
         work = working_problem(self.model.maps, self.data.blackbox, x0)
-        alpha = float(np.linalg.norm(self.misfit_F.bb.C) / np.linalg.norm(work.bb.C)) if np.any(work.bb.C) else 1.0
         theta0, T0, _ = initial_point(self.init, x0, self.seed, work.maps, work.bb)
         run = self._solver.solve(self.misfit_F.join(theta0, T0), scale=unknown_scale(theta0, T0, self._lower),
-                                 values=np.append(work.back / alpha, alpha))
+                                 values=np.append(work.sizes, work.alpha))
         theta, T = self.misfit_F.split(run.z)
         T = work.original_T(T)
         message = f"IPOPT: {run.status}{run.note}"

@@ -162,28 +162,40 @@ class WorkingProblem:
 
     The model's maps (numeric parts X0, Xi only) and the black box after :func:`working_problem`'s changes of
     units. The equations T𝔸 = A(θ)T, T𝔹 = B(θ), ℂ = C(θ)T (𝔻 = D(θ)) hold for the same θ, and a T̃ of this
-    problem is ``back[:, None] * T̃`` for the model and black box as given: only the weights of the misfit
-    change, to ones that do not depend on the units of time, inputs, outputs or states.
+    problem is ``alpha * sizes[:, None] * T̃`` for the model and black box as given (:meth:`original_T`): only the
+    weights of the misfit change, to ones that do not depend on the units of time, inputs, outputs or states.
+
+    Attributes
+    ----------
+    maps : dict
+        A, B, C (and D) of the model in these units.
+    bb : BlackBox
+        The black box in these units.
+    sizes : numpy.ndarray
+        The size of each model state at the start (:func:`state_sizes`; ones where unknown).
+    alpha : float
+        The size of T that the start implies (step 4 of :func:`working_problem`).
     """
 
     maps: dict[str, Any]
     bb: Any
-    back: np.ndarray
+    sizes: np.ndarray
+    alpha: float
 
     def original_T(self, T: np.ndarray) -> np.ndarray:
         """T for the model and black box as given."""
-        return self.back[:, None] * np.asarray(T, dtype=float)
+        return self.alpha * self.sizes[:, None] * np.asarray(T, dtype=float)
 
 
 def working_problem(maps: dict[str, Any], bb: Any, x0: np.ndarray) -> WorkingProblem:
     """:class:`WorkingProblem` for the start x₀. In turn:
 
-    1. **inputs and outputs**: each output in units of its row of ℂ, each input in units
-       of its column of 𝔹 (B → B U, C → V C, D → V D U, the same for the black box);
-    2. **time** in units of τ = :func:`time_unit` (A, B, 𝔸, 𝔹 times τ);
-    3. **the model's states** of size one at x₀ where its Gramians exist
+    1. **time** in units of τ = :func:`time_unit` (A, B, 𝔸, 𝔹 times τ), and **each input and
+       output** in units of its own size (B → B U, C → V C, D → V D U, the same for the black
+       box; :func:`io_time_normalised`);
+    2. **the model's states** of size one at x₀ where its Gramians exist
        (:func:`state_sizes`: A → W A W⁻¹, B → W B, C → C W⁻¹, W = diag(1/s));
-    4. **the black box's state** scaled by α = √(‖B(x₀)‖/‖𝔹‖ · ‖ℂ‖/‖C(x₀)‖), the size of T
+    3. **the black box's state** scaled by α = √(‖B(x₀)‖/‖𝔹‖ · ‖ℂ‖/‖C(x₀)‖), the size of T
        that T𝔹 = B and ℂ = CT imply, so that T is of size one.
 
     Without these, (C-1) sums blocks in different units (‖T𝔸 − AT‖² is a rate, ‖ℂ − CT‖²
@@ -191,24 +203,24 @@ def working_problem(maps: dict[str, Any], bb: Any, x0: np.ndarray) -> WorkingPro
     estimates (measured on a two-state model with time in units of 1e-6: ALS stopped after
     one sweep, GB after 4 iterations, IPOPT at its iteration limit, 40 % off).
     """
+    from symid.data import BlackBox
+
     x0 = np.asarray(x0, dtype=float)
     work, bb_io = io_time_normalised(maps, bb)
     rows = state_sizes(work, x0)
     rows = np.ones(bb.n_states) if rows is None else rows
     work["A"] = _diagonal(work["A"], left=1.0 / rows, right=rows)
     work["B"], work["C"] = _diagonal(work["B"], left=1.0 / rows), _diagonal(work["C"], right=rows)
-    sizes = [float(np.linalg.norm(x)) for x in (work["B"](x0), bb_io.B, bb_io.C, work["C"](x0))]
+    norms = [float(np.linalg.norm(x)) for x in (work["B"](x0), bb_io.B, bb_io.C, work["C"](x0))]
     alpha = 1.0
-    if all(np.isfinite(x) and x > 0 for x in sizes):
-        alpha = float(np.sqrt(sizes[0] / sizes[1] * sizes[2] / sizes[3]))
-    from symid.data import BlackBox
-
-    return WorkingProblem(work, BlackBox(bb_io.A, bb_io.B * alpha, bb_io.C / alpha, bb_io.D), alpha * rows)
+    if all(np.isfinite(x) and x > 0 for x in norms):
+        alpha = float(np.sqrt(norms[0] / norms[1] * norms[2] / norms[3]))
+    return WorkingProblem(work, BlackBox(bb_io.A, bb_io.B * alpha, bb_io.C / alpha, bb_io.D), rows, alpha)
 
 
 def io_time_normalised(maps: dict[str, Any], bb: Any) -> tuple[dict[str, Any], Any]:
-    """Steps 1 and 2 of :func:`working_problem` (they depend on the black box only): the maps and the black box
-    with time in units of τ = :func:`time_unit`, then each input and output in units of its own size.
+    """Step 1 of :func:`working_problem` (it depends on the black box only): the maps and the black box with time
+    in units of τ = :func:`time_unit`, then each input and output in units of its own size.
 
     The sizes do not depend on the black box's basis nor on the unit of time: input i's is
     the rms output energy √(𝔹ᵢᵀ Q 𝔹ᵢ) it drives (Q the observability Gramian), output j's
