@@ -206,6 +206,30 @@ def test_the_least_squares_fit_of_noisy_spectra_is_a_success_and_a_worse_one_is_
     assert not out.success and "structured residual" in out.fit
 
 
+def test_a_white_spectra_fit_far_from_a_minimum_is_refused():
+    # Found by a new user: a 3-mass chain (force on mass 1, all three positions measured), output spectra with 1 %
+    # noise on 200 lines over the modes; the truth with k2 0.2 % off has misfit 38 times the truth's, yet its residual
+    # in the misfit's weighting is white (a few resonance lines dominate: the statistic has no power) and spectra have
+    # no black box to bound the misfit. One Gauss–Newton step predicts 98 % of that misfit away: refused
+    # (symid.fit.success, LOCAL_GAIN_LIMIT = 0.5); the truth stays a fit (the least-squares estimates of the quarter
+    # car above too).
+    m1, m2, m3, c1, c2, c3, k1, k2, k3 = si.parameters("m1 m2 m3 c1 c2 c3 k1 k2 k3", positive=True)
+    model = si.SecondOrderModel(M=sp.diag(m1, m2, m3), V=[[c1 + c2, -c2, 0], [-c2, c2 + c3, -c3], [0, -c3, c3]],
+                                K=[[k1 + k2, -k2, 0], [-k2, k2 + k3, -k3], [0, -k3, k3]], B=[[1], [0], [0]],
+                                C=sp.eye(3))
+    truth = np.array([2.0, 1.5, 0.8, 5.0, 3.0, 2.0, 2e4, 1.5e4, 1e4])
+    data = si.simulate_spectra(model, truth, np.logspace(np.log10(20), np.log10(400), 200), 1.0, noise=0.01,
+                               seed=0)
+    est = IpoptPSD(model, data)
+    off = truth * np.where(np.arange(9) == 7, 1.002, 1.0)
+    out = est.outcome(off, off, finished=True, status="", message="", iterations=0, wall_time=0.0)
+    assert not out.success and out.cost > 30 * est.misfit(truth) and "Gauss–Newton" in out.fit
+    assert est.local_gain(off) > 0.9
+    # the truth itself: white, and a step predicts about a quarter of its misfit away (to the least-squares point)
+    at_truth = est.outcome(truth, truth, finished=True, status="", message="", iterations=0, wall_time=0.0)
+    assert at_truth.success and 0.1 < est.local_gain(truth) < 0.5
+
+
 def test_success_means_the_data_fit_for_every_method():
     warnings.simplefilter("ignore", si.IdentifiabilityWarning)
     belt = si.load_model("belt_drive")

@@ -118,6 +118,11 @@ class Estimator(abc.ABC):
         """Number of real data values the misfit sums over."""
         return 0
 
+    def local_gain(self, theta: np.ndarray) -> float | None:
+        """The fraction of the misfit one Gauss–Newton step from θ predicts to remove, for data kinds without a black
+        box (:mod:`symid.fit.success`); ``None`` (default) when not computed."""
+        return None
+
     def black_box(self) -> tuple[float, int] | None:
         """``(misfit, b)`` of a black box of the model's order fitted to the data, in the same misfit, with its
         number of real parameters b; ``None`` (default) when the data kind has none. The success rule refuses a
@@ -181,7 +186,8 @@ class Estimator(abc.ABC):
         cost = self.misfit(theta) if finite else float("inf")
         res = self.residuals(theta) if finite and np.isfinite(cost) else None
         test = fit_test(cost, n_data=self.n_data(), n_parameters=int(theta.size), residuals=res,
-                        noise_floor=self.noise_floor, black_box=self.black_box)
+                        noise_floor=self.noise_floor, black_box=self.black_box,
+                        local_gain=lambda: self.local_gain(theta))
         fits, fit_text = test.fits, test.text
         unphysical = physical_check(self.model, theta)  # never a success against the model's declarations
         if unphysical is not None:

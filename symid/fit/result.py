@@ -28,11 +28,14 @@ _NEXT_STEPS = (
     ("black box", "a model of this order fits the data far better than this estimate, which is a local minimum or "
                   "stopped short: try more starts (starts=20), method='auto' with scale= your typical values, or "
                   "polish=True"),
+    ("Gauss–Newton", "the estimate is not at a minimum of the misfit (a local step would lower it much): "
+                     "polish=True, or method='ipopt' started from it"),
     ("structured", "the residual is smooth across frequency: a local minimum, or noise that grows with |H|; with "
                    "noisy data give variance= (si.estimate_frf returns it) or noise_floor= (1e-4 for 1 % noise), "
                    "otherwise try more starts or method='auto' with scale="),
     ("over 10 %", "far from a fit: try more starts (starts=20), method='auto' with scale= your typical values, and "
-                  "check the model's structure and the data's units"),
+                  "check the model's structure and the data's units; if the data are that noisy (over 10 % rms), "
+                  "give noise_floor= (0.01 for 10 % noise) so that the fit is judged against the noise"),
     ("χ²", "the misfit exceeds what the declared noise explains: a local minimum (more starts, "
            "method='auto'), or a noise_floor/variance smaller than the data's noise"),
     ("pass noise_floor=", "without a noise level only an exact fit counts: give noise_floor= (the relative misfit "
