@@ -219,7 +219,7 @@ class SpectraEstimator(Estimator, SpectraFisher):
         th = np.asarray(theta, dtype=float).reshape(-1)
         try:
             r, J = self.jacobian(th)
-        except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+        except (ModelError, ValueError, ArithmeticError, np.linalg.LinAlgError):  # a pole on a line, singular M
             return None
         if not (np.all(np.isfinite(r)) and np.all(np.isfinite(J))) or not np.any(r):
             return None
