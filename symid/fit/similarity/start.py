@@ -10,7 +10,10 @@ from x₀, in one of four ways (``aux_init``):
     kept as ``"model"`` would keep it. Otherwise
     T₀ = α G₁ and S₀ = G₂ / α with G₁, G₂ independent N(0, 1) matrices ("S and T with
     entries drawn from a random distribution"), seeded by ``seed`` and the bytes of x₀,
-    so the same x₀ gives the same T₀, S₀ in every method and every run; θ₀ =
+    so the same x₀ gives the same G₁, G₂ in every method and every run (ALS, GB and IPOPT
+    draw them in the units of :func:`working_problem`, SCR in the model's own, so their T₀
+    are not the same matrix; a start in other units is other bytes and draws other G₁,
+    G₂); θ₀ =
     argmin_θ F(θ, T₀), the least squares (C-8). α is the scale the data imply for T
     (:func:`transform_scale`), so that T₀ and S₀ = T₀⁻¹-sized draws are both plausible.
 ``"model"`` (prior knowledge on θ, thesis §6-7-2)
