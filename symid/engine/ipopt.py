@@ -18,8 +18,8 @@ import numpy as np
 
 from symid.interrupt import native_interrupts
 
-__all__ = ["HESSIANS", "IPOPT_SUCCESS", "IpoptIteration", "IpoptRun", "IpoptSolver", "ScaledIpopt", "casadi_frf",
-           "casadi_matrices", "iteration_reporter", "positivity_bounds", "print_iteration", "start_scale"]
+__all__ = ["HESSIANS", "IPOPT_SUCCESS", "IpoptIteration", "IpoptRun", "IpoptSolver", "ScaledIpopt", "casadi_affine",
+           "casadi_frf", "casadi_matrices", "iteration_reporter", "positivity_bounds", "print_iteration", "start_scale"]
 
 HESSIANS = ("exact", "limited-memory")
 """IPOPT's Hessian choices: exact (CasADi's automatic differentiation) or L-BFGS."""
@@ -28,15 +28,17 @@ IPOPT_SUCCESS = frozenset({"Solve_Succeeded", "Solved_To_Acceptable_Level"})
 """IPOPT return statuses counted as finished (its stopping rule was met)."""
 
 
+def casadi_affine(amap: Any, theta: ca.MX) -> ca.MX:
+    """An affine matrix X(θ) = X0 + Σ θi Xi (an :class:`~symid.model.affine.AffineMap`) as a CasADi expression."""
+    X = ca.MX(ca.DM(amap.X0))
+    for k in amap.depends_on:
+        X = X + theta[k] * ca.DM(amap.Xi[k])
+    return X
+
+
 def casadi_matrices(model: Any, theta: ca.MX) -> dict[str, ca.MX]:
     """Every affine matrix X(θ) = X0 + Σ θi Xi of a model as a CasADi expression."""
-    out = {}
-    for name, amap in model.maps.items():
-        X = ca.MX(ca.DM(amap.X0))
-        for k in amap.depends_on:
-            X = X + theta[k] * ca.DM(amap.Xi[k])
-        out[name] = X
-    return out
+    return {name: casadi_affine(amap, theta) for name, amap in model.maps.items()}
 
 
 def casadi_frf(model: Any, theta: ca.MX, w: np.ndarray) -> tuple[list[ca.MX], list[ca.MX]]:

@@ -72,7 +72,6 @@ class AlsSimilarity(SimilarityEstimator):
         self.time_limit = check_time_limit("time_limit", time_limit)
         self._progress_options(callback, verbose)
         self.model, self.data, self.frf = model, data, data.frf
-        self.objective = SimilarityMisfit(model.maps, data.blackbox)
         self.options = {"aux_init": aux_init, "seed": seed, "max_iter": max_iter, "tol": tol,
                         "time_limit": self.time_limit, "callback": None if callback is None else "given",
                         "verbose": self._verbose, "black_box": data.source}

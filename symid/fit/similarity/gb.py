@@ -102,7 +102,7 @@ class GbSimilarity(SimilarityEstimator):
                 raise StopIteration
 
         with np.errstate(over="ignore", invalid="ignore"):
-            res = scipy.optimize.minimize(scaled, self.objective.join(theta, T) / s, jac=True, method="BFGS",
+            res = scipy.optimize.minimize(scaled, objective.join(theta, T) / s, jac=True, method="BFGS",
                                           callback=each if report is not None or deadline is not None else None,
                                           options={"gtol": self.gtol, "maxiter": self.max_iter})
         res.x = res.x * s

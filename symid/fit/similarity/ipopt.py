@@ -9,7 +9,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from symid.engine.ipopt import ScaledIpopt, iteration_reporter, positivity_bounds
+from symid.engine.ipopt import ScaledIpopt, casadi_affine, iteration_reporter, positivity_bounds
 from symid.fit.options import (
     check_bool,
     check_callback,
@@ -25,15 +25,6 @@ from symid.fit.similarity.objective import SimilarityMisfit
 from symid.fit.similarity.start import INITS, initial_point, io_time_normalised, unknown_scale, working_problem
 
 __all__ = ["IpoptSimilarity", "IpoptSimilarityFRF"]
-
-
-def _affine(amap: Any, theta: Any) -> Any:
-    """X0 + Σ θᵢ Xᵢ of an affine map as a CasADi expression in θ."""
-    out = ca.DM(amap.X0)
-    for i in range(amap.Xi.shape[0]):
-        if np.any(amap.Xi[i]):
-            out = out + theta[i] * ca.DM(amap.Xi[i])
-    return out
 
 
 class IpoptSimilarity(SimilarityEstimator):
@@ -99,7 +90,7 @@ class IpoptSimilarity(SimilarityEstimator):
         z = ca.MX.sym("z", l + n * n)
         theta = z[:l]
         T = ca.reshape(z[l:], n, n).T  # row-major vec T
-        mats = {k: _affine(maps_t[k], theta) for k in "ABCD" if k in maps_t}
+        mats = {k: casadi_affine(maps_t[k], theta) for k in "ABCD" if k in maps_t}
         q = ca.MX.sym("q", n + 1)
         sizes, alpha = q[:n], q[n]
         w, wi = ca.diag(1 / sizes), ca.diag(sizes)

@@ -228,7 +228,8 @@ class SpectraEstimator(Estimator, SpectraFisher):
         J = J[:, free]
         if J.shape[1] == 0:
             return None
-        J = J / np.where(np.linalg.norm(J, axis=0) > 0, np.linalg.norm(J, axis=0), 1.0)
+        norms = np.linalg.norm(J, axis=0)
+        J = J / np.where(norms > 0, norms, 1.0)
         U, S, _ = np.linalg.svd(J, full_matrices=False)
         if S.size == 0 or S[0] == 0:
             return None
