@@ -48,7 +48,7 @@ from symid.fit.options import check_bool, check_choice, check_float, check_seed,
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import SimilarityData, SimilarityEstimator, budget_message
 from symid.fit.similarity.scr import consistent, implied_equalities, left_times, right_times
-from symid.fit.similarity.start import random_pair
+from symid.fit.similarity.start import random_pair, start_key
 
 __all__ = ["LinearSimilarity2nd", "ScrSimilarity2nd", "check_second_order", "second_order_case"]
 
@@ -464,7 +464,12 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
         x0 = np.asarray(x0, dtype=float)
         N = self.model.n_states
         if self.init == "random":
-            T0, S0 = random_pair(N, x0, self.seed)
+            try:
+                ss = self.model.state_space(x0)
+                key = start_key(ss.A, ss.B, ss.C, self.data.blackbox)
+            except (ModelError, np.linalg.LinAlgError, ValueError, FloatingPointError):
+                key = 0  # M(x₀) singular: no model to read the key off
+            T0, S0 = random_pair(N, key, self.seed)
         else:
             T0 = S0 = np.eye(N) if self.init == "identity" else np.zeros((N, N))
         out: dict[str, np.ndarray] = {"T": T0, "S": S0}

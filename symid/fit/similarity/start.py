@@ -9,11 +9,11 @@ from x₀, in one of four ways (``aux_init``):
     terms for the least-squares T of x₀, e.g. the truth on noise-free data — the start is
     kept as ``"model"`` would keep it. Otherwise
     T₀ = α G₁ and S₀ = G₂ / α with G₁, G₂ independent N(0, 1) matrices ("S and T with
-    entries drawn from a random distribution"), seeded by ``seed`` and the bytes of x₀,
-    so the same x₀ gives the same G₁, G₂ in every method and every run (ALS, GB and IPOPT
-    draw them in the units of :func:`working_problem`, SCR in the model's own, so their T₀
-    are not the same matrix; a start in other units is other bytes and draws other G₁,
-    G₂); θ₀ =
+    entries drawn from a random distribution"), seeded by ``seed`` and the start
+    (:func:`start_key`: numbers of the start's model that no unit changes), so the same x₀
+    gives the same G₁, G₂ in every method and every run, and so does the same start in
+    other units (ALS, GB and IPOPT scale them in the units of :func:`working_problem`, SCR
+    in the model's own, so their T₀ are not the same matrix); θ₀ =
     argmin_θ F(θ, T₀), the least squares (C-8). α is the scale the data imply for T
     (:func:`transform_scale`), so that T₀ and S₀ = T₀⁻¹-sized draws are both plausible.
 ``"model"`` (prior knowledge on θ, thesis §6-7-2)
@@ -39,8 +39,8 @@ import numpy as np
 from symid.errors import ModelError
 
 __all__ = ["INITS", "WorkingProblem", "initial_point", "io_time_normalised", "least_squares_theta",
-           "least_squares_transform", "random_pair", "state_sizes", "time_unit", "transform_scale", "unknown_scale",
-           "working_problem"]
+           "least_squares_transform", "random_pair", "start_key", "state_sizes", "time_unit", "transform_scale",
+           "unknown_scale", "working_problem"]
 
 INITS = ("random", "model", "zero", "identity")
 _EXPLAINS = 1e-12  # relative similarity misfit below which a start explains the black box ("random" keeps it)
@@ -59,11 +59,68 @@ def least_squares_transform(maps: dict[str, Any], bb: Any, theta: np.ndarray) ->
     return np.linalg.lstsq(lhs, rhs, rcond=None)[0].reshape(n, n, order="F")
 
 
-def random_pair(n: int, x0: np.ndarray, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """Two independent N(0, 1) n×n matrices, seeded by ``seed`` and the bytes of the start x₀."""
-    key = zlib.crc32(np.ascontiguousarray(x0, dtype=float).tobytes())
-    rng = np.random.default_rng([int(seed), key])
+def random_pair(n: int, key: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Two independent N(0, 1) n×n matrices, seeded by ``seed`` and the start's ``key`` (:func:`start_key`)."""
+    rng = np.random.default_rng([int(seed), int(key)])
     return rng.standard_normal((n, n)), rng.standard_normal((n, n))
+
+
+_KEY_DIGITS = 5  # significant digits of the start's unit-free numbers that seed its random T₀
+_KEY_ZERO = 1e-9  # relative size below which a part of such a number counts as 0
+
+
+def _key_text(values: np.ndarray) -> list[str]:
+    """Each complex number rounded to ``_KEY_DIGITS`` significant digits; parts below ``_KEY_ZERO`` of the
+    largest |value| are 0, so rounding noise (an imaginary part of 1e-17) does not change the text."""
+    v = np.asarray(values, dtype=complex).ravel()
+    v = np.where(np.isfinite(v), v, 0.0)
+    big = float(np.max(np.abs(v))) if v.size else 0.0
+    re = np.where(np.abs(v.real) > _KEY_ZERO * big, v.real, 0.0)
+    im = np.where(np.abs(v.imag) > _KEY_ZERO * big, np.abs(v.imag), 0.0)  # a conjugate pair: the same text
+    return [f"{a:.{_KEY_DIGITS - 1}e},{b:.{_KEY_DIGITS - 1}e}" for a, b in zip(re, im, strict=True)]
+
+
+def start_key(A: np.ndarray, B: np.ndarray, C: np.ndarray, bb: Any) -> int:
+    """A number that tells starts apart and does not depend on units: the seed of a start's random T₀.
+
+    It is read off the start's model (A, B, C) = (A(x₀), B(x₀), C(x₀)) against the black box,
+    through numbers that no choice of units changes: the model's eigenvalues in units of
+    the black box's rate ρ(𝔸) = 1/:func:`time_unit` (sorted), and the ratio of each entry of
+    the model's |H(iρ)| to the black box's. Each is rounded to 5 significant digits, and the
+    text hashed (CRC-32). The same start in other units of time, inputs, outputs, states
+    or parameters — the same system — gives the same key (unless one of these numbers lies
+    within rounding of a rounding boundary, about once in 10⁹), so it draws the same T₀;
+    before, the bytes of x₀ seeded it, and a start in other units drew another T₀. Two
+    starts with the same poles and gains at ρ draw the same G₁, G₂ (scaled each by its own
+    T's size).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.similarity.start import start_key
+    >>> bb = si.BlackBox(np.diag([-1.0, -4.0]), np.ones((2, 1)), np.ones((1, 2)))
+    >>> A, B, C = np.diag([-1.5, -3.0]), np.array([[2.0], [1.0]]), np.array([[1.0, 1.0]])
+    >>> d = np.array([1e3, 1e-3])                               # the states in other units
+    >>> start_key(A, B, C, bb) == start_key(A, d[:, None] * B, C / d, bb)
+    True
+    >>> start_key(A, B, C, bb) == start_key(2 * A, B, C, bb)   # another start
+    False
+    """
+    A, B, C = (np.asarray(X, dtype=float) for X in (A, B, C))
+    rho = 1.0 / time_unit(bb)
+    parts = sorted(_key_text(np.linalg.eigvals(A) / rho)) if A.size else []
+    try:
+        s = 1j * rho
+        Hm = C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B.astype(complex))
+        Ab, Bb, Cb = (np.asarray(X, dtype=float) for X in (bb.A, bb.B, bb.C))
+        Hb = Cb @ np.linalg.solve(s * np.eye(Ab.shape[0]) - Ab, Bb.astype(complex))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(np.abs(Hb) > 0, np.abs(Hm) / np.abs(Hb), 0.0)
+        parts += _key_text(ratio)
+    except (np.linalg.LinAlgError, ValueError):
+        pass  # iρ a pole, or shapes that do not match: the eigenvalues alone
+    return zlib.crc32(";".join(parts).encode("ascii"))
 
 
 def least_squares_theta(maps: dict[str, Any], bb: Any, T: np.ndarray) -> np.ndarray:
@@ -317,7 +374,7 @@ def initial_point(init: str, x0: np.ndarray, seed: int, maps: dict[str, Any], bb
         if np.all(np.isfinite(resid)) and float(resid @ resid) <= _EXPLAINS * float(r @ r + (J @ x0) @ (J @ x0)):
             return x0, T, np.linalg.pinv(T)
         alpha = transform_scale(maps, bb)
-        G1, G2 = random_pair(n, x0, seed)
+        G1, G2 = random_pair(n, start_key(*(maps[k](x0) for k in "ABC"), bb), seed)
         T, S = alpha * G1, G2 / alpha
     elif init == "zero":
         T, S = np.zeros((n, n)), np.zeros((n, n))
