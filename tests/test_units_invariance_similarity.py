@@ -195,3 +195,97 @@ def test_another_start_draws_another_transform(black_box):
     _, T2, _ = initial_point("random", SS_START * 1.01, 0, maps, black_box)
     _, T3, _ = initial_point("random", SS_START, 1, maps, black_box)
     assert not np.allclose(T1, T2, rtol=0.1) and not np.allclose(T1, T3, rtol=0.1)
+
+
+# -- SCR (Algorithm 6.1) ---------------------------------------------------------------------------------------
+#
+# A two-compartment model (k10, k12, k21 in 1/h; c = 1/V in 1/L; dose into compartment 1, its concentration
+# measured; truth 0.3, 0.8, 0.2, 1/12) and its exact black box in another basis. From this start SCR stops at a
+# stationary point after some 30 iterations: a path of many relaxation steps, so that a change of units shows.
+# SCR builds each start's problem in that start's units (symid.fit.similarity.scr.ScrSimilarity.start_problem),
+# keeping the model's states in the units it declares them in.
+# Before, on this model (another basis), time in ms changed the path (320 iterations to a 30 s budget instead of
+# 37), and a rate declared in units of 1e-6 made the implied equalities look inconsistent (dropped: 85 iterations
+# instead of 36, to another point).
+
+def compartments(factors=None):
+    factors = np.ones(4) if factors is None else factors
+    names = si.parameters("k10 k12 k21 c", positive=True)
+    k10, k12, k21, c = (f * p for f, p in zip(factors, names, strict=True))
+    return si.StateSpaceModel(A=[[-(k10 + k12), k21], [k12, -k21]], B=[[1], [0]], C=[[c, 0]],
+                              parameters=list(names))
+
+
+PK_TRUTH = np.array([0.3, 0.8, 0.2, 1 / 12])
+PK_START = PK_TRUTH * np.array([1.3, 0.7, 1.2, 0.8])
+
+
+def pk_black_box(tau=1.0, beta=1.0, gamma=1.0):
+    """Time t' = t / tau (A times tau: the rates times tau), input times 1/gamma (B times gamma), output times beta
+    (c times beta). With the model's fixed B = [1; 0], an input not in units of the new time (gamma ≠ 1) changes
+    the unit of the model's states: x' = x / gamma, and c' = gamma c."""
+    A, B, C, _ = compartments().state_space(PK_TRUTH)
+    T = np.array([[2.5, 0.4], [-0.3, 2.3]])
+    Ti = np.linalg.inv(T)
+    return si.BlackBox(tau * T @ A @ Ti, gamma * T @ B, beta * C @ Ti, np.zeros((1, 1)))
+
+
+@pytest.fixture(scope="module")
+def scr_ref():
+    ref = estimate(compartments(), pk_black_box(), "scr", PK_START, max_iter=300)
+    assert ref.iterations > 20  # a path, not a presolve that solves it at once
+    return ref
+
+
+def assert_same_scr_run(out, ref, phys):
+    """θ / phys equals the reference to 1e-10 of the truth's size (two rates end at their bound 0, where a
+    relative comparison means nothing), after the same iterations."""
+    np.testing.assert_allclose(out.theta / phys, ref.theta, rtol=0, atol=1e-10 * float(np.max(PK_TRUTH)))
+    assert (out.status, out.iterations) == (ref.status, ref.iterations)
+
+
+@pytest.mark.parametrize("k", [0, 3])
+@pytest.mark.parametrize("a", [-6, 6])
+def test_scr_follows_a_parameter_in_other_units(scr_ref, k, a):
+    f = np.ones(4)
+    f[k] = 10.0**a
+    out = estimate(compartments(f), pk_black_box(), "scr", PK_START / f, max_iter=300)
+    assert_same_scr_run(out, scr_ref, 1 / f)
+
+
+@pytest.mark.parametrize("tau", [1e-6, 1e6])
+def test_scr_follows_the_time_axis(scr_ref, tau):
+    """Time t' = t / tau with the dose rate in units of the new time: the rates times tau, the states as they were."""
+    phys = np.array([tau, tau, tau, 1.0])
+    out = estimate(compartments(), pk_black_box(tau=tau), "scr", PK_START * phys, max_iter=300)
+    assert_same_scr_run(out, scr_ref, phys)
+
+
+@pytest.mark.parametrize("beta", [1e-6, 1e6])
+def test_scr_follows_the_output_unit(scr_ref, beta):
+    phys = np.array([1.0, 1.0, 1.0, beta])
+    out = estimate(compartments(), pk_black_box(beta=beta), "scr", PK_START * phys, max_iter=300)
+    assert_same_scr_run(out, scr_ref, phys)
+
+
+@pytest.mark.parametrize("gamma", [1e-6, 1e6])
+def test_scr_follows_the_input_unit(scr_ref, gamma):
+    """The dose in other units with the model's B fixed at [1; 0]: the states change unit with it (x' = x / gamma,
+    c' = gamma c); T scales as a whole, which the size of T at the start absorbs."""
+    phys = np.array([1.0, 1.0, 1.0, gamma])
+    out = estimate(compartments(), pk_black_box(gamma=gamma), "scr", PK_START * phys, max_iter=300)
+    assert_same_scr_run(out, scr_ref, phys)
+
+
+@pytest.mark.xfail(strict=True, reason="SCR keeps the model's states in the units it declares (per-start state sizes "
+                                       "cost it successes: e-nose 15 -> 5 of 40), so the model written with one "
+                                       "state in other units is another problem to it")
+def test_scr_does_not_follow_one_state_in_other_units(scr_ref):
+    """The peripheral amount in units of 1e-3 (x2' = 1e3 x2): A = [[-(k10 + k12), k21/d], [d k12, -k21]], the same
+    θ and the same black box; ALS, GB and IPOPT follow it (their states of size one at the start)."""
+    d = 1e3
+    k10, k12, k21, c = names = si.parameters("k10 k12 k21 c", positive=True)
+    model = si.StateSpaceModel(A=[[-(k10 + k12), k21 / d], [k12 * d, -k21]], B=[[1], [0]], C=[[c, 0]],
+                               parameters=list(names))
+    out = estimate(model, pk_black_box(), "scr", PK_START, max_iter=300)
+    assert_same_scr_run(out, scr_ref, np.ones(4))

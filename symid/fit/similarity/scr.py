@@ -21,6 +21,25 @@ parameter error after 600 iterations: 2.3e-1 with α = 1, 2e-5 with α = 3, 4.5e
 α = 5, 6e-2 with α = 10 (the automatic α is 5.8). :meth:`ScrSimilarity.transform`
 returns T and S for ``data.blackbox`` (balanced when stable) or the black box as given.
 
+Units. Each start's problem is built in that start's units
+(:meth:`ScrSimilarity.start_problem`, tens of milliseconds): time in units of 1/ρ(𝔸), the
+black box's states scaled by the size of T that the start implies
+(:func:`~symid.fit.similarity.start.working_problem` with ``keep_states=True,
+keep_io=True``), and each parameter in units of its value at the start (θ = |x₀|·θ̃,
+:func:`unit_columns`). From the same start, SCR's iterations then do not depend on the
+units of the parameters, of time, of the inputs or of the outputs (a unit that changes all
+the model's states alike, as a fixed 1 in B does when the input changes unit, is absorbed
+by the size of T), and the random T₀ is drawn alike
+(:func:`~symid.fit.similarity.start.start_key`). The model's states otherwise keep the
+units it declares them in: SCR's relaxation is sensitive to how T is scaled, and state
+sizes taken at a random start are noise to it. On the e-nose (6-19), 40 random starts
+(seeds 0–3, ``max_iter=2000``): the truth from 15 with these units, 5 with the states also
+of size one at the start (as ALS, GB and IPOPT have them), 6 with those sizes rounded to
+powers of ten, 12 in the model's own units before. Before, on a two-compartment model,
+time in ms took one start from 37 iterations to its 30 s budget, and a rate declared in
+units of 1e-6 made the implied equalities below look inconsistent (they are checked once,
+with the parameters' coefficients of norm one).
+
 Implied equalities (option ``implied``, default on) add the rows and columns of the
 similarity relations that the model's known entries make linear
 (:func:`implied_equalities`); on the 3-D mass-spring-damper of §7-6-1 the engine's
@@ -30,6 +49,7 @@ from the same start the bilinear residual after 300 iterations was 3e-2 instead 
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
@@ -41,7 +61,14 @@ from symid.fit.base import ScrEstimator, identity_coef, positivity_lmis, theta_c
 from symid.fit.options import check_bool, check_choice, check_float, check_seed
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import SimilarityData, SimilarityEstimator
-from symid.fit.similarity.start import INITS, initial_point, transform_scale
+from symid.fit.similarity.start import (
+    INITS,
+    WorkingProblem,
+    initial_point,
+    io_time_normalised,
+    transform_scale,
+    working_problem,
+)
 
 __all__ = ["ScrSimilarity"]
 
@@ -97,6 +124,44 @@ def consistent(compiled: scr.CompiledProblem) -> bool:
     over-determine T; the engine would then report the problem infeasible.
     """
     return compiled.reduced.inconsistent <= scr.INCONSISTENT_TOL
+
+
+def unit_columns(maps: dict[str, Any], x0: np.ndarray, lower: np.ndarray) -> tuple[dict[str, Any], np.ndarray]:
+    """The maps in parameters θ̃ = θ / unit, unit = |x₀| (:func:`symid.engine.ipopt.start_scale`: where x₀ is 0,
+    the largest finite bound, else 1), and the unit: a parameter declared in other units has the same θ̃ from the
+    same start."""
+    from symid.engine.ipopt import start_scale
+
+    unit = start_scale(np.asarray(x0, dtype=float), lower, np.full(lower.shape, np.inf))
+    out = dict(maps)
+    for k in (k for k in "ABCD" if k in maps):
+        out[k] = dataclasses.replace(maps[k], Xi=maps[k].Xi * unit[:, None, None])
+    return out, unit
+
+
+@dataclasses.dataclass(frozen=True)
+class StartProblem:
+    """The engine problem of one start of :class:`ScrSimilarity`, in the units of that start.
+
+    Attributes
+    ----------
+    work : WorkingProblem
+        The similarity problem in units where its blocks weigh alike (:func:`working_problem`).
+    maps : dict
+        ``work.maps`` in parameters θ̃ = θ / ``unit`` (:func:`unit_columns`).
+    unit : numpy.ndarray
+        θ = unit · θ̃.
+    alpha : float
+        The engine works on T/α and αS (:func:`~symid.fit.similarity.start.transform_scale`).
+    compiled : CompiledProblem
+        The engine's problem.
+    """
+
+    work: WorkingProblem
+    maps: dict[str, Any]
+    unit: np.ndarray
+    alpha: float
+    compiled: Any
 
 
 def left_times(X: np.ndarray, n: int) -> np.ndarray:
@@ -167,9 +232,18 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
                         "heuristic": heuristic, "truncate_after": truncate_after,
                         "time_limit": solve_opts["time_limit"], "callback": None if callback is None else "given",
                         "verbose": self._verbose, "black_box": data.source, "basis": data.basis}
-        self._setup_engine(self._build(weights, positivity, implied), solve_opts)
+        self._weights, self._positivity, self._implied = weights, positivity, implied
+        # the implied equalities are checked once, with time, inputs, outputs and parameters in units of their
+        # size (coefficients of norm one; in the model's units, a parameter in units of 1e-6 made them look
+        # inconsistent); each start then builds its own problem (start_problem)
+        self._lower = np.where(np.asarray(self.model.positive, dtype=bool), 0.0, -np.inf)
+        maps, bb = io_time_normalised(self.model.maps, self.data.blackbox)
+        size = np.sqrt(sum(np.sum(np.abs(maps[k].Xi) ** 2, axis=(1, 2)) for k in "ABCD" if k in maps))
+        maps = unit_columns(maps, np.where(size > 0, 1.0 / np.where(size > 0, size, 1.0), 1.0), self._lower)[0]
+        self._setup_engine(self._build(maps, bb, implied)[0], solve_opts)
         if implied and not consistent(self.compiled):
-            self._setup_engine(self._build(weights, positivity, False), solve_opts)
+            self._implied = False
+            self._setup_engine(self._build(maps, bb, False)[0], solve_opts)
             self.options["implied"] = "dropped: inconsistent with this (estimated) black box"
 
     def polisher(self) -> Any:
@@ -179,11 +253,11 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         return IpoptSimilarity(self.model, self.data, aux_init="model", positivity=self.options["positivity"],
                                time_limit=self.options["time_limit"])
 
-    def _build(self, lam: float, positivity: bool, implied: bool) -> scr.BilinearProblem:
-        maps = self.model.maps
-        bb = self.data.blackbox
-        self.alpha = transform_scale(maps, bb)
-        Bb, Cb = self.alpha * bb.B, bb.C / self.alpha
+    def _build(self, maps: dict[str, Any], bb: Any, implied: bool) -> tuple[scr.BilinearProblem, float]:
+        """The engine problem on these maps and black box, and the α of T/α, αS."""
+        lam, positivity = self._weights, self._positivity
+        alpha = transform_scale(maps, bb)
+        Bb, Cb = alpha * bb.B, bb.C / alpha
         n, l = bb.n_states, self.model.n_parameters
         theta = scr.Variable("theta", (l,))
         T = scr.Variable("T", (n, n))
@@ -208,22 +282,52 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         if implied:
             eqs += implied_equalities(T, S, bb.A, Bb, Cb, *((maps[k].X0, maps[k].Xi) for k in "ABC"))
         lmis = positivity_lmis(self.model, theta) if positivity else []
-        return scr.BilinearProblem(variables=[theta, T, S], bilinear=terms, equalities=eqs, lmis=lmis)
+        return scr.BilinearProblem(variables=[theta, T, S], bilinear=terms, equalities=eqs, lmis=lmis), alpha
 
-    def start(self, x0: np.ndarray) -> dict[str, np.ndarray]:
-        """The engine start {θ, T, S} for the start x₀ (:func:`~.similarity_start.initial_point`)."""
-        theta0, T0, S0 = initial_point(self.init, x0, self.seed, self.model.maps, self.data.blackbox)
-        return {"theta": theta0, "T": T0 / self.alpha, "S": S0 * self.alpha}
+    def start_problem(self, x0: np.ndarray) -> StartProblem:
+        """The engine problem for the start x₀, in its units (module notes: Units); built per start (tens of
+        milliseconds): θ in units of |x₀|, and the black box's states of the size of T that x₀ implies."""
+        x0 = np.asarray(x0, dtype=float)
+        work = working_problem(self.model.maps, self.data.blackbox, x0, keep_states=True, keep_io=True)
+        maps, unit = unit_columns(work.maps, x0, self._lower)
+        problem, alpha = self._build(maps, work.bb, self._implied)
+        compiled = scr.compile(problem, presolve=True, normalize=True, equalities="exact")
+        if self._implied and not consistent(compiled):  # consistent in the model's units, not in these
+            problem, alpha = self._build(maps, work.bb, False)
+            compiled = scr.compile(problem, presolve=True, normalize=True, equalities="exact")
+        return StartProblem(work=work, maps=maps, unit=unit, alpha=alpha, compiled=compiled)
+
+    def start(self, x0: np.ndarray, setup: StartProblem | None = None) -> dict[str, np.ndarray]:
+        """The engine start {θ̃, T/α, αS} for the start x₀ (:func:`~.similarity_start.initial_point` on the
+        start's problem, ``setup`` or :meth:`start_problem`)."""
+        x0 = np.asarray(x0, dtype=float)
+        setup = self.start_problem(x0) if setup is None else setup
+        theta0, T0, S0 = initial_point(self.init, x0 / setup.unit, self.seed, setup.maps, setup.work.bb)
+        return {"theta": theta0, "T": T0 / setup.alpha, "S": S0 * setup.alpha}
 
     def solve(self, x0: np.ndarray, monitor: Any = None) -> scr.SCRSolution:
-        """The raw engine solution from the start x₀; its T and S are in the scaled basis (T/α, αS).
-        ``monitor`` as :func:`symid.engine.scr.solve`."""
-        return self.engine_solve(self.start(np.asarray(x0, dtype=float)), monitor=monitor)
+        """The engine solution from the start x₀, translated to the model's units: ``x["theta"]`` is θ, and
+        ``x["T"]``, ``x["S"]`` are T and S for ``data.blackbox`` (:meth:`transform`). ``monitor`` as
+        :func:`symid.engine.scr.solve` (its iterates' θ in the model's units)."""
+        x0 = np.asarray(x0, dtype=float)
+        setup = self.start_problem(x0)
+        if monitor is not None:
+            inner = monitor
+
+            def monitor(k: int, x: dict[str, Any], it: Any, elapsed: float) -> Any:
+                return inner(k, {**x, "theta": setup.unit * np.asarray(x["theta"], dtype=float)}, it, elapsed)
+
+        sol = self.engine_solve(self.start(x0, setup), compiled=setup.compiled, monitor=monitor)
+        theta = setup.unit * np.asarray(sol.x["theta"], dtype=float).reshape(-1)
+        Tw, Sw = setup.alpha * np.asarray(sol.x["T"]), np.asarray(sol.x["S"]) / setup.alpha
+        sizes, a = setup.work.sizes, setup.work.alpha
+        sol.x.update(theta=theta, T=setup.work.original_T(Tw), S=Sw / sizes[None, :] / a)
+        return sol
 
     def transform(self, sol: scr.SCRSolution, original: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """(T, S) of an engine solution for ``data.blackbox`` (the balanced one when stable), or with
+        """(T, S) of a :meth:`solve` solution for ``data.blackbox`` (the balanced one when stable), or with
         ``original=True`` for the black box as given (estimated)."""
-        T, S = self.alpha * np.asarray(sol.x["T"]), np.asarray(sol.x["S"]) / self.alpha
+        T, S = np.asarray(sol.x["T"]), np.asarray(sol.x["S"])
         if original:
             P = self.data.to_basis
             T, S = T @ P, np.linalg.solve(P, S)
