@@ -239,7 +239,8 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         self._lower = np.where(np.asarray(self.model.positive, dtype=bool), 0.0, -np.inf)
         maps, bb = io_time_normalised(self.model.maps, self.data.blackbox)
         size = np.sqrt(sum(np.sum(np.abs(maps[k].Xi) ** 2, axis=(1, 2)) for k in "ABCD" if k in maps))
-        maps = unit_columns(maps, np.where(size > 0, 1.0 / np.where(size > 0, size, 1.0), 1.0), self._lower)[0]
+        unit = np.where(size > 0, 1.0 / np.where(size > 0, size, 1.0), 1.0)  # θ = unit θ̃: coefficients of norm 1
+        maps = unit_columns(maps, unit, self._lower)[0]
         self._setup_engine(self._build(maps, bb, implied)[0], solve_opts)
         if implied and not consistent(self.compiled):
             self._implied = False

@@ -289,7 +289,7 @@ def working_problem(maps: dict[str, Any], bb: Any, x0: np.ndarray, *, keep_state
 
 def io_time_normalised(maps: dict[str, Any], bb: Any, io: bool = True) -> tuple[dict[str, Any], Any]:
     """Step 1 of :func:`working_problem` (it depends on the black box only): the maps and the black box with time
-    in units of τ = :func:`time_unit`, then each input and output in units of its own size.
+    in units of τ = :func:`time_unit`, then (unless ``io=False``) each input and output in units of its own size.
 
     The sizes do not depend on the black box's basis nor on the unit of time: input i's is
     the rms output energy √(𝔹ᵢᵀ Q 𝔹ᵢ) it drives (Q the observability Gramian), output j's
