@@ -285,3 +285,15 @@ def test_a_start_at_the_truth_stays_there_on_noise_free_records(method):
     res = si.identify(model, io, method=method, x0=truth, identifiability_check=False, time_limit=60)
     assert res.success, res.message
     np.testing.assert_allclose(res.theta_vector, list(truth.values()), rtol=1e-6)
+
+
+@pytest.mark.parametrize("method", ["scr", "als", "gb", "ipopt"])
+def test_a_black_box_with_another_fixed_feedthrough_is_refused_in_the_users_units(method):
+    """The model's D is fixed at 0 and the black box has D = 0.3: a similarity transform cannot change D. Found by a
+    new user: SCR refused it with the value in its internal units (3.25), ALS, GB and IPOPT ran on (misfits
+    0.7–0.8)."""
+    model, truth = small_model()
+    bb = transformed(model, truth, T_SMALL)
+    with_d = si.BlackBox(bb.A, bb.B, bb.C, [[0.3]])
+    with pytest.raises(si.DataError, match=r"fixed at \[\[0\.0\]\] but the black box has D = \[\[0\.3\]\]"):
+        prepare(model, with_d, method, {})

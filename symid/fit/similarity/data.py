@@ -154,6 +154,7 @@ def similarity_data(model: Any, data: Any, *, horizon: int | None = None, allow_
     else:
         raise DataError(f"similarity formulations take BlackBox or IOData; got {type(data).__name__}")
     _check_sizes(model, bb.n_states, bb.n_inputs, bb.n_outputs, where)
+    _check_feedthrough(model, bb, where)
     poles = bb.poles
     if not allow_unstable and np.any(poles.real >= -1e-12 * max(1.0, np.abs(poles).max())):
         bad = poles[np.argmax(poles.real)]
@@ -177,6 +178,19 @@ def similarity_data(model: Any, data: Any, *, horizon: int | None = None, allow_
         basis = "balanced"
     return SimilarityData(blackbox=bb, frf=FrequencyData(w, H), subspace=dss, source=source, basis=basis,
                           to_basis=P)
+
+
+def _check_feedthrough(model: Any, bb: Any, where: str) -> None:
+    """A model whose feedthrough D holds no parameter must have the black box's: a similarity transform does not
+    change D (found by a new user: SCR refused D = 0.3 against a fixed 0, ALS, GB and IPOPT ran on to misfits of
+    0.7-0.8)."""
+    Dmap = getattr(model, "maps", {}).get("D")
+    if Dmap is None or not Dmap.is_constant:
+        return
+    D0, Db = np.asarray(Dmap.X0, dtype=float), np.asarray(bb.D, dtype=float)
+    if D0.shape == Db.shape and not np.allclose(D0, Db, rtol=1e-9, atol=1e-12 * max(1.0, float(np.abs(Db).max()))):
+        raise DataError(f"the model's feedthrough D is fixed at {D0.tolist()} but {where} has D = {Db.tolist()}; "
+                        "a similarity transform does not change D (give D parameters, or remove the feedthrough)")
 
 
 def budget_message(limit: float, iterations: int, unit: str = "iteration") -> str:

@@ -56,7 +56,6 @@ from typing import Any
 import numpy as np
 
 from symid import scr
-from symid.errors import DataError
 from symid.fit.base import ScrEstimator, identity_coef, positivity_lmis, theta_coef
 from symid.fit.options import check_bool, check_choice, check_float, check_seed
 from symid.fit.result import StartOutcome
@@ -274,11 +273,7 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         eqs = [scr.Affine(-maps["B"].X0, {T: right_times(Bb, n), theta: -theta_coef(maps["B"])}),
                scr.Affine(-maps["C"].X0, {S: left_times(Cb, n), theta: -theta_coef(maps["C"])})]
         Dmap = maps["D"]
-        if Dmap.is_constant:
-            if not np.allclose(Dmap.X0, bb.D, rtol=1e-9, atol=1e-12 * max(1.0, float(np.abs(bb.D).max()))):
-                raise DataError(f"the model's feedthrough D is fixed at {Dmap.X0.tolist()} but the black box has "
-                                f"D = {bb.D.tolist()}; a similarity transform does not change D")
-        else:
+        if not Dmap.is_constant:  # a fixed D that differs from the black box's is refused by similarity_data
             eqs.append(scr.Affine(Dmap.X0 - bb.D, {theta: theta_coef(Dmap)}))
         if implied:
             eqs += implied_equalities(T, S, bb.A, Bb, Cb, *((maps[k].X0, maps[k].Xi) for k in "ABC"))
