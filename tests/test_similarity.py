@@ -297,3 +297,25 @@ def test_a_black_box_with_another_fixed_feedthrough_is_refused_in_the_users_unit
     with_d = si.BlackBox(bb.A, bb.B, bb.C, [[0.3]])
     with pytest.raises(si.DataError, match=r"fixed at \[\[0\.0\]\] but the black box has D = \[\[0\.3\]\]"):
         prepare(model, with_d, method, {})
+
+
+def test_scr_keeps_contradicted_equalities_in_the_least_squares_sense():
+    """A DC motor with both states measured (C = I, B = [g; 0]): on 1 % noisy records the N4SID black box
+    contradicts T𝔹 = B(θ), ℂS = C(θ) (relative residual 1.7e-4). Found by a new user: SCR, the default, stopped
+    'infeasible' at iteration 0, from the truth too, and returned negative 'positive' parameters. Now those
+    equalities are kept in the least-squares sense (no bilinear term is left: one step), and SCR meets IPOPT's fit.
+    Truth: R = 2 Ω, L = 10 mH, K = 0.05, J = 1.25e-4, b = 2.5e-4 (r = R/L, ke = K/L, kt = K/J, d = b/J, g = 1/L)."""
+    names = "r ke kt d g"
+    r, ke, kt, d, g = si.parameters(names, positive=True)
+    motor = si.StateSpaceModel(A=[[-r, -ke], [kt, -d]], B=[[g], [0]], C=[[1, 0], [0, 1]], parameters=[r, ke, kt, d, g])
+    truth = np.array([200.0, 5.0, 400.0, 2.0, 100.0])
+    u = np.random.default_rng(0).standard_normal(2000)
+    io = si.simulate_io(motor, truth, u, 1e-3, noise=0.01, seed=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", si.IdentifiabilityWarning)
+        res = si.identify(motor, io, method="scr", x0=truth * np.array([1.3, 0.7, 1.2, 1.5, 0.8]))
+        ref = si.identify(motor, io, method="ipopt", x0=truth)
+    assert "least squares" in res.options["equalities"]
+    assert res.success and ref.success
+    assert res.cost <= 1.01 * ref.cost  # the same fit of the records (both about 9.7e-5)
+    assert relative_parameter_error(res.theta_vector, truth) < 0.05  # 1 % noise

@@ -240,11 +240,19 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         size = np.sqrt(sum(np.sum(np.abs(maps[k].Xi) ** 2, axis=(1, 2)) for k in "ABCD" if k in maps))
         unit = np.where(size > 0, 1.0 / np.where(size > 0, size, 1.0), 1.0)  # θ = unit θ̃: coefficients of norm 1
         maps = unit_columns(maps, unit, self._lower)[0]
+        self._equalities = "exact"
         self._setup_engine(self._build(maps, bb, implied)[0], solve_opts)
         if implied and not consistent(self.compiled):
             self._implied = False
             self._setup_engine(self._build(maps, bb, False)[0], solve_opts)
             self.options["implied"] = "dropped: inconsistent with this (estimated) black box"
+        if not consistent(self.compiled):
+            # T𝔹 = B(θ) and ℂS = C(θ) themselves contradict an estimated black box (known B and C rows, e.g. every
+            # state measured): they are kept in the least-squares sense (found by a new user: on 1 % noisy records
+            # of a DC motor with C = I, SCR stopped 'infeasible' at iteration 0, from the truth too)
+            self._equalities = "least_squares"
+            self._setup_engine(self._build(maps, bb, False)[0], solve_opts, equalities="least_squares")
+            self.options["equalities"] = "least squares: T𝔹 = B(θ), ℂS = C(θ) contradict this (estimated) black box"
 
     def polisher(self) -> Any:
         """IPOPT on (6-9), T₀ from the SCR estimate by (C-7) (:class:`~symid.fit.similarity.ipopt.IpoptSimilarity`)."""
@@ -287,10 +295,10 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         work = working_problem(self.model.maps, self.data.blackbox, x0, keep_states=True, keep_io=True)
         maps, unit = unit_columns(work.maps, x0, self._lower)
         problem, alpha = self._build(maps, work.bb, self._implied)
-        compiled = scr.compile(problem, presolve=True, normalize=True, equalities="exact")
+        compiled = scr.compile(problem, presolve=True, normalize=True, equalities=self._equalities)
         if self._implied and not consistent(compiled):  # consistent in the model's units, not in these
             problem, alpha = self._build(maps, work.bb, False)
-            compiled = scr.compile(problem, presolve=True, normalize=True, equalities="exact")
+            compiled = scr.compile(problem, presolve=True, normalize=True, equalities=self._equalities)
         return StartProblem(work=work, maps=maps, unit=unit, alpha=alpha, compiled=compiled)
 
     def start(self, x0: np.ndarray, setup: StartProblem | None = None) -> dict[str, np.ndarray]:
