@@ -131,3 +131,23 @@ def test_d2c_bad_input():
         si.d2c([[0.5]], [[1.0]], [[1.0]], dt=-1)
     with pytest.raises(si.DataError, match="B must have 1 rows"):
         si.d2c([[0.5]], [[1.0], [2.0]], [[1.0]], dt=0.1)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_n4sid_does_not_depend_on_the_units_of_any_channel(seed):
+    """Each input and output in other units (factors 1e-3 … 1e4, one per channel) on noisy records: the same poles
+    (to rounding), and B, C, D follow the units. Without normalise=True the projections weigh the channels by their
+    size: a new user's thermal network with one output in mK had its poles moved by 30 %."""
+    rng = np.random.default_rng(seed)
+    A, B, C, D = random_stable(rng, 3, 2, 3)
+    truth = si.BlackBox(A, B, C, D)
+    io = si.simulate_io(truth, None, rng.standard_normal((800, 2)), dt=0.05, noise=0.01, seed=seed)
+    gu, gy = np.array([1e-3, 10.0]), np.array([1e4, 1.0, 1e-2])
+    ref = si.n4sid(io, 3)
+    out = si.n4sid(si.IOData(io.u * gu, io.y * gy, io.dt), 3)
+    np.testing.assert_allclose(np.sort_complex(out.poles), np.sort_complex(ref.poles), rtol=1e-9)
+    w = np.logspace(-1, 1.5, 30)
+    np.testing.assert_allclose(out.frequency_response(w), gy[:, None] * ref.frequency_response(w) / gu[None, :],
+                               rtol=1e-8)
+    raw = si.n4sid(si.IOData(io.u * gu, io.y * gy, io.dt), 3, normalise=False)  # the channels weighed by size
+    assert np.max(np.abs(np.sort_complex(raw.poles) - np.sort_complex(ref.poles))) > 1e-6

@@ -288,7 +288,7 @@ def _b_d_x0(io: IOData, A: np.ndarray, C: np.ndarray, feedthrough: bool, *, u: n
 
 
 def n4sid(io: IOData, order: int, *, horizon: int | None = None, feedthrough: bool = True,
-          offset: bool = False) -> DiscreteStateSpace:
+          offset: bool = False, normalise: bool = True) -> DiscreteStateSpace:
     """Estimate a discrete-time state-space model of the given order from input/output records (N4SID).
 
     Parameters
@@ -310,6 +310,13 @@ def n4sid(io: IOData, order: int, *, horizon: int | None = None, feedthrough: bo
         constant force or disturbance, its D column (with ``feedthrough``) a constant
         output offset. A constant column already in ``io.u`` is handled the same way
         (module notes); at most one constant input.
+    normalise : bool
+        Run the algorithm on each input and output divided by its rms over the record, and
+        scale the estimate back (default True), so that it does not depend on the units of
+        any channel: the projections and the least squares of N4SID weigh the channels by
+        their size, and an output in mK instead of K moved a new user's three-node thermal
+        network's poles by 30 % (FRF error 0.2 % → 5 %). ``singular_values`` are then
+        those of the normalised records. ``False``: the records as given.
 
     Returns
     -------
@@ -346,6 +353,17 @@ def n4sid(io: IOData, order: int, *, horizon: int | None = None, feedthrough: bo
         raise DataError(f"offset must be True or False; got {offset!r}")
     if not isinstance(io, IOData):
         raise DataError(f"n4sid needs input/output records as symid.IOData(u, y, dt); got {type(io).__name__}")
+    if not isinstance(normalise, (bool, np.bool_)):
+        raise DataError(f"normalise must be True or False; got {normalise!r}")
+    if normalise:
+        su, sy = _rms(io.u), _rms(io.y)
+        if np.any(su != 1.0) or np.any(sy != 1.0):
+            unit = IOData(io.u / su, io.y / sy, io.dt, time_unit=io.time_unit)
+            dss = n4sid(unit, order, horizon=horizon, feedthrough=feedthrough, offset=offset, normalise=False)
+            su = np.append(su, 1.0) if offset else su  # the offset input is 1 in any units
+            return DiscreteStateSpace(A=dss.A, B=dss.B / su[None, :], C=sy[:, None] * dss.C,
+                                      D=sy[:, None] * dss.D / su[None, :], dt=dss.dt,
+                                      singular_values=dss.singular_values, horizon=dss.horizon, x0=dss.x0)
     u_all, y = io.u, io.y
     if offset:
         u_all = np.hstack([u_all, np.ones((io.n_samples, 1))])
@@ -367,6 +385,12 @@ def n4sid(io: IOData, order: int, *, horizon: int | None = None, feedthrough: bo
     except np.linalg.LinAlgError as exc:  # a last guard: every step above names its own failures
         raise DataError(f"N4SID failed in its linear algebra ({exc}); check the record for huge values or "
                         "lower the order") from None
+
+
+def _rms(x: np.ndarray) -> np.ndarray:
+    """Root mean square of each column; 1 where it is 0 or not finite (a zero input is refused later)."""
+    r = np.sqrt(np.mean(np.asarray(x, dtype=float) ** 2, axis=0))
+    return np.where(np.isfinite(r) & (r > 0), r, 1.0)
 
 
 def _n4sid_core(H: np.ndarray, io: IOData, u_all: np.ndarray | None, n: int, i: int, m: int, p: int,
