@@ -51,9 +51,16 @@ _FRF_ONLY = {  # advice that only a frequency response can follow, and what to s
 }
 
 
-def next_step(fit: str, frf: bool = True) -> str | None:
+_IN_TIME = {  # the whiteness advice for residuals ordered in time (measured samples) rather than frequency
+    "smooth across frequency": "smooth in time",
+    "noise that grows with |H|": "noise that is not white (coloured, or growing with the signal)",
+}
+
+
+def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
     """What to try when an estimate does not fit, from its ``fit`` text (``None`` when there is no advice);
-    ``frf=False`` for data other than a frequency response (no ``method='auto'``, no ``variance=``).
+    ``frf=False`` for data other than a frequency response (no ``method='auto'``, no ``variance=``);
+    ``time=True`` for residuals ordered in time (measured samples).
 
     Examples
     --------
@@ -62,11 +69,17 @@ def next_step(fit: str, frf: bool = True) -> str | None:
     True
     >>> "auto" in next_step("misfit 9.87e-01 > 0.01 (over 10 % rms) and no noise floor given", frf=False)
     False
+    >>> next_step("structured residual (lag-1 statistic 5.1 > 3)", frf=False, time=True).startswith(
+    ...     "the residual is smooth in time")
+    True
     """
     for key, advice in _NEXT_STEPS:
         if key in fit:
             if not frf:
                 for text, other in _FRF_ONLY.items():
+                    advice = advice.replace(text, other)
+            if time:
+                for text, other in _IN_TIME.items():
                     advice = advice.replace(text, other)
             return advice
     return None
@@ -355,7 +368,8 @@ class IdentificationResult:
         if not self.success:
             if self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
-            elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind)) is not None:
+            elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
+                                      time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
         ambiguity = self.ambiguity()
         if ambiguity is not None:
