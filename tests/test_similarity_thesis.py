@@ -37,7 +37,7 @@ def test_enose_scr_from_random_starts():
 
 
 def test_enose_zero_start_converges_unlike_the_thesis():
-    """Thesis §6-6-2: S, T "initialized as zero matrices ... the method fails". Here it converges (723
+    """Thesis §6-6-2: S, T "initialized as zero matrices ... the method fails". Here it converges (763
     iterations measured): the balanced basis, the scaling α and the implied equalities change the path."""
     entry = si.load_model("enose")
     solver = prepare(entry.model, entry.data(), "scr", {"aux_init": "zero", "max_iter": 2000})
