@@ -8,12 +8,15 @@ fixes k10, k12, k21 and 1/V; Godfrey, *Compartmental Models and Their Applicatio
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 import scipy.linalg
 
 import symid as si
 from symid.data.timeseries import TimeSeries
+from symid.fit.registry import prepare
 from symid.fit.timeseries.response import simulate_output
 
 TRUTH = {"k10": 0.2, "k12": 0.5, "k21": 0.15, "q": 0.05}
@@ -254,3 +257,17 @@ def test_bad_time_series_input_is_named():
         si.identify(forced, io, method="scr", identifiability_check=False)
     res = si.identify(forced, io, method="oe", x0=START, identifiability_check=False)
     np.testing.assert_allclose(res.theta_vector, [TRUTH[k] for k in forced.parameter_names], rtol=1e-6)
+
+
+def test_the_output_error_of_a_diverged_estimate_is_inf_without_a_numpy_warning():
+    """A new user's ALS run on noisy records diverged and numpy's 'overflow encountered in square' leaked from the
+    misfit; the cost says inf by itself. x' = a x + u from x = 0, u = 1 for 10 s: a = 46 reaches about 1e199, whose
+    square overflows."""
+    a = si.parameters("a")
+    model = si.StateSpaceModel(A=[[a]], B=[[1]], C=[[1]], parameters=[a])
+    io = si.simulate_io(model, [-1.0], np.ones(101), 0.1)
+    est = prepare(model, io, "oe", {})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert est.misfit(np.array([46.0])) == float("inf")
+        assert np.isfinite(est.misfit(np.array([-1.0])))

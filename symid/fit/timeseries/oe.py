@@ -259,8 +259,9 @@ class OutputError(Estimator, FisherInformation):
             sims = self.simulate(theta)
         except (np.linalg.LinAlgError, ValueError):
             return float("inf")
-        total = sum(float(np.sum(self._weights * np.sum((r.y - s) ** 2, axis=0)))
-                    for r, s in zip(self.records, sims, strict=True))
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverged θ: inf, said by the cost, not by numpy
+            total = sum(float(np.sum(self._weights * np.sum((r.y - s) ** 2, axis=0)))
+                        for r, s in zip(self.records, sims, strict=True))
         return total if np.isfinite(total) else float("inf")
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
