@@ -26,7 +26,7 @@ Units. Each start's problem is built in that start's units
 black box's states scaled by the size of T that the start implies
 (:func:`~symid.fit.similarity.start.working_problem` with ``keep_states=True,
 keep_io=True``), and each parameter in units of its value at the start (θ = |x₀|·θ̃,
-:func:`unit_columns`). From the same start, SCR's iterations then do not depend on the
+:func:`unit_columns`; where x₀ is 0, a bound or 1). From the same start, SCR's iterations then do not depend on the
 units of the parameters, of time, of the inputs or of the outputs (a unit that changes all
 the model's states alike, as a fixed 1 in B does when the input changes unit, is absorbed
 by the size of T), and the random T₀ is drawn alike
@@ -56,6 +56,7 @@ from typing import Any
 import numpy as np
 
 from symid import scr
+from symid.engine.ipopt import start_scale
 from symid.fit.base import ScrEstimator, identity_coef, positivity_lmis, theta_coef
 from symid.fit.options import check_bool, check_choice, check_float, check_seed
 from symid.fit.result import StartOutcome
@@ -125,17 +126,12 @@ def consistent(compiled: scr.CompiledProblem) -> bool:
     return compiled.reduced.inconsistent <= scr.INCONSISTENT_TOL
 
 
-def unit_columns(maps: dict[str, Any], x0: np.ndarray, lower: np.ndarray) -> tuple[dict[str, Any], np.ndarray]:
-    """The maps in parameters θ̃ = θ / unit, unit = |x₀| (:func:`symid.engine.ipopt.start_scale`: where x₀ is 0,
-    the largest finite bound, else 1), and the unit: a parameter declared in other units has the same θ̃ from the
-    same start."""
-    from symid.engine.ipopt import start_scale
-
-    unit = start_scale(np.asarray(x0, dtype=float), lower, np.full(lower.shape, np.inf))
+def unit_columns(maps: dict[str, Any], unit: np.ndarray) -> dict[str, Any]:
+    """The maps in parameters θ̃ = θ / unit (each parameter's coefficients times its unit)."""
     out = dict(maps)
     for k in (k for k in "ABCD" if k in maps):
         out[k] = dataclasses.replace(maps[k], Xi=maps[k].Xi * unit[:, None, None])
-    return out, unit
+    return out
 
 
 @dataclasses.dataclass(frozen=True)
@@ -149,7 +145,7 @@ class StartProblem:
     maps : dict
         ``work.maps`` in parameters θ̃ = θ / ``unit`` (:func:`unit_columns`).
     unit : numpy.ndarray
-        θ = unit · θ̃.
+        θ = unit · θ̃, unit = |x₀| (:func:`symid.engine.ipopt.start_scale`).
     alpha : float
         The engine works on T/α and αS (:func:`~symid.fit.similarity.start.transform_scale`).
     compiled : CompiledProblem
@@ -238,8 +234,7 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         self._lower = np.where(np.asarray(self.model.positive, dtype=bool), 0.0, -np.inf)
         maps, bb = io_time_normalised(self.model.maps, self.data.blackbox)
         size = np.sqrt(sum(np.sum(np.abs(maps[k].Xi) ** 2, axis=(1, 2)) for k in "ABCD" if k in maps))
-        unit = np.where(size > 0, 1.0 / np.where(size > 0, size, 1.0), 1.0)  # θ = unit θ̃: coefficients of norm 1
-        maps = unit_columns(maps, unit, self._lower)[0]
+        maps = unit_columns(maps, 1.0 / np.where(size > 0, size, 1.0))  # coefficients of norm one
         self._equalities = "exact"
         self._setup_engine(self._build(maps, bb, implied)[0], solve_opts)
         if implied and not consistent(self.compiled):
@@ -293,7 +288,8 @@ class ScrSimilarity(ScrEstimator, SimilarityEstimator):
         milliseconds): θ in units of |x₀|, and the black box's states of the size of T that x₀ implies."""
         x0 = np.asarray(x0, dtype=float)
         work = working_problem(self.model.maps, self.data.blackbox, x0, keep_states=True, keep_io=True)
-        maps, unit = unit_columns(work.maps, x0, self._lower)
+        unit = start_scale(x0, self._lower, np.full(x0.shape, np.inf))  # |x₀|; where 0, a bound, else 1
+        maps = unit_columns(work.maps, unit)
         problem, alpha = self._build(maps, work.bb, self._implied)
         compiled = scr.compile(problem, presolve=True, normalize=True, equalities=self._equalities)
         if self._implied and not consistent(compiled):  # consistent in the model's units, not in these

@@ -107,18 +107,20 @@ def start_key(A: np.ndarray, B: np.ndarray, C: np.ndarray, bb: Any) -> int:
     >>> start_key(A, B, C, bb) == start_key(2 * A, B, C, bb)   # another start
     False
     """
+    from symid.model.lti import StateSpaceMatrices, frequency_response_ss
+
     A, B, C = (np.asarray(X, dtype=float) for X in (A, B, C))
     rho = 1.0 / time_unit(bb)
     parts = sorted(_key_text(np.linalg.eigvals(A) / rho)) if A.size else []
+    w, D = np.array([rho]), np.zeros((C.shape[0], B.shape[1]))  # the strictly proper parts, without D
     try:
-        s = 1j * rho
-        Hm = C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B.astype(complex))
-        Ab, Bb, Cb = (np.asarray(X, dtype=float) for X in (bb.A, bb.B, bb.C))
-        Hb = Cb @ np.linalg.solve(s * np.eye(Ab.shape[0]) - Ab, Bb.astype(complex))
+        Hm = frequency_response_ss(StateSpaceMatrices(A, B, C, D), w)[0]
+        Hb = frequency_response_ss(StateSpaceMatrices(*(np.asarray(X, dtype=float) for X in (bb.A, bb.B, bb.C)), D),
+                                   w)[0]
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(np.abs(Hb) > 0, np.abs(Hm) / np.abs(Hb), 0.0)
         parts += _key_text(ratio)
-    except (np.linalg.LinAlgError, ValueError):
+    except (ModelError, ValueError):
         pass  # iρ a pole, or shapes that do not match: the eigenvalues alone
     return zlib.crc32(";".join(parts).encode("ascii"))
 
