@@ -198,9 +198,10 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         (Buchberger over ℚ, pure Python), or ``"auto"`` (default: msolve when found, else
         sympy). A model that is not locally identifiable is solved on a generic slice
         of its solution set (:mod:`~symid.structural.slicing`), by the same engine. A
-        mass-spring-damper chain driven and measured at an end mass needs neither: its
-        continued-fraction inversion (:mod:`~symid.structural.ladder`) proves every
-        parameter global in milliseconds, whatever the engine.
+        mass-spring-damper chain driven and measured at one mass needs neither: its
+        continued-fraction inversion (:mod:`~symid.structural.ladder` at an end mass,
+        :mod:`~symid.structural.ladder_interior` at an interior one) proves every
+        parameter global in well under a second, whatever the engine.
         The report is the same either way (``engine`` in it says which ran; the floats of
         ``solutions`` agree to rounding). sympy's count over ℚ is exact; msolve's over ℚ
         is multi-modular with a probabilistic stopping criterion (Monte Carlo, as the

@@ -175,8 +175,10 @@ class GlobalResult:
         solutions (the result is the same either way, up to the float rounding of
         ``solutions``); ``"formula"`` when no solution was computed because every verdict
         came from checked formulas (:mod:`~symid.structural.rational_formulas`);
-        ``"ladder"`` when a chain driven and measured at an end mass was inverted by
-        continued fractions (:mod:`~symid.structural.ladder`: one solution, no Gröbner basis).
+        ``"ladder"`` when a chain driven and measured at one mass was inverted (at an end
+        mass by continued fractions, :mod:`~symid.structural.ladder`; at an interior mass by
+        a pole split and continued fractions on either side,
+        :mod:`~symid.structural.ladder_interior`): one solution, no Gröbner basis.
     slice_values : dict of str to sympy.Rational
         For a model that is not locally identifiable, solved on a slice
         (:mod:`~symid.structural.slicing`): the random values given to the parameters
@@ -601,7 +603,7 @@ def confirm_mod_p(model, known: Mapping[str, object] | None = None, *, seed: int
     params, star, _, summ, rng = star_and_summary(model, known, seed=seed, draw=draw, rank=rank, summary=summary)
     names = [p.name for p in params]
     theta2 = {n: str(v) for n, v in zip(names, star, strict=True)}
-    if proves_global(model, known, star):  # an end-driven chain: one solution, by continued fractions
+    if proves_global(model, known, star):  # a chain driven at one mass: one solution, by continued fractions
         return True, 1, dict.fromkeys(names, True), theta2
     pt = [QQ.from_sympy(v) for v in star]
     exact = [Fraction(int(v.p), int(v.q)) for v in star]
@@ -749,7 +751,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     pt = [QQ.from_sympy(v) for v in star]
     exact_star = [Fraction(int(v.p), int(v.q)) for v in star]
     crossed = [_cross_terms(e, params, exact_star) for e in extra_candidates]
-    ladder = proves_global(model, known, star)  # an end-driven chain: one solution, by continued fractions
+    ladder = proves_global(model, known, star)  # a chain driven at one mass: one solution, by continued fractions
     degree = 1 if ladder else _degree_mod_p(msolve, summ, params, exact_star, rng) \
         if msolve is not None and all(c is not None for c in crossed) else None
     if degree is not None and 1 < degree <= MAX_QUOTIENT:
@@ -774,10 +776,15 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     if degree == 1:
         # one solution, θ*: every parameter and every candidate is single-valued
         times["groebner"] = time.perf_counter() - t1
-        if ladder:
+        if ladder == "end":
             notes.append("a mass chain driven and measured at an end mass: its continued fraction gives every "
                          "parameter as a rational function of the transfer function (symid.structural.ladder), so "
                          "no Gröbner basis was needed")
+        elif ladder:
+            notes.append("a mass chain driven and measured at an interior mass: of the splits of the driving-point "
+                         "impedance's poles between the two sides only θ*'s meets the necessary conditions (a "
+                         "floating-point test with wide margins), and on it each side's continued fraction gives "
+                         "its parameters (symid.structural.ladder_interior), so no Gröbner basis was needed")
         sol = {n: float(v) for n, v in theta_star.items()}
         every = dict.fromkeys(names, True)
         k_forms = range(len(linear_forms))

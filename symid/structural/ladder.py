@@ -84,7 +84,7 @@ import sympy as sp
 from symid.errors import ModelError, OptionError
 from symid.structural.summary import free_parameters, model_kind, model_matrices
 
-__all__ = ["Ladder", "invert", "ladder_of", "proves_global"]
+__all__ = ["Ladder", "invert", "ladder_of", "peel", "proves_global"]
 
 _S = sp.Symbol("s")
 _SHIFT = {"position": 0, "velocity": 1, "acceleration": 2}
@@ -341,6 +341,13 @@ def invert(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequ
         D = _RF.poly(sp.Poly(m[j] * _S**2, _S, domain="QQ") + _lin(*g[j])) + series
     if not _matches_model(D, ladder, model, known, subs):
         return False
+    return peel(D, ladder, m, e, g, subs)
+
+
+def peel(D: _RF, ladder: Ladder, m: list, e: list, g: list, subs: Mapping) -> bool:
+    """Steps 1–4 of the module notes from node 0 of ``ladder``, D = D_0 exact: whether each recovered value is
+    θ*'s (``m``, ``e``, ``g``: the masses, edges and grounds at θ*) and every step's uniqueness condition holds."""
+    n = len(ladder.masses)
     for j in range(n):
         L = n - j
         if D.num.degree() != 2 * L or D.den.degree() != 2 * L - 2:
@@ -458,11 +465,20 @@ def _matches_model(D: _RF, ladder: Ladder, model, known, subs: Mapping) -> bool:
     return True
 
 
-def proves_global(model, known: Mapping[str, object] | None, star: Sequence[object]) -> bool:
-    """Whether ``model`` is a chain of :func:`ladder_of` whose inversion succeeds at θ* = ``star``.
+def proves_global(model, known: Mapping[str, object] | None, star: Sequence[object]) -> str:
+    """Whether ``model`` is a chain whose inversion succeeds at θ* = ``star``: ``"end"`` (driven and measured at an
+    end mass, :func:`invert`), ``"interior"`` (at an interior mass,
+    :func:`~symid.structural.ladder_interior.invert_interior`), or ``""`` (no proof).
 
-    True: every free parameter is globally identifiable and summary(θ) = summary(θ*) has
-    one complex solution for generic θ* (module notes).
+    Non-empty: every free parameter is globally identifiable and summary(θ) = summary(θ*)
+    has one complex solution for generic θ* (module notes).
     """
     ladder = ladder_of(model, known)
-    return ladder is not None and invert(ladder, model, known, star)
+    if ladder is not None:
+        return "end" if invert(ladder, model, known, star) else ""
+    inner = ladder_of(model, known, driven_anywhere=True)
+    if inner is None or not 0 < inner.at < len(inner.masses) - 1:
+        return ""
+    from symid.structural.ladder_interior import invert_interior  # it builds on this module
+
+    return "interior" if invert_interior(inner, model, known, star) else ""

@@ -142,9 +142,10 @@ class IdentifiabilityReport:
     engine : str
         Which program solved summary(θ) = summary(θ*): ``"msolve"`` or ``"sympy"``
         (empty when the exact step did not finish), ``"ladder"`` for a mass chain driven and
-        measured at an end mass, inverted by continued fractions with no Gröbner basis
-        (:mod:`symid.structural.ladder`), ``"formula"`` when checked rational formulas
-        decided every verdict. Like ``timing``, a record of how the
+        measured at one mass, inverted by continued fractions with no Gröbner basis
+        (:mod:`symid.structural.ladder` at an end mass; :mod:`symid.structural.ladder_interior`
+        at an interior one, whose pole split is a floating-point test), ``"formula"`` when
+        checked rational formulas decided every verdict. Like ``timing``, a record of how the
         report was made: the rest of the report is the same whichever ran (the floats of
         ``solutions`` agree to rounding).
     """

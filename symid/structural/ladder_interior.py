@@ -1,0 +1,164 @@
+"""Global identifiability of a mass-spring-damper chain driven and measured at an interior mass.
+
+A chain driven and measured at an interior mass j (a collocated sensor and actuator in
+the middle of a structure) has the dynamic stiffness
+
+    D(s) = m_j s² + Z_L(s) + Z_R(s),
+
+Z_L and Z_R the impedances of the two sub-chains as seen from mass j, each through the
+element e = c s + k that ties it to j. Unlike an end-driven chain
+(:mod:`~symid.structural.ladder`), D does not say which of its poles belong to which
+side: a solution of D(θ) = D(θ*) could split them differently. The inversion is
+
+1. every split of D's 2n − 2 poles into 2a for Z_L and 2b for Z_R (a, b masses on either
+   side; C(2n − 2, 2b) of them, 3003 for 8 masses) is tested against two necessary
+   conditions (:mod:`~symid.structural.pole_split`): a free side's impedance vanishes to
+   second order at s = 0, and e − Z has a double zero at −k/c. Exactly one split must pass,
+   and it must be θ*'s: the poles of Z_R(θ*);
+2. on it, in exact rational arithmetic: Z_R and Z_L (the split's partial fractions with
+   c s + β fixed by condition 1) are θ*'s; the numerators G = N′F − N F′ and
+   H = N + (c s + β) F of each side have a greatest common divisor of degree 1, whose root
+   −k/c gives k (one choice of s₀); then D′ = 1/(1/Z − 1/e) is the impedance of the side's
+   own chain, driven at its end, inverted node by node by
+   :func:`~symid.structural.ladder.peel` (one solution, module notes there).
+
+Every solution θ of D(θ) = D(θ*) for a generic θ* goes through exactly these steps, so θ*
+is the only one. Step 1 is a floating-point test with wide margins, not an interval proof
+(see :mod:`~symid.structural.pole_split`); step 2 is exact. As for the Gröbner step, the
+claim is confirmed at a second random point θ** (:func:`~symid.structural.global_.generic_global`).
+
+Structure recognised: :func:`~symid.structural.ladder.ladder_of` with
+``driven_anywhere=True`` and the driven mass interior (ground elements at most at one end,
+never at the driven mass), both elements at the driven mass with a damper and a spring.
+Anything else returns False and the usual global step decides.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import mpmath
+import sympy as sp
+
+from symid.errors import OptionError
+from symid.structural.ladder import _RF, _S, Ladder, _lin, _matches_model, _value, peel
+from symid.structural.pole_split import DPS, possible_splits
+from symid.structural.summary import free_parameters
+
+__all__ = ["invert_interior"]
+
+
+def _side(ladder: Ladder, nodes: list[int], m: list, e: list, g: list) -> tuple[Ladder, list, list, list]:
+    """The sub-chain on ``nodes`` (positions in ``ladder.order``, from the driven mass outwards) as a Ladder driven
+    at its first node, with its values at θ*."""
+    step = 1 if nodes[0] > ladder.at else -1
+    # edge i of the ladder joins positions i and i + 1
+    idx = [min(p, p + step) for p in nodes[:-1]]
+    side = Ladder(tuple(ladder.order[p] for p in nodes), tuple(ladder.masses[p] for p in nodes),
+                  tuple(ladder.edges[i] for i in idx), tuple(ladder.grounds[p] for p in nodes), ladder.shift,
+                  ladder.gain)
+    return side, [m[p] for p in nodes], [e[i] for i in idx], [g[p] for p in nodes]
+
+
+def _impedance(m: list, e: list, g: list) -> _RF:
+    """D_0 of an end-driven chain with node values m, g and edges e (exact)."""
+    D = _RF.poly(sp.Poly(m[-1] * _S**2, _S, domain="QQ") + _lin(*g[-1]))
+    for j in range(len(m) - 2, -1, -1):
+        D = _RF.poly(sp.Poly(m[j] * _S**2, _S, domain="QQ") + _lin(*g[j])) + _series(e[j], D)
+    return D
+
+
+def _series(edge: tuple, D: _RF) -> _RF:
+    """The impedance of D seen through the element ``edge`` = (c, k): e D / (e + D)."""
+    return (_RF.poly(_lin(*edge)).inv() + D.inv()).inv()
+
+
+def _side_unique(Z: _RF, edge: tuple, free: bool) -> bool:
+    """Step 2 on one side (module notes): Z's polynomial part is c s + β with c θ*'s damper, a free side has
+    Z(0) = Z′(0) = 0, and gcd(G, H) has degree 1 with root −k/c."""
+    c, k = edge
+    q, N = Z.num.div(Z.den)
+    F = Z.den
+    if q.degree() > 1 or q.coeff_monomial(_S) != c:
+        return False
+    beta = q.coeff_monomial(1)
+    if free:  # Z(0) = 0 and Z'(0) = 0: β = −g(0), c = −g'(0) with g = N/F
+        f0, n0 = F.eval(0), N.eval(0)
+        if f0 == 0 or beta != -n0 / f0 or c != -(N.diff(_S).eval(0) * f0 - n0 * F.diff(_S).eval(0)) / f0**2:
+            return False
+    G = N.diff(_S) * F - N * F.diff(_S)
+    common = G.gcd(Z.num)
+    return common.degree() == 1 and -common.coeff_monomial(1) / common.LC() == -k / c
+
+
+def invert_interior(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequence[object]) -> bool:
+    """Whether the inversion of the module notes shows θ* = ``star`` to be the only solution.
+
+    ``ladder`` from :func:`~symid.structural.ladder.ladder_of` with ``driven_anywhere=True``.
+    True proves (step 1 up to floating point, see the module notes) that summary(θ) =
+    summary(θ*) has one complex solution; False proves nothing (the usual global step
+    decides).
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> import symid as si
+    >>> from symid.structural.ladder import ladder_of
+    >>> from symid.structural.ladder_interior import invert_interior
+    >>> m1, m2, m3, c1, c2, c3, k1, k2, k3 = si.parameters("m1 m2 m3 c1 c2 c3 k1 k2 k3", positive=True)
+    >>> chain = si.SecondOrderModel(M=sp.diag(m1, m2, m3), V=[[c1 + c2, -c2, 0], [-c2, c2 + c3, -c3], [0, -c3, c3]],
+    ...                             K=[[k1 + k2, -k2, 0], [-k2, k2 + k3, -k3], [0, -k3, k3]],
+    ...                             B=[[0], [1], [0]], C=[[0, 1, 0]])
+    >>> lad = ladder_of(chain, driven_anywhere=True)
+    >>> lad.at
+    1
+    >>> invert_interior(lad, chain, None, [3, 5, 7, sp.Rational(1, 2), 11, 2, 13, 17, 19])
+    True
+    """
+    params = free_parameters(model, known)
+    if len(star) != len(params):
+        raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
+    n, at = len(ladder.masses), ladder.at
+    if not 0 < at < n - 1 or ladder.grounds[at] != (0, 0):
+        return False
+    if any(x == 0 for x in (*ladder.edges[at - 1], *ladder.edges[at])):
+        return False  # an element at the driven mass without a damper or a spring: condition 2 does not apply
+    subs = {p: sp.Rational(v) for p, v in zip(params, star, strict=True)}
+    m = [_value(v, subs) for v in ladder.masses]
+    e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
+    g = [tuple(_value(v, subs) for v in pair) for pair in ladder.grounds]
+    present = [*ladder.masses, *(x for pair in ladder.edges for x in pair),
+               *(x for pair in ladder.grounds for x in pair)]
+    slots = [*m, *(x for pair in e for x in pair), *(x for pair in g for x in pair)]
+    if any(x == 0 and p != 0 for x, p in zip(slots, present, strict=True)):
+        return False  # an element of the structure is 0 at θ*: not a generic point
+    left, ml, el, gl = _side(ladder, list(range(at - 1, -1, -1)), m, e, g)
+    right, mr, er, gr = _side(ladder, list(range(at + 1, n)), m, e, g)
+    ZL, ZR = _series(e[at - 1], _impedance(ml, el, gl)), _series(e[at], _impedance(mr, er, gr))
+    D = _RF.poly(sp.Poly(m[at] * _S**2, _S, domain="QQ")) + ZL + ZR
+    if not _matches_model(D, ladder, model, known, subs):
+        return False
+    P = D.den
+    if D.num.degree() != 2 * n or P.degree() != 2 * n - 2 or D.num.LC() / P.LC() != m[at]:
+        return False
+    q, rem = (D - _RF.poly(sp.Poly(m[at] * _S**2, _S, domain="QQ"))).num.div(P)
+    if q.degree() > 1:
+        return False
+    left_free = all(x == (0, 0) for x in gl)
+    found = possible_splits(P, rem, q.coeff_monomial(_S), q.coeff_monomial(1), 2 * len(mr), left_free)
+    if found is None or len(found[0]) != 1:
+        return False
+    # the one passing split must be θ*'s: the poles of Z_R
+    with mpmath.workdps(DPS):
+        fr = [mpmath.mpf(int(c.p)) / int(c.q) for c in ZR.den.all_coeffs()]
+        for z in found[0][0]:
+            size = mpmath.fsum(abs(c) * abs(z) ** i for i, c in enumerate(reversed(fr)))
+            if abs(mpmath.polyval(fr, mpmath.mpc(z))) > 1e-12 * size:
+                return False
+    if not (_side_unique(ZR, e[at], True) and _side_unique(ZL, e[at - 1], left_free)):
+        return False
+    for Z, edge, side, vals in ((ZR, e[at], right, (mr, er, gr)), (ZL, e[at - 1], left, (ml, el, gl))):
+        own = (Z.inv() - _RF.poly(_lin(*edge)).inv()).inv()
+        if not peel(own, side, *vals, subs):
+            return False
+    return True

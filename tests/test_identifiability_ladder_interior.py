@@ -1,0 +1,121 @@
+"""The inversion of mass chains driven and measured at an interior mass (symid.structural.ladder_interior).
+
+Reference for every verdict here: the Gröbner step itself (msolve, or sympy's Buchberger
+when msolve is not installed), run on the same model and θ* with the inversions turned
+off. Where it claims one solution the inversion must agree; where the Gröbner step finds
+two (a chain free at both ends, the same structure on both sides of the driven mass) it
+must claim nothing.
+"""
+
+from __future__ import annotations
+
+import pytest
+import sympy as sp
+
+import symid as si
+import symid.structural.global_ as gg
+from symid.structural.global_ import generic_global, star_and_summary
+from symid.structural.ladder import Ladder, ladder_of, proves_global
+from symid.structural.ladder_interior import invert_interior
+from symid.structural.msolve import msolve_binary
+from symid.structural.summary import model_matrices
+
+MSOLVE = msolve_binary()
+
+
+def _gröbner(model, monkeypatch):
+    with monkeypatch.context() as mp:
+        mp.setattr(gg, "proves_global", lambda *a, **k: "")
+        return generic_global(model, rank=len(model.parameters), msolve=MSOLVE)
+
+
+def _free_chain(n: int, at: int):
+    """n masses joined by n − 1 spring-damper elements, nothing to the ground, force and sensor at mass ``at``."""
+    m = si.parameters(" ".join(f"m{i + 1}" for i in range(n)), positive=True)
+    c = si.parameters(" ".join(f"c{i + 1}" for i in range(n - 1)), positive=True)
+    k = si.parameters(" ".join(f"k{i + 1}" for i in range(n - 1)), positive=True)
+    c, k = (c,) if n == 2 else c, (k,) if n == 2 else k
+    V, K = sp.zeros(n, n), sp.zeros(n, n)
+    for X, v in ((V, c), (K, k)):
+        for i, x in enumerate(v):  # element i joins masses i and i + 1
+            X[i, i] += x
+            X[i + 1, i + 1] += x
+            X[i, i + 1] -= x
+            X[i + 1, i] -= x
+    B = sp.zeros(n, 1)
+    B[at] = 1
+    return si.SecondOrderModel(M=sp.diag(*m), V=V, K=K, B=B, C=B.T)
+
+
+@pytest.mark.parametrize("name", ["chain_mid-3-mm", "chain_mid-4-mm", "chain_mid-4-mm-velocity", "free-4-1"])
+def test_the_inversion_agrees_with_the_groebner_step(name, monkeypatch, families):
+    if name.startswith("free"):
+        model = _free_chain(4, 1)
+    else:
+        model = families.build(name.removesuffix("-velocity"))
+        if name.endswith("velocity"):
+            model = si.SecondOrderModel(**model_matrices(model, None), output="velocity")
+    lad = ladder_of(model, driven_anywhere=True)
+    assert lad is not None and 0 < lad.at < len(lad.masses) - 1
+    fast = generic_global(model, rank=len(model.parameters), msolve=MSOLVE)
+    ref = _gröbner(model, monkeypatch)
+    assert fast.engine == "ladder" and ref.engine in ("msolve", "sympy")
+    assert (fast.n_complex, fast.n_real, fast.n_admissible) == (ref.n_complex, ref.n_real, ref.n_admissible) \
+        == (1, 1, 1)
+    assert fast.global_complex == ref.global_complex and all(fast.global_complex.values())
+    assert fast.confirmed and fast.theta_confirm
+
+
+def test_a_mirror_symmetric_chain_is_left_to_the_groebner_step(monkeypatch):
+    """Free at both ends, one mass on either side of the driven one: swapping the sides is a second solution
+    (Gröbner: 2), so two splits pass and the inversion claims nothing."""
+    model = _free_chain(3, 1)
+    star = star_and_summary(model)[1]
+    lad = ladder_of(model, driven_anywhere=True)
+    assert lad is not None and lad.at == 1
+    assert not invert_interior(lad, model, None, star)
+    assert proves_global(model, None, star) == ""
+    ref = _gröbner(model, monkeypatch)
+    assert ref.n_complex == 2
+    res = generic_global(model, rank=len(model.parameters), msolve=MSOLVE)
+    assert res.engine != "ladder" and res.n_complex == 2
+
+
+@pytest.mark.parametrize("n", [5, 6, 7, 8])
+def test_every_interior_chain_size_inverts_at_theta_star_and_theta_2(n, families):
+    """Sizes the Gröbner step does not finish in minutes (chain_mid-5-mm: msolve, 150 s): the inversion in well under
+    a second at two independent points."""
+    model = families.build(f"chain_mid-{n}-mm")
+    lad = ladder_of(model, driven_anywhere=True)
+    for draw in (0, 500):
+        star = star_and_summary(model, seed=3, draw=draw)[1]
+        assert invert_interior(lad, model, None, star)
+        assert proves_global(model, None, star) == "interior"
+
+
+def test_a_misread_structure_is_caught(families):
+    model = families.build("chain_mid-5-mm")
+    lad = ladder_of(model, driven_anywhere=True)
+    star = star_and_summary(model)[1]
+    wrong = Ladder(lad.order, lad.masses, (lad.edges[1], lad.edges[0], *lad.edges[2:]), lad.grounds, lad.shift,
+                   lad.gain, lad.at)
+    assert invert_interior(lad, model, None, star)
+    assert not invert_interior(wrong, model, None, star)
+
+
+def test_an_element_without_damper_at_the_driven_mass_proves_nothing(families):
+    """Condition 2 (a double zero at −k/c) needs a damper and a spring in both elements at the driven mass."""
+    model = families.build("chain_mid-5-mm")
+    c3 = next(p for p in model.parameters if p.name == "c3")
+    mats = model_matrices(model, None)
+    model = si.SecondOrderModel(**{**mats, "V": mats["V"].subs(c3, 0)})
+    lad = ladder_of(model, driven_anywhere=True)
+    assert lad is not None
+    assert not invert_interior(lad, model, None, star_and_summary(model)[1])
+
+
+def test_the_report_says_how_it_was_proven(families):
+    rep = si.identifiability(families.build("chain_mid-6-mm"))
+    assert rep.engine == "ladder" and rep.verdict == "global" and rep.n_solutions_complex == 1
+    assert set(rep.verdicts.values()) == {"global"}
+    assert any("interior mass" in note and "symid.structural.ladder_interior" in note for note in rep.notes)
