@@ -107,7 +107,9 @@ def possible_splits(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Ratio
         z = np.array([complex(r) for r in roots])
         rh = np.array([complex(r) for r in rho])
         splits = np.array(list(combinations(range(len(z)), n_right)), dtype=int)
-        rest = np.array([[i for i in range(len(z)) if i not in set(row)] for row in splits], dtype=int)
+        mask = np.ones((len(splits), len(z)), dtype=bool)
+        mask[np.arange(len(splits))[:, None], splits] = False
+        rest = np.nonzero(mask)[1].reshape(len(splits), len(z) - n_right)  # the other poles, in increasing order
         res = _residual_double(z, rh, splits, rest, complex(al), complex(be), left_free)
         passing = []
         for k in np.flatnonzero(~(res >= RECHECK)):  # NaN (a degenerate double computation) is rechecked too
