@@ -36,16 +36,17 @@ Anything else returns False and the usual global step decides.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import mpmath
 import sympy as sp
 
 from symid.errors import OptionError
 from symid.structural.ladder import _RF, _S, Ladder, _lin, _matches_model, _value, peel
-from symid.structural.pole_split import DPS, possible_splits
+from symid.structural.pole_split import DPS, possible_splits, split_residuals
 from symid.structural.summary import free_parameters
 
-__all__ = ["invert_interior"]
+__all__ = ["invert_interior", "split_margins"]
 
 
 def _side(ladder: Ladder, nodes: list[int], m: list, e: list, g: list) -> tuple[Ladder, list, list, list]:
@@ -115,14 +116,46 @@ def invert_interior(ladder: Ladder, model, known: Mapping[str, object] | None, s
     >>> invert_interior(lad, chain, None, [3, 5, 7, sp.Rational(1, 2), 11, 2, 13, 17, 19])
     True
     """
+    setup = _setup(ladder, model, known, star)
+    if setup is None:
+        return False
+    found = possible_splits(*setup.split_args)
+    if found is None or len(found[0]) != 1 or not _poles_of(setup.ZR, found[0][0]):
+        return False  # undecided, several splits, or the one passing split is not θ*'s (the poles of Z_R)
+    ZL, ZR, e, at, subs = setup.ZL, setup.ZR, setup.e, ladder.at, setup.subs
+    left, right = setup.left, setup.right
+    left_free = setup.split_args[-1]
+    if not (_side_unique(ZR, e[at], True) and _side_unique(ZL, e[at - 1], left_free)):
+        return False
+    for Z, edge, (side, *vals) in ((ZR, e[at], right), (ZL, e[at - 1], left)):
+        own = (Z.inv() - _RF.poly(_lin(*edge)).inv()).inv()
+        if not peel(own, side, *vals, subs):
+            return False
+    return True
+
+
+@dataclass(frozen=True)
+class _Setup:
+    subs: dict
+    e: list
+    left: tuple  # (Ladder, m, e, g) of the side from the driven mass to the grounded end (if any)
+    right: tuple
+    ZL: _RF
+    ZR: _RF
+    split_args: tuple  # the arguments of possible_splits
+
+
+def _setup(ladder: Ladder, model, known, star) -> _Setup | None:
+    """θ*'s values, the two sides, their impedances and D (checked against the model), or None when the
+    structure or θ* is outside the cases of the module notes."""
     params = free_parameters(model, known)
     if len(star) != len(params):
         raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
     n, at = len(ladder.masses), ladder.at
     if not 0 < at < n - 1 or ladder.grounds[at] != (0, 0):
-        return False
+        return None
     if any(x == 0 for x in (*ladder.edges[at - 1], *ladder.edges[at])):
-        return False  # an element at the driven mass without a damper or a spring: condition 2 does not apply
+        return None  # an element at the driven mass without a damper or a spring: condition 2 does not apply
     subs = {p: sp.Rational(v) for p, v in zip(params, star, strict=True)}
     m = [_value(v, subs) for v in ladder.masses]
     e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
@@ -131,34 +164,51 @@ def invert_interior(ladder: Ladder, model, known: Mapping[str, object] | None, s
                *(x for pair in ladder.grounds for x in pair)]
     slots = [*m, *(x for pair in e for x in pair), *(x for pair in g for x in pair)]
     if any(x == 0 and p != 0 for x, p in zip(slots, present, strict=True)):
-        return False  # an element of the structure is 0 at θ*: not a generic point
-    left, ml, el, gl = _side(ladder, list(range(at - 1, -1, -1)), m, e, g)
-    right, mr, er, gr = _side(ladder, list(range(at + 1, n)), m, e, g)
-    ZL, ZR = _series(e[at - 1], _impedance(ml, el, gl)), _series(e[at], _impedance(mr, er, gr))
+        return None  # an element of the structure is 0 at θ*: not a generic point
+    left = _side(ladder, list(range(at - 1, -1, -1)), m, e, g)
+    right = _side(ladder, list(range(at + 1, n)), m, e, g)
+    ZL, ZR = _series(e[at - 1], _impedance(*left[1:])), _series(e[at], _impedance(*right[1:]))
     D = _RF.poly(sp.Poly(m[at] * _S**2, _S, domain="QQ")) + ZL + ZR
     if not _matches_model(D, ladder, model, known, subs):
-        return False
+        return None
     P = D.den
     if D.num.degree() != 2 * n or P.degree() != 2 * n - 2 or D.num.LC() / P.LC() != m[at]:
-        return False
+        return None
     q, rem = (D - _RF.poly(sp.Poly(m[at] * _S**2, _S, domain="QQ"))).num.div(P)
     if q.degree() > 1:
-        return False
-    left_free = all(x == (0, 0) for x in gl)
-    found = possible_splits(P, rem, q.coeff_monomial(_S), q.coeff_monomial(1), 2 * len(mr), left_free)
-    if found is None or len(found[0]) != 1:
-        return False
-    # the one passing split must be θ*'s: the poles of Z_R
+        return None
+    left_free = all(x == (0, 0) for x in left[3])
+    return _Setup(subs, e, left, right, ZL, ZR,
+                  (P, rem, q.coeff_monomial(_S), q.coeff_monomial(1), 2 * len(right[1]), left_free))
+
+
+def _poles_of(Z: _RF, poles) -> bool:
+    """Whether every one of ``poles`` (complex) is a root of Z's denominator, to 1e-12 of the size of its terms."""
     with mpmath.workdps(DPS):
-        fr = [mpmath.mpf(int(c.p)) / int(c.q) for c in ZR.den.all_coeffs()]
-        for z in found[0][0]:
-            size = mpmath.fsum(abs(c) * abs(z) ** i for i, c in enumerate(reversed(fr)))
-            if abs(mpmath.polyval(fr, mpmath.mpc(z))) > 1e-12 * size:
+        den = [mpmath.mpf(int(c.p)) / int(c.q) for c in Z.den.all_coeffs()]
+        for z in poles:
+            size = mpmath.fsum(abs(c) * abs(z) ** i for i, c in enumerate(reversed(den)))
+            if abs(mpmath.polyval(den, mpmath.mpc(z))) > 1e-12 * size:
                 return False
-    if not (_side_unique(ZR, e[at], True) and _side_unique(ZL, e[at - 1], left_free)):
-        return False
-    for Z, edge, side, vals in ((ZR, e[at], right, (mr, er, gr)), (ZL, e[at - 1], left, (ml, el, gl))):
-        own = (Z.inv() - _RF.poly(_lin(*edge)).inv()).inv()
-        if not peel(own, side, *vals, subs):
-            return False
     return True
+
+
+def split_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequence[object]) -> dict | None:
+    """How clearly the split test of step 1 separates θ*'s split from the others, at θ* = ``star``.
+
+    Returns ``{"splits": number tested, "true": θ*'s 40-digit residual, "nearest": the
+    smallest residual of any other split (40 digits where it was rechecked, else
+    double)}``, or None outside the cases of the module notes. For the benchmarks
+    (the residuals are defined in :mod:`~symid.structural.pole_split`).
+    """
+    setup = _setup(ladder, model, known, star)
+    found = None if setup is None else split_residuals(*setup.split_args)
+    if found is None:
+        return None
+    roots, splits, double, fine = found
+    mine = [k for k in range(len(splits)) if _poles_of(setup.ZR, [complex(roots[i]) for i in splits[k]])]
+    if len(mine) != 1 or mine[0] not in fine:
+        return None
+    others = [fine[k] if k in fine and fine[k] is not None else float(double[k])
+              for k in range(len(splits)) if k != mine[0]]
+    return {"splits": len(splits), "true": fine[mine[0]], "nearest": min(others, default=float("inf"))}

@@ -20,12 +20,11 @@ Z = c s + β_S + g_S (its polynomial part is c s + β_S because every mass is no
    impedance is O(s²) there, so Z(0) = Z′(0) = 0, which gives c = Σ_S ρ_r / r² and
    β_S = Σ_S ρ_r / r. A grounded side gets c and β_S from the other side (the sums are α
    and β);
-2. from Z = e D′ / (e + D′) (D′ the sub-chain's own impedance), e − Z = e² / (e + D′) has a
-   double zero at s₀ = −k/c: Z(s₀) = 0 and Z′(s₀) = c, i.e. g_S′(s₀) = 0 and
-   g_S(s₀) + c s₀ + β_S = 0. With c and β_S fixed by the split, these are two equations in
-   one unknown s₀: the numerators G = N′F − N F′ of g_S′ and H = N + (c s + β_S) F
-   (g_S = N/F) must have a common root. A split whose G and H share no root on either side
-   is impossible.
+2. from Z = e D′ / (e + D′), e − Z = e² / (e + D′) has a double zero at s₀ = −k/c:
+   Z(s₀) = 0 and Z′(s₀) = c, i.e. h(s₀) = 0 for h = Z = c s + β_S + g_S, and
+   g_S′(s₀) = 0. With c and β_S fixed by the split, these are two equations in one unknown
+   s₀: some root of h must be a critical point of g_S. A split for which no root of h is
+   one, on either side, is impossible.
 
 Both conditions hold on every solution outside a proper subvariety (a zero damper or a
 vanishing cofactor), which the solutions for a generic θ* avoid.
@@ -33,15 +32,20 @@ vanishing cofactor), which the solutions for a generic θ* avoid.
 How it is computed
 ------------------
 The poles and residues are computed from the exact rational D in 40-digit arithmetic
-(``mpmath.polyroots``); every split is then tested in double precision, all splits at
-once (numpy): the relative residual min over the roots s₀ of G of
-|H(s₀)| / (|N(s₀)| + |(c s₀ + β_S) F(s₀)|), the larger of the two sides'. Any split whose
-double residual is below :data:`RECHECK` is recomputed in 40-digit arithmetic, where it
-passes below :data:`PASS` and fails above :data:`FAIL`; in between (or when a damper
-value c of the split is not clearly nonzero, or the poles are not simple) nothing is
-decided. This is a floating-point test with wide margins (on the chains of
-``benchmarks/identifiability_models.py`` the passing split is at 1e-40 and the nearest
-failing one above 1e-5), not an interval proof.
+(numpy's roots refined by Newton's method). For each split and side, the roots of h are
+the eigenvalues of an arrowhead matrix built from the poles and residues (no polynomial
+in the monomial basis is formed, so poles of very different sizes cost no accuracy),
+and the residual is min over them of |Σ ρ_r/(s − r)²| / Σ |ρ_r/(s − r)²| (the relative size
+of g′ there); a split's residual is the larger of its two sides'. All splits are tested
+at once in double precision (numpy); any split whose residual is below :data:`RECHECK`
+(or within 1e4 of the smallest one, which shows the double computation's error on this
+D) is recomputed in 40 digits (the eigenvalues refined by Newton's method on h), where it
+passes below :data:`PASS` and fails above :data:`FAIL`. In between, or when a damper value
+c of the split is not clearly nonzero, a root does not refine, or the poles are not
+simple, nothing is decided. This is a floating-point test with wide margins, not an
+interval proof: on the chains of ``benchmarks/identifiability_models.py`` driven at the
+middle mass (3–8 masses, five random points each; ``benchmarks/pole_split_margins.py``)
+θ*'s split is at 6e-35 or below and every other one at 1.7e-5 or above.
 """
 
 from __future__ import annotations
@@ -52,7 +56,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-__all__ = ["FAIL", "PASS", "RECHECK", "possible_splits"]
+__all__ = ["FAIL", "PASS", "RECHECK", "possible_splits", "split_residuals"]
 
 DPS = 40
 """Decimal digits of the high-precision steps."""
@@ -69,6 +73,45 @@ nonzero: condition 2 needs c ≠ 0, so such a split is not decided."""
 
 def _mpc(x: sp.Rational) -> mpmath.mpf:
     return mpmath.mpf(int(x.p)) / int(x.q)
+
+
+def split_residuals(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Rational, n_right: int,
+                    left_free: bool) -> tuple[list, np.ndarray, np.ndarray, dict] | None:
+    """Every split's residual (module notes): the arguments of :func:`possible_splits`.
+
+    Returns
+    -------
+    (roots, splits, double, fine) or None
+        The poles (40 digits), the splits (rows of pole indices given to Z_R), each
+        split's double-precision residual, and ``{row: 40-digit residual or None}`` for
+        the rows below :data:`RECHECK` (None: a damper value not clearly nonzero, or no
+        root to test). None when the poles are not simple.
+    """
+    if P.degree() < 2 or P.gcd(P.diff()).degree() > 0:
+        return None  # a multiple pole: the partial fractions below do not apply
+    with mpmath.workdps(DPS):
+        coeffs = [_mpc(c) for c in P.all_coeffs()]
+        roots = _roots(coeffs)
+        dP = P.diff()
+        rho = [mpmath.polyval([_mpc(c) for c in rem.all_coeffs()], z)
+               / mpmath.polyval([_mpc(c) for c in dP.all_coeffs()], z) for z in roots]
+        al, be = _mpc(alpha), _mpc(beta)
+        # in units of the poles' geometric mean size (the residuals are invariant under s → s/w: ρ → ρ/w,
+        # α → α w): the coefficients of the polynomials below are then of comparable size
+        w = mpmath.exp(mpmath.fsum(mpmath.log(abs(r)) for r in roots) / len(roots)) if all(roots) else 1
+        z = np.array([complex(r / w) for r in roots])
+        rh = np.array([complex(r / w) for r in rho])
+        splits = np.array(list(combinations(range(len(z)), n_right)), dtype=int)
+        mask = np.ones((len(splits), len(z)), dtype=bool)
+        mask[np.arange(len(splits))[:, None], splits] = False
+        rest = np.nonzero(mask)[1].reshape(len(splits), len(z) - n_right)  # the other poles, in increasing order
+        res = _residual_double(z, rh, splits, rest, complex(al * w), complex(be), left_free)
+        # the smallest double residual (θ*'s split, normally) shows the double computation's error on this D:
+        # anything within 1e4 of it is rechecked, and NaN (a degenerate double computation) too
+        limit = max(RECHECK, 1e4 * float(np.nanmin(res, initial=np.inf)))
+        fine = {int(k): _residual_mp(roots, rho, list(splits[k]), list(rest[k]), al, be, left_free)
+                for k in np.flatnonzero(~(res >= limit))}
+    return roots, splits, res, fine
 
 
 def possible_splits(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Rational, n_right: int,
@@ -95,29 +138,13 @@ def possible_splits(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Ratio
         Python complex); ``roots``: all the poles. None when the poles are not simple or a
         split could not be decided.
     """
-    if P.degree() < 2 or P.gcd(P.diff()).degree() > 0:
-        return None  # a multiple pole: the partial fractions below do not apply
-    with mpmath.workdps(DPS):
-        coeffs = [_mpc(c) for c in P.all_coeffs()]
-        roots = _roots(coeffs)
-        dP = P.diff()
-        rho = [mpmath.polyval([_mpc(c) for c in rem.all_coeffs()], z)
-               / mpmath.polyval([_mpc(c) for c in dP.all_coeffs()], z) for z in roots]
-        al, be = _mpc(alpha), _mpc(beta)
-        z = np.array([complex(r) for r in roots])
-        rh = np.array([complex(r) for r in rho])
-        splits = np.array(list(combinations(range(len(z)), n_right)), dtype=int)
-        mask = np.ones((len(splits), len(z)), dtype=bool)
-        mask[np.arange(len(splits))[:, None], splits] = False
-        rest = np.nonzero(mask)[1].reshape(len(splits), len(z) - n_right)  # the other poles, in increasing order
-        res = _residual_double(z, rh, splits, rest, complex(al), complex(be), left_free)
-        passing = []
-        for k in np.flatnonzero(~(res >= RECHECK)):  # NaN (a degenerate double computation) is rechecked too
-            r = _residual_mp(roots, rho, list(splits[k]), list(rest[k]), al, be, left_free)
-            if r is None or PASS <= r <= FAIL:
-                return None
-            if r < PASS:
-                passing.append(tuple(complex(roots[i]) for i in splits[k]))
+    found = split_residuals(P, rem, alpha, beta, n_right, left_free)
+    if found is None:
+        return None
+    roots, splits, _, fine = found
+    if any(r is None or PASS <= r <= FAIL for r in fine.values()):
+        return None
+    passing = [tuple(complex(roots[i]) for i in splits[k]) for k, r in fine.items() if r < PASS]
     return passing, [complex(r) for r in roots]
 
 
@@ -149,70 +176,34 @@ def _roots(coeffs: list) -> list:
 
 # -- double precision, every split at once ------------------------------------------------------------------------
 
-def _polys(z: np.ndarray, rho: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """F = Π (s − z_i) and N = Σ ρ_i F / (s − z_i) over each row of idx (coefficients, highest first)."""
-    B, k = idx.shape
-    F = np.ones((B, 1), dtype=complex)
-    for t in range(k):
-        zt = z[idx[:, t]][:, None]
-        G = np.zeros((B, F.shape[1] + 1), dtype=complex)
-        G[:, :-1] += F
-        G[:, 1:] -= zt * F
-        F = G
-    N = np.zeros((B, k), dtype=complex)
-    for t in range(k):
-        zt = z[idx[:, t]]
-        q = np.zeros((B, k), dtype=complex)  # F / (s − z_t) by synthetic division
-        acc = np.zeros(B, dtype=complex)
-        for i in range(k):
-            acc = F[:, i] + zt * acc
-            q[:, i] = acc
-        N += rho[idx[:, t]][:, None] * q
-    return F, N
-
-
-def _der(p: np.ndarray) -> np.ndarray:
-    d = p.shape[1] - 1
-    return p[:, :-1] * np.arange(d, 0, -1)
-
-
-def _mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    out = np.zeros((p.shape[0], p.shape[1] + q.shape[1] - 1), dtype=complex)
-    for i in range(p.shape[1]):
-        out[:, i:i + q.shape[1]] += p[:, i:i + 1] * q
-    return out
-
-
-def _horner(p: np.ndarray, x: np.ndarray) -> np.ndarray:
-    out = np.zeros_like(x)
-    for i in range(p.shape[1]):
-        out = out * x + p[:, i:i + 1]
-    return out
-
-
 def _side_double(z, rho, idx, c, beta) -> np.ndarray:
-    F, N = _polys(z, rho, idx)
-    G = _mul(_der(N), F) - _mul(N, _der(F))  # both of degree 2k − 2
-    lead = G[:, 0]
+    """Per row of ``idx``: min over the roots s of h = c s + β + Σ ρ_i/(s − z_i) of the relative size of g′(s).
+
+    The roots of h are the eigenvalues of the arrowhead matrix [[−β/c, uᵀ], [v, diag(z)]]
+    with u_i v_i = −ρ_i / c (its characteristic polynomial is (s + β/c + Σ ρ_i / (c (s − z_i)))
+    Π (s − z_i)); no polynomial in the monomial basis is formed, so poles of very different
+    sizes cost no accuracy.
+    """
+    B, k = idx.shape
     with np.errstate(all="ignore"):
-        comp = np.zeros((len(G), G.shape[1] - 1, G.shape[1] - 1), dtype=complex)
-        comp[:, 0, :] = -G[:, 1:] / lead[:, None]
-        if G.shape[1] > 2:
-            comp[:, np.arange(1, G.shape[1] - 1), np.arange(G.shape[1] - 2)] = 1
-        ok = np.isfinite(comp).all(axis=(1, 2)) & (np.abs(lead) > 1e-10 * np.abs(G).max(axis=1))
-        comp[~ok] = 0
-        s0 = np.linalg.eigvals(comp)
-        Nv, Fv = _horner(N, s0), _horner(F, s0)
-        lin = (c[:, None] * s0 + beta[:, None]) * Fv
-        res = np.abs(Nv + lin) / (np.abs(Nv) + np.abs(lin))
+        A = np.zeros((B, k + 1, k + 1), dtype=complex)
+        A[:, 0, 0] = -beta / c
+        A[:, 0, 1:] = 1.0
+        A[:, 1:, 0] = -rho[idx] / c[:, None]
+        A[:, np.arange(1, k + 1), np.arange(1, k + 1)] = z[idx]
+        ok = np.isfinite(A).all(axis=(1, 2))
+        A[~ok] = 0
+        s0 = np.linalg.eigvals(A)  # (B, k + 1)
+        terms = rho[idx][:, None, :] / (s0[:, :, None] - z[idx][:, None, :]) ** 2
+        res = np.abs(terms.sum(axis=2)) / np.abs(terms).sum(axis=2)
         out = res.min(axis=1)
-    out[~ok] = np.nan  # a degree drop: recomputed in 40 digits
+    out[~ok] = np.nan  # c = 0 or overflow: recomputed in 40 digits
     return out
 
 
 def _residual_double(z, rho, right, left, al, be, left_free) -> np.ndarray:
     """The larger of the two sides' residuals per split (the side with fewer poles first: a split it fails is not
-    tested on the other side, whose polynomials are of higher degree)."""
+    tested on the other side)."""
     cR = (rho[right] / z[right] ** 2).sum(axis=1)
     bR = (rho[right] / z[right]).sum(axis=1)
     if left_free:
@@ -235,45 +226,52 @@ def _residual_double(z, rho, right, left, al, be, left_free) -> np.ndarray:
 
 # -- 40 digits, one split ---------------------------------------------------------------------------------------
 
-def _pmul(p, q):
-    out = [mpmath.mpc(0)] * (len(p) + len(q) - 1)
-    for i, x in enumerate(p):
-        for j, y in enumerate(q):
-            out[i + j] += x * y
-    return out
+def _side_mp(roots, rho, S, c, beta, cscale, free: bool) -> mpmath.mpf | None:
+    """:func:`_side_double` for one split in working precision: the double eigenvalues refined by Newton's method
+    on h (partial fractions); None when c is not clearly nonzero or a root does not refine to a distinct one.
 
-
-def _pder(p):
-    d = len(p) - 1
-    return [p[i] * (d - i) for i in range(d)]
-
-
-def _side_mp(roots, rho, S, c, beta, cscale) -> mpmath.mpf | None:
+    On a free side c and β make h = Z vanish to second order at 0 (condition 1), a double
+    root at which g′(0) = −c ≠ 0: the two eigenvalues nearest 0 are that root and are left out.
+    """
     if abs(c) < _C_MIN * cscale:
         return None
-    F = [mpmath.mpc(1)]
-    for i in S:
-        F = _pmul(F, [1, -roots[i]])
-    N = [mpmath.mpc(0)] * (len(F) - 1)
-    for i in S:
-        q, acc = [], mpmath.mpc(0)
-        for a in F[:-1]:
-            acc = a + roots[i] * acc
-            q.append(acc)
-        N = [x + rho[i] * y for x, y in zip(N, q, strict=True)]
-    A, Bq = _pmul(_pder(N), F), _pmul(N, _pder(F))
-    A = [mpmath.mpc(0)] * (len(Bq) - len(A)) + A
-    G = [x - y for x, y in zip(A, Bq, strict=True)]
-    big = max(abs(x) for x in G)
-    while len(G) > 1 and abs(G[0]) < mpmath.mpf(10) ** (-DPS // 2) * big:
-        G = G[1:]
-    if len(G) < 2:
+    z = [roots[i] for i in S]
+    r = [rho[i] for i in S]
+    k = len(S)
+    A = np.zeros((k + 1, k + 1), dtype=complex)
+    A[0, 0] = complex(-beta / c)
+    A[0, 1:] = 1.0
+    A[1:, 0] = [complex(-x / c) for x in r]
+    A[np.arange(1, k + 1), np.arange(1, k + 1)] = [complex(x) for x in z]
+    if not np.isfinite(A).all():
         return None
+    tol = mpmath.mpf(10) ** (5 - mpmath.mp.dps)
+    found = []
+    eig = sorted(np.linalg.eigvals(A), key=abs)
+    if free:  # the double root splits into two eigenvalues ~ sqrt(u) from 0: they must stand apart from the rest
+        if len(eig) < 3 or abs(eig[1]) > 1e-3 * abs(eig[2]):
+            return None
+        eig = eig[2:]
+    for x0 in eig:
+        x = mpmath.mpc(x0)
+        for _ in range(60):
+            h = c * x + beta + mpmath.fsum(ri / (x - zi) for ri, zi in zip(r, z, strict=True))
+            dh = c - mpmath.fsum(ri / (x - zi) ** 2 for ri, zi in zip(r, z, strict=True))
+            step = h / dh
+            x -= step
+            if abs(step) <= tol * max(abs(x), 1):
+                break
+        else:
+            return None
+        found.append(x)
+    sep = min((abs(p - q) / max(abs(p), abs(q), 1) for i, p in enumerate(found) for q in found[:i]), default=1)
+    if sep < mpmath.mpf(10) ** (-mpmath.mp.dps // 2):
+        return None  # two eigenvalues refined to one root: one may be missed
     best = None
-    for s0 in _roots(G):
-        Nv, lin = mpmath.polyval(N, s0), (c * s0 + beta) * mpmath.polyval(F, s0)
-        r = abs(Nv + lin) / (abs(Nv) + abs(lin))
-        best = r if best is None else min(best, r)
+    for x in found:
+        terms = [ri / (x - zi) ** 2 for ri, zi in zip(r, z, strict=True)]
+        v = abs(mpmath.fsum(terms)) / mpmath.fsum(abs(t) for t in terms)
+        best = v if best is None else min(best, v)
     return best
 
 
@@ -290,7 +288,7 @@ def _residual_mp(roots, rho, right, left, al, be, left_free) -> float | None:
     terms = {i: abs(rho[i] / roots[i] ** 2) for i in range(len(roots))}
     sR = mpmath.fsum(terms[i] for i in right)
     sL = mpmath.fsum(terms[i] for i in left) if left_free else sR + abs(al)
-    sides = [_side_mp(roots, rho, right, cR, bR, sR), _side_mp(roots, rho, left, cL, bL, sL)]
+    sides = [_side_mp(roots, rho, right, cR, bR, sR, True), _side_mp(roots, rho, left, cL, bL, sL, left_free)]
     if any(x is None for x in sides):
         return None
     return float(max(*sides, gap))
