@@ -21,7 +21,8 @@ A second-order model M q'' + V q' + K q = B u, y = C q (or q', q'') with
 - ground elements at node 0 only (the grounded end driven: a chain "11") or at node
   n − 1 only (the free end driven: "nn", a shear building driven at the roof), or none.
 
-Anything else returns None and the usual global step decides.
+Anything else returns None and the usual global step decides (a chain driven and
+measured at an interior mass: :mod:`~symid.structural.ladder_interior`).
 
 The inversion (:func:`invert`)
 ------------------------------
@@ -143,7 +144,8 @@ def ladder_of(model, known: Mapping[str, object] | None = None, *, driven_anywhe
     """The chain structure of ``model`` (see the module notes), or None when it is not one.
 
     ``driven_anywhere=True`` also recognises a chain driven and measured at an interior
-    mass (for :mod:`symid.fit.frf.chain`; the inversion of this module needs an end):
+    mass (for :mod:`symid.fit.frf.chain` and :mod:`symid.structural.ladder_interior`; the
+    inversion of this module needs an end):
     ``order`` then runs from the end that has the ground element (ground elements at one
     end only, never at the driven mass) and ``at`` says where the driven mass is.
 
