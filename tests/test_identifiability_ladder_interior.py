@@ -9,6 +9,8 @@ must claim nothing.
 
 from __future__ import annotations
 
+import math
+
 import pytest
 import sympy as sp
 
@@ -18,6 +20,7 @@ from symid.structural.global_ import generic_global, star_and_summary
 from symid.structural.ladder import Ladder, ladder_of, proves_global
 from symid.structural.ladder_interior import invert_interior
 from symid.structural.msolve import msolve_binary
+from symid.structural.pole_split import MAX_SPLITS, possible_splits
 from symid.structural.summary import model_matrices
 
 MSOLVE = msolve_binary()
@@ -119,3 +122,12 @@ def test_the_report_says_how_it_was_proven(families):
     assert rep.engine == "ladder" and rep.verdict == "global" and rep.n_solutions_complex == 1
     assert set(rep.verdicts.values()) == {"global"}
     assert any("interior mass" in note and "symid.structural.ladder_interior" in note for note in rep.notes)
+
+
+def test_too_many_splits_are_not_tried():
+    """C(18, 8) = 43 758 splits (a 10-mass chain) exceed MAX_SPLITS: nothing decided, at once (the helper's 12-mass
+    chain built all 646 646 splits and their eigenproblems in 3 GB before this cap)."""
+    s = sp.Symbol("s")
+    P = sp.Poly(sp.prod([s + i for i in range(1, 19)]), s, domain="QQ")
+    assert math.comb(18, 8) > MAX_SPLITS >= math.comb(16, 8)  # 9 masses are still tried
+    assert possible_splits(P, sp.Poly(1, s, domain="QQ"), sp.Rational(1), sp.Rational(1), 8, False) is None

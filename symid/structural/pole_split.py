@@ -37,26 +37,28 @@ the eigenvalues of an arrowhead matrix built from the poles and residues (no pol
 in the monomial basis is formed, so poles of very different sizes cost no accuracy),
 and the residual is min over them of |Σ ρ_r/(s − r)²| / Σ |ρ_r/(s − r)²| (the relative size
 of g′ there); a split's residual is the larger of its two sides'. All splits are tested
-at once in double precision (numpy); any split whose residual is below :data:`RECHECK`
+at once in double precision (numpy, in blocks); any split whose residual is below :data:`RECHECK`
 (or within 1e4 of the smallest one, which shows the double computation's error on this
 D) is recomputed in 40 digits (the eigenvalues refined by Newton's method on h), where it
-passes below :data:`PASS` and fails above :data:`FAIL`. In between, or when a damper value
-c of the split is not clearly nonzero, a root does not refine, or the poles are not
-simple, nothing is decided. This is a floating-point test with wide margins, not an
-interval proof: on the chains of ``benchmarks/identifiability_models.py`` driven at the
-middle mass (3–8 masses, five random points each; ``benchmarks/pole_split_margins.py``)
-θ*'s split is at 6e-35 or below and every other one at 1.7e-5 or above.
+passes below :data:`PASS` and fails above :data:`FAIL`. In between, or when a damper
+value c of the split is not clearly nonzero, a root does not refine, the poles are not
+simple or there are more than :data:`MAX_SPLITS` splits (10 masses and more), nothing is
+decided. This is a floating-point test with wide margins, not an interval proof: on the
+chains of ``benchmarks/identifiability_models.py`` driven at the middle mass (3–8
+masses, five random points each; ``benchmarks/pole_split_margins.py``) θ*'s split is at
+6e-35 or below and every other one at 1.7e-5 or above.
 """
 
 from __future__ import annotations
 
+import math
 from itertools import combinations
 
 import mpmath
 import numpy as np
 import sympy as sp
 
-__all__ = ["FAIL", "PASS", "RECHECK", "possible_splits", "split_residuals"]
+__all__ = ["FAIL", "MAX_SPLITS", "PASS", "RECHECK", "possible_splits", "split_residuals"]
 
 DPS = 40
 """Decimal digits of the high-precision steps."""
@@ -66,6 +68,10 @@ PASS = 1e-25
 """40-digit residual below which a split passes (a solution could have it)."""
 FAIL = 1e-12
 """40-digit residual above which a split fails."""
+MAX_SPLITS = 20_000
+"""More splits than this (10 masses and more; 3003 at 8 masses, 12 870 at 9) are not tried: nothing is decided."""
+_CHUNK = 2048
+"""Splits tested at once in double precision (bounds the memory: ~40 MB at 9 masses)."""
 _C_MIN = 1e-8
 """A damper value c of a split smaller than this (relative to the sum of the magnitudes of its terms) is not clearly
 nonzero: condition 2 needs c ≠ 0, so such a split is not decided."""
@@ -85,10 +91,13 @@ def split_residuals(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Ratio
         The poles (40 digits), the splits (rows of pole indices given to Z_R), each
         split's double-precision residual, and ``{row: 40-digit residual or None}`` for
         the rows below :data:`RECHECK` (None: a damper value not clearly nonzero, or no
-        root to test). None when the poles are not simple.
+        root to test). None when the poles are not simple or there are more than
+        :data:`MAX_SPLITS` splits.
     """
     if P.degree() < 2 or P.gcd(P.diff()).degree() > 0:
         return None  # a multiple pole: the partial fractions below do not apply
+    if math.comb(P.degree(), n_right) > MAX_SPLITS:
+        return None
     with mpmath.workdps(DPS):
         coeffs = [_mpc(c) for c in P.all_coeffs()]
         roots = _roots(coeffs)
@@ -105,7 +114,8 @@ def split_residuals(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Ratio
         mask = np.ones((len(splits), len(z)), dtype=bool)
         mask[np.arange(len(splits))[:, None], splits] = False
         rest = np.nonzero(mask)[1].reshape(len(splits), len(z) - n_right)  # the other poles, in increasing order
-        res = _residual_double(z, rh, splits, rest, complex(al * w), complex(be), left_free)
+        res = np.concatenate([_residual_double(z, rh, splits[i:i + _CHUNK], rest[i:i + _CHUNK], complex(al * w),
+                                               complex(be), left_free) for i in range(0, len(splits), _CHUNK)])
         # the smallest double residual (θ*'s split, normally) shows the double computation's error on this D:
         # anything within 1e4 of it is rechecked, and NaN (a degenerate double computation) too
         limit = max(RECHECK, 1e4 * float(np.nanmin(res, initial=np.inf)))
