@@ -29,8 +29,9 @@ claim is confirmed at a second random point θ** (:func:`~symid.structural.globa
 
 Structure recognised: :func:`~symid.structural.ladder.ladder_of` with
 ``driven_anywhere=True`` and the driven mass interior (ground elements at most at one end,
-never at the driven mass), both elements at the driven mass with a damper and a spring.
-Anything else returns False and the usual global step decides.
+never at the driven mass), both elements at the driven mass with a damper and a spring,
+at most :data:`~symid.structural.pole_split.MAX_SPLITS` splits (up to 9 masses). Anything
+else returns False and the usual global step decides.
 """
 
 from __future__ import annotations
