@@ -131,3 +131,30 @@ def test_too_many_splits_are_not_tried():
     P = sp.Poly(sp.prod([s + i for i in range(1, 19)]), s, domain="QQ")
     assert math.comb(18, 8) > MAX_SPLITS >= math.comb(16, 8)  # 9 masses are still tried
     assert possible_splits(P, sp.Poly(1, s, domain="QQ"), sp.Rational(1), sp.Rational(1), 8, False) is None
+
+
+def _with_known(model, values: dict):
+    mats = model_matrices(model, None)
+    subs = {p: v for p in model.parameters for n, v in values.items() if p.name == n}
+    return si.SecondOrderModel(**{k: X.subs(subs) for k, X in mats.items()})
+
+
+@pytest.mark.parametrize(("known", "count"), [({"m1": 2}, 1), ({"k1": 5}, 1), ({"m1": 1, "m3": 1}, 2)])
+def test_the_swapped_sides_of_a_free_chain_are_excluded_by_a_known_value(known, count, monkeypatch):
+    """Free at both ends, one mass either side: the swapped split passes the split test, and is a solution iff the
+    known values allow the mirror image (m1 = 2 known: no, Gröbner 1; m1 = m3 = 1 known: yes, Gröbner 2). Found by a
+    new user: such 5-mass chains timed out in the Gröbner step."""
+    model = _with_known(_free_chain(3, 1), known)
+    star = star_and_summary(model)[1]
+    assert _gröbner(model, monkeypatch).n_complex == count
+    assert proves_global(model, None, star) == ("interior" if count == 1 else "")
+
+
+def test_a_free_five_mass_chain_with_a_known_mass_is_proven():
+    model = _with_known(_free_chain(5, 2), {"m1": 2})
+    lad = ladder_of(model, driven_anywhere=True)
+    assert lad is not None and lad.at == 2
+    for draw in (0, 500):
+        assert invert_interior(lad, model, None, star_and_summary(model, seed=3, draw=draw)[1])
+    assert not invert_interior(ladder_of(_free_chain(5, 2), driven_anywhere=True), _free_chain(5, 2), None,
+                               star_and_summary(_free_chain(5, 2))[1])  # the mirror image is a second solution

@@ -14,7 +14,9 @@ side: a solution of D(θ) = D(θ*) could split them differently. The inversion i
    side; C(2n − 2, 2b) of them, 3003 for 8 masses) is tested against two necessary
    conditions (:mod:`~symid.structural.pole_split`): a free side's impedance vanishes to
    second order at s = 0, and e − Z has a double zero at −k/c. Exactly one split must pass,
-   and it must be θ*'s: the poles of Z_R(θ*);
+   and it must be θ*'s: the poles of Z_R(θ*). One exception: with both sides free and of
+   the same length the sides swapped pass too, and their solution is θ*'s mirror image,
+   ruled out when a known value does not fit it (:func:`_mirror_excluded`);
 2. on it, in exact rational arithmetic: Z_R and Z_L (the split's partial fractions with
    c s + β fixed by condition 1) are θ*'s; the numerators G = N′F − N F′ and
    H = N + (c s + β) F of each side have a greatest common divisor of degree 1, whose root
@@ -121,8 +123,12 @@ def invert_interior(ladder: Ladder, model, known: Mapping[str, object] | None, s
     if setup is None:
         return False
     found = possible_splits(*setup.split_args)
-    if found is None or len(found[0]) != 1 or not _poles_of(setup.ZR, found[0][0]):
-        return False  # undecided, several splits, or the one passing split is not θ*'s (the poles of Z_R)
+    if found is None:
+        return False
+    mine = [p for p in found[0] if _poles_of(setup.ZR, p)]
+    others = [p for p in found[0] if not _poles_of(setup.ZR, p)]
+    if len(mine) != 1 or (others and not (len(others) == 1 and _mirror_excluded(ladder, setup, others[0]))):
+        return False  # undecided, θ*'s split not passing, or another split some solution could have
     ZL, ZR, e, at, subs = setup.ZL, setup.ZR, setup.e, ladder.at, setup.subs
     left, right = setup.left, setup.right
     left_free = setup.split_args[-1]
@@ -133,6 +139,34 @@ def invert_interior(ladder: Ladder, model, known: Mapping[str, object] | None, s
         if not peel(own, side, *vals, subs):
             return False
     return True
+
+
+def _mirror_excluded(ladder: Ladder, setup: _Setup, other) -> bool:
+    """Whether the other passing split is the two sides swapped and no solution can have it.
+
+    Both sides free and of the same length: the split that gives Z_R the poles of Z_L(θ*)
+    passes both conditions (each side's c and β come from its own poles), and on it the
+    continued fraction recovers θ*'s left values in the right side's slots and vice versa
+    (each step is unique). That is a solution iff every slot can take the other side's
+    value: a free parameter can; a known number (or an absent element, 0) only if equal.
+    Declared excluded only when both sides have elements in the same places and some known
+    number differs (a missing element on one side only is not argued here: False).
+    """
+    at = ladder.at
+    if not setup.split_args[-1] or len(setup.left[1]) != len(setup.right[1]) or not _poles_of(setup.ZL, other):
+        return False
+
+    def slots(side: tuple, join: tuple, join_value: tuple) -> tuple[list, list]:
+        lad, m, e, g = side  # mirrored order: masses outwards, the joining element, edges outwards, grounds
+        return ([*lad.masses, *join, *(x for p in lad.edges for x in p), *(x for p in lad.grounds for x in p)],
+                [*m, *join_value, *(x for p in e for x in p), *(x for p in g for x in p)])
+
+    sl, vl = slots(setup.left, ladder.edges[at - 1], setup.e[at - 1])
+    sr, vr = slots(setup.right, ladder.edges[at], setup.e[at])
+    if any((a == 0) != (b == 0) for a, b in zip(sl, sr, strict=True)):
+        return False  # elements in different places: not argued here
+    free = set(setup.subs)
+    return any((a not in free or b not in free) and va != vb for a, va, b, vb in zip(sl, vl, sr, vr, strict=True))
 
 
 @dataclass(frozen=True)
