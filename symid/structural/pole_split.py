@@ -106,7 +106,7 @@ def split_residuals(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Ratio
                / mpmath.polyval([_mpc(c) for c in dP.all_coeffs()], z) for z in roots]
         al, be = _mpc(alpha), _mpc(beta)
         # in units of the poles' geometric mean size (the residuals are invariant under s → s/w: ρ → ρ/w,
-        # α → α w): the coefficients of the polynomials below are then of comparable size
+        # α → α w), so that the double computation works on numbers near 1
         w = mpmath.exp(mpmath.fsum(mpmath.log(abs(r)) for r in roots) / len(roots)) if all(roots) else 1
         z = np.array([complex(r / w) for r in roots])
         rh = np.array([complex(r / w) for r in rho])
