@@ -16,6 +16,7 @@ import sympy as sp
 
 import symid as si
 import symid.structural.global_ as gg
+from symid.structural import pole_split
 from symid.structural.global_ import generic_global, star_and_summary
 from symid.structural.ladder import Ladder, ladder_of, proves_global
 from symid.structural.ladder_interior import invert_interior
@@ -130,7 +131,16 @@ def test_too_many_splits_are_not_tried():
     s = sp.Symbol("s")
     P = sp.Poly(sp.prod([s + i for i in range(1, 19)]), s, domain="QQ")
     assert math.comb(18, 8) > MAX_SPLITS >= math.comb(16, 8)  # 9 masses are still tried
-    assert possible_splits(P, sp.Poly(1, s, domain="QQ"), sp.Rational(1), sp.Rational(1), 8, False) is None
+
+    def enumerate_none(*args):
+        raise AssertionError("the splits were enumerated")
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(pole_split, "combinations", enumerate_none)
+        assert possible_splits(P, sp.Poly(1, s, domain="QQ"), sp.Rational(1), sp.Rational(1), 8, False) is None
+        with pytest.raises(AssertionError, match="enumerated"):  # below the cap they are
+            possible_splits(sp.Poly(sp.prod([s + i for i in range(1, 17)]), s, domain="QQ"),
+                            sp.Poly(1, s, domain="QQ"), sp.Rational(1), sp.Rational(1), 8, False)
 
 
 def _with_known(model, values: dict):

@@ -85,7 +85,7 @@ import sympy as sp
 from symid.errors import ModelError, OptionError
 from symid.structural.summary import free_parameters, model_kind, model_matrices
 
-__all__ = ["Ladder", "invert", "ladder_of", "peel", "proves_global"]
+__all__ = ["Ladder", "impedance", "invert", "ladder_of", "peel", "proves_global", "series"]
 
 _S = sp.Symbol("s")
 _SHIFT = {"position": 0, "velocity": 1, "acceleration": 2}
@@ -324,7 +324,6 @@ def invert(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequ
     if len(star) != len(params):
         raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
     subs = {p: sp.Rational(v) for p, v in zip(params, star, strict=True)}
-    n = len(ladder.masses)
     m = [_value(v, subs) for v in ladder.masses]
     e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
     g = [tuple(_value(v, subs) for v in pair) for pair in ladder.grounds]
@@ -334,16 +333,26 @@ def invert(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequ
     if any(x == 0 and p != 0 for x, p in zip(slots, present, strict=True)):
         return False  # an element of the structure is 0 at θ*: not a generic point
     # D_0 at θ* by the recursion, checked against the model's own transfer function
-    D = _RF.poly(sp.Poly(m[-1] * _S**2, _S, domain="QQ") + _lin(*g[-1]))
-    for j in range(n - 2, -1, -1):
-        ej = _RF.poly(_lin(*e[j]))
-        if ej.num.is_zero:
-            return False
-        series = (ej.inv() + D.inv()).inv()
-        D = _RF.poly(sp.Poly(m[j] * _S**2, _S, domain="QQ") + _lin(*g[j])) + series
+    if any(c == 0 and k == 0 for c, k in e):
+        return False
+    D = impedance(m, e, g)
     if not _matches_model(D, ladder, model, known, subs):
         return False
     return peel(D, ladder, m, e, g, subs)
+
+
+def impedance(m: list, e: list, g: list) -> _RF:
+    """D_0 of an end-driven chain at θ*, exactly: node values ``m`` and ``g`` (damper, spring to the ground) and
+    edges ``e`` (damper, spring; none both zero), from node 0 (module notes)."""
+    D = _RF.poly(sp.Poly(m[-1] * _S**2, _S, domain="QQ") + _lin(*g[-1]))
+    for j in range(len(m) - 2, -1, -1):
+        D = _RF.poly(sp.Poly(m[j] * _S**2, _S, domain="QQ") + _lin(*g[j])) + series(e[j], D)
+    return D
+
+
+def series(edge: tuple, D: _RF) -> _RF:
+    """The impedance D seen through the element ``edge`` = (damper, spring): e D / (e + D)."""
+    return (_RF.poly(_lin(*edge)).inv() + D.inv()).inv()
 
 
 def peel(D: _RF, ladder: Ladder, m: list, e: list, g: list, subs: Mapping) -> bool:

@@ -45,7 +45,7 @@ import mpmath
 import sympy as sp
 
 from symid.errors import OptionError
-from symid.structural.ladder import _RF, _S, Ladder, _lin, _matches_model, _value, peel
+from symid.structural.ladder import _RF, _S, Ladder, _lin, _matches_model, _value, impedance, peel, series
 from symid.structural.pole_split import DPS, possible_splits, split_residuals
 from symid.structural.summary import free_parameters
 
@@ -62,19 +62,6 @@ def _side(ladder: Ladder, nodes: list[int], m: list, e: list, g: list) -> tuple[
                   tuple(ladder.edges[i] for i in idx), tuple(ladder.grounds[p] for p in nodes), ladder.shift,
                   ladder.gain)
     return side, [m[p] for p in nodes], [e[i] for i in idx], [g[p] for p in nodes]
-
-
-def _impedance(m: list, e: list, g: list) -> _RF:
-    """D_0 of an end-driven chain with node values m, g and edges e (exact)."""
-    D = _RF.poly(sp.Poly(m[-1] * _S**2, _S, domain="QQ") + _lin(*g[-1]))
-    for j in range(len(m) - 2, -1, -1):
-        D = _RF.poly(sp.Poly(m[j] * _S**2, _S, domain="QQ") + _lin(*g[j])) + _series(e[j], D)
-    return D
-
-
-def _series(edge: tuple, D: _RF) -> _RF:
-    """The impedance of D seen through the element ``edge`` = (c, k): e D / (e + D)."""
-    return (_RF.poly(_lin(*edge)).inv() + D.inv()).inv()
 
 
 def _side_unique(Z: _RF, edge: tuple, free: bool) -> bool:
@@ -125,8 +112,9 @@ def invert_interior(ladder: Ladder, model, known: Mapping[str, object] | None, s
     found = possible_splits(*setup.split_args)
     if found is None:
         return False
-    mine = [p for p in found[0] if _poles_of(setup.ZR, p)]
-    others = [p for p in found[0] if not _poles_of(setup.ZR, p)]
+    theirs = [_poles_of(setup.ZR, p) for p in found[0]]
+    mine = [p for p, t in zip(found[0], theirs, strict=True) if t]
+    others = [p for p, t in zip(found[0], theirs, strict=True) if not t]
     if len(mine) != 1 or (others and not (len(others) == 1 and _mirror_excluded(ladder, setup, others[0]))):
         return False  # undecided, θ*'s split not passing, or another split some solution could have
     ZL, ZR, e, at, subs = setup.ZL, setup.ZR, setup.e, ladder.at, setup.subs
@@ -202,7 +190,7 @@ def _setup(ladder: Ladder, model, known, star) -> _Setup | None:
         return None  # an element of the structure is 0 at θ*: not a generic point
     left = _side(ladder, list(range(at - 1, -1, -1)), m, e, g)
     right = _side(ladder, list(range(at + 1, n)), m, e, g)
-    ZL, ZR = _series(e[at - 1], _impedance(*left[1:])), _series(e[at], _impedance(*right[1:]))
+    ZL, ZR = series(e[at - 1], impedance(*left[1:])), series(e[at], impedance(*right[1:]))
     D = _RF.poly(sp.Poly(m[at] * _S**2, _S, domain="QQ")) + ZL + ZR
     if not _matches_model(D, ladder, model, known, subs):
         return None
