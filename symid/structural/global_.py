@@ -264,13 +264,20 @@ def draw_point(rng: random.Random, n: int, *, negative: Sequence[bool] | None = 
     return out
 
 
+_NON_MINIMAL_DRAWS = 3
+"""Points with the generic rank but a non-minimal realisation tried before settling for the first of them."""
+
+
 def _pick_theta_star(model, mats, kind, output, params, rng: random.Random, *, known=None, rank: int | None = None):
     """A random θ* where M(θ*) is invertible and, when ``rank`` is given, the Jacobian has that (generic) rank.
 
     A realisation minimal at θ* is preferred (the transfer-function summary is then
-    exhaustive); ``(point, minimal)``.
+    exhaustive); after three points with the rank where it is not, the first of them is
+    taken (a realisation not minimal anywhere: the summary then checks whether the
+    transfer function, reduced by a common power of s, is in lowest terms there, else
+    uses Markov parameters). Returns ``(point, minimal)``.
     """
-    fallback, singular = None, 0
+    fallback, singular, non_minimal = None, 0, 0
     for _ in range(50):
         pt = draw_point(rng, len(params))
         if kind == "second-order":
@@ -284,6 +291,9 @@ def _pick_theta_star(model, mats, kind, output, params, rng: random.Random, *, k
             return pt, True
         if fallback is None:
             fallback = pt
+        non_minimal += 1
+        if non_minimal >= _NON_MINIMAL_DRAWS:  # not minimal anywhere, most likely: structural (the summary is
+            break  # checked at the point returned in any case)
     if singular == 50:
         raise ModelError("det M(θ) is identically zero (singular at 50 random points); the second-order model is "
                          "degenerate")
@@ -325,7 +335,7 @@ def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: 
     params = free_parameters(model, known)
     rng = random.Random(10_007 + 1000 * seed + draw)
     star, minimal = _pick_theta_star(model, mats, kind, output, params, rng, known=known, rank=rank)
-    if summary is not None and minimal and summary.kind == KIND_TF:
+    if summary is not None and summary.kind == KIND_TF and (minimal or summary.exhaustive_at(star)):
         return params, star, minimal, summary, rng
     summ = exhaustive_summary(model, known, check_point=star)
     return params, star, minimal, summ, rng
@@ -730,7 +740,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     t0 = time.perf_counter()
     if prepared is None:
         prepared = star_and_summary(model, known, seed=seed)
-    params, star, minimal, summ, shared_rng = prepared
+    params, star, _minimal, summ, shared_rng = prepared
     rng = random.Random()
     rng.setstate(shared_rng.getstate())  # a re-run makes the same random choices
     names = [p.name for p in params]
@@ -738,10 +748,12 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     theta_star = dict(zip(names, star, strict=True))
     times["summary"] = time.perf_counter() - t0
     notes = []
-    if not minimal:
+    if summ.kind != KIND_TF:
         notes.append("the realisation is not minimal at random points; Markov parameters used as the summary")
-    elif summ.kind != KIND_TF:  # pragma: no cover - consistent by construction
-        notes.append("Markov parameters used as the summary")
+    elif summ.shift:
+        notes.append(f"the transfer function's numerator and denominator share the factor s^{summ.shift} for "
+                     "every θ (a mode the output does not see); divided out, the rest is in lowest terms at θ*, "
+                     "so its coefficients are the summary")
     if not params:
         return GlobalResult(summ.kind, summ.labels, tuple(summ.expressions()), {}, True, 1, 1, 1, ({},), ({},),
                             {}, {}, {}, (), (), 0, times, tuple(notes))
