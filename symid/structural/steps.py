@@ -50,7 +50,7 @@ HEAD_START = 0.05
 models' bases take less than this)."""
 
 _MODEL_ERRORS = ("ModelError", "NonAffineError", "PoleError", "DataError")
-_LIMITS = ("ExactStepLimit", "MemoryError")
+_LIMITS = ("ExactStepLimit", "SummaryTooLarge", "MemoryError")
 
 
 def _global_step(model, known, positive, seed, extra_candidates, expressions, rank, msolve=None, fix=(),
