@@ -16,7 +16,8 @@ side: a solution of D(θ) = D(θ*) could split them differently. The inversion i
    second order at s = 0, and e − Z has a double zero at −k/c. Exactly one split must pass,
    and it must be θ*'s: the poles of Z_R(θ*). One exception: with both sides free and of
    the same length the sides swapped pass too, and their solution is θ*'s mirror image,
-   ruled out when a known value does not fit it (:func:`_mirror_excluded`);
+   ruled out when a known value, or an element present on one side only, does not fit it
+   (:func:`_mirror_excluded`);
 2. on it, in exact rational arithmetic: Z_R and Z_L (the split's partial fractions with
    c s + β fixed by condition 1) are θ*'s; the numerators G = N′F − N F′ and
    H = N + (c s + β) F of each side have a greatest common divisor of degree 1, whose root
@@ -137,8 +138,9 @@ def _mirror_excluded(ladder: Ladder, setup: _Setup, other) -> bool:
     continued fraction recovers θ*'s left values in the right side's slots and vice versa
     (each step is unique). That is a solution iff every slot can take the other side's
     value: a free parameter can; a known number (or an absent element, 0) only if equal.
-    Declared excluded only when both sides have elements in the same places and some known
-    number differs (a missing element on one side only is not argued here: False).
+    Declared excluded when some known number differs, or when an element is present on one
+    side and absent in the mirrored place of the other: the absent place would have to take
+    the present element's value at θ*, which is not 0 (a known 0 reads as absent).
     """
     at = ladder.at
     if not setup.split_args[-1] or len(setup.left[1]) != len(setup.right[1]) or not _poles_of(setup.ZL, other):
@@ -152,7 +154,7 @@ def _mirror_excluded(ladder: Ladder, setup: _Setup, other) -> bool:
     sl, vl = slots(setup.left, ladder.edges[at - 1], setup.e[at - 1])
     sr, vr = slots(setup.right, ladder.edges[at], setup.e[at])
     if any((a == 0) != (b == 0) for a, b in zip(sl, sr, strict=True)):
-        return False  # elements in different places: not argued here
+        return True  # an element present on one side only: its value at θ* cannot go where the other has none
     free = set(setup.subs)
     return any((a not in free or b not in free) and va != vb for a, va, b, vb in zip(sl, vl, sr, vr, strict=True))
 
