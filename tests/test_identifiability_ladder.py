@@ -125,3 +125,29 @@ def test_a_middle_mass_driven_chain_is_the_interior_inversion(families):
     model = families.build("chain_mid-3-mm")
     assert ladder_of(model) is None
     assert proves_global(model, None, star_and_summary(model)[1]) == "interior"
+
+
+@pytest.mark.parametrize("springless", [0, 1])
+def test_an_element_without_spring_before_a_free_sub_chain(springless, monkeypatch):
+    """A 3-mass chain free at both ends, driven and measured at mass 1, whose element ``springless`` (joining masses
+    ``springless`` and ``springless`` + 1, from 0) is a damper alone: e D′/(e + D′) loses a factor s for every θ
+    (D′ of the free sub-chain beyond is O(s²)), so D_0's degrees are one lower than 2n, 2n − 2. The inversion reads
+    that from the structure (before: it declined and the Gröbner step decided); same count as the Gröbner step."""
+    m = si.parameters("m1 m2 m3", positive=True)
+    c = si.parameters("c1 c2", positive=True)
+    k = list(si.parameters("k1 k2", positive=True))
+    k[springless] = 0
+    V, K = sp.zeros(3, 3), sp.zeros(3, 3)
+    for X, v in ((V, c), (K, k)):
+        for i, x in enumerate(v):
+            X[i, i] += x
+            X[i + 1, i + 1] += x
+            X[i, i + 1] -= x
+            X[i + 1, i] -= x
+    model = si.SecondOrderModel(M=sp.diag(*m), V=V, K=K, B=[[1], [0], [0]], C=[[1, 0, 0]])
+    assert ladder_of(model) is not None
+    fast = generic_global(model, rank=len(model.parameters), msolve=MSOLVE)
+    ref = _gröbner(model, monkeypatch)
+    assert fast.engine == "ladder" and ref.engine in ("msolve", "sympy")
+    assert (fast.n_complex, ref.n_complex) == (1, 1)
+    assert fast.global_complex == ref.global_complex

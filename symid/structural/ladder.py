@@ -59,10 +59,13 @@ allows has them generically, so no factor cancels and no pole of 1/e_j is a pole
 1/D_{j+1}; the gcd of step 3 has degree at most its degree at θ* once the leading
 coefficients do not vanish there):
 
-- every D_j at θ* has numerator degree 2(n − j) and denominator degree 2(n − j − 1)
-  in lowest terms;
-- at a node with both c_j and k_j, R has numerator degree 2(n − j) − 1 in lowest terms,
-  and the gcd of step 3 has degree 1;
+- every D_j at θ* has numerator degree 2(n − j) − d_j and denominator degree
+  2(n − j − 1) − d_j in lowest terms, d_j the number of elements from node j on that have
+  no spring and join a free sub-chain: each cancels a factor s for every θ (e = c s and
+  D′ = O(s²) at s = 0 in e D′ / (e + D′)), the largest degrees the structure allows
+  (:func:`_degree_drops`);
+- at a node with both c_j and k_j, R has numerator degree 2(n − j) − 1 − d_j in lowest
+  terms, and the gcd of step 3 has degree 1;
 - at a grounded node 0, det(K_sub + k₀ E₁₁) ≠ 0 at θ*.
 
 Each recovered value is compared with θ*'s, and γ / D_0 from the recursion with the
@@ -359,9 +362,10 @@ def peel(D: _RF, ladder: Ladder, m: list, e: list, g: list, subs: Mapping) -> bo
     """Steps 1–4 of the module notes from node 0 of ``ladder``, D = D_0 exact: whether each recovered value is
     θ*'s (``m``, ``e``, ``g``: the masses, edges and grounds at θ*) and every step's uniqueness condition holds."""
     n = len(ladder.masses)
+    drops = _degree_drops(ladder)
     for j in range(n):
         L = n - j
-        if D.num.degree() != 2 * L or D.den.degree() != 2 * L - 2:
+        if D.num.degree() != 2 * L - drops[j] or D.den.degree() != 2 * L - 2 - drops[j]:
             return False
         mj = D.num.LC() / D.den.LC()
         if mj != m[j]:
@@ -391,7 +395,7 @@ def peel(D: _RF, ladder: Ladder, m: list, e: list, g: list, subs: Mapping) -> bo
             c_hat = Q.LC() / P.LC()
             k_hat = sp.Rational(0)
             if ladder.edges[j][1] != 0:
-                if Q.degree() != 2 * L - 1:
+                if Q.degree() != 2 * L - 1 - drops[j]:
                     return False
                 G = Q.gcd(P.mul_ground(c_hat) - Q.diff(_S))
                 if G.degree() != 1:
@@ -408,6 +412,20 @@ def peel(D: _RF, ladder: Ladder, m: list, e: list, g: list, subs: Mapping) -> bo
             return False
         D = rest.inv()
     return False  # pragma: no cover - the loop returns at the last node
+
+
+def _degree_drops(ladder: Ladder) -> list[int]:
+    """Per node j: how far below 2L and 2L − 2 (L masses from j on) the degrees of D_j's numerator and
+    denominator lie for every θ. An element without a spring (e = c s) joining a free sub-chain (no ground
+    element beyond it: its D′ vanishes like M s² at s = 0) cancels a factor s from e D′ / (e + D′), one
+    degree less for it and every node before it; any other element keeps the degrees."""
+    n = len(ladder.masses)
+    drops = [0] * (n + 1)
+    for j in range(n - 2, -1, -1):
+        free_beyond = all(g == (0, 0) for g in ladder.grounds[j + 1:])
+        damper_only = ladder.edges[j][0] != 0 and ladder.edges[j][1] == 0
+        drops[j] = drops[j + 1] + int(damper_only and free_beyond)
+    return drops[:n]
 
 
 def _series_regular(ladder: Ladder, subs: Mapping) -> bool:

@@ -197,14 +197,17 @@ def _setup(ladder: Ladder, model, known, star) -> _Setup | None:
     if not _matches_model(D, ladder, model, known, subs):
         return None
     P = D.den
-    if D.num.degree() != 2 * n or P.degree() != 2 * n - 2 or D.num.LC() / P.LC() != m[at]:
+    # each side's poles: twice its masses, fewer by the factors s an element without a spring cancels
+    # (ladder._degree_drops); a solution's sides cannot have more (θ* is generic), so they have as many
+    n_left, n_right = ZL.den.degree(), ZR.den.degree()
+    if P.degree() != n_left + n_right or D.num.degree() != P.degree() + 2 or D.num.LC() / P.LC() != m[at]:
         return None
     q, rem = (D - _RF.poly(sp.Poly(m[at] * _S**2, _S, domain="QQ"))).num.div(P)
     if q.degree() > 1:
         return None
     left_free = all(x == (0, 0) for x in left[3])
     return _Setup(subs, e, left, right, ZL, ZR,
-                  (P, rem, q.coeff_monomial(_S), q.coeff_monomial(1), 2 * len(right[1]), left_free))
+                  (P, rem, q.coeff_monomial(_S), q.coeff_monomial(1), n_right, left_free))
 
 
 def _poles_of(Z: _RF, poles) -> bool:
