@@ -740,7 +740,7 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     t0 = time.perf_counter()
     if prepared is None:
         prepared = star_and_summary(model, known, seed=seed)
-    params, star, _minimal, summ, shared_rng = prepared
+    params, star, minimal, summ, shared_rng = prepared
     rng = random.Random()
     rng.setstate(shared_rng.getstate())  # a re-run makes the same random choices
     names = [p.name for p in params]
@@ -750,10 +750,12 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     notes = []
     if summ.kind != KIND_TF:
         notes.append("the realisation is not minimal at random points; Markov parameters used as the summary")
-    elif summ.shift:
-        notes.append(f"the transfer function's numerator and denominator share the factor s^{summ.shift} for "
-                     "every θ (a mode the output does not see); divided out, the rest is in lowest terms at θ*, "
-                     "so its coefficients are the summary")
+    elif not minimal:
+        shared = (f"; its numerator and denominator share the factor s^{summ.shift} for every θ (poles at s = 0 "
+                  "that zeros at s = 0 cancel: a rigid-body mode, an integrator, a derivative sensor), divided out"
+                  if summ.shift else "")
+        notes.append(f"the realisation is not minimal at θ*, but the transfer function is in lowest terms there"
+                     f"{shared}; so its coefficients are an exhaustive summary")
     if not params:
         return GlobalResult(summ.kind, summ.labels, tuple(summ.expressions()), {}, True, 1, 1, 1, ({},), ({},),
                             {}, {}, {}, (), (), 0, times, tuple(notes))

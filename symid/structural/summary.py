@@ -16,8 +16,9 @@ Two summaries are used:
   summary when the realisation is minimal at the point where identifiability is
   examined, which is checked exactly (controllability and observability ranks).
   A power sᵏ that divides ``d`` and every numerator for every θ is divided out first
-  (a mode the output never sees: a chain free at both ends, whose ``d`` has the factor
-  s², measured in velocity or acceleration). The coefficients are also exhaustive when
+  (poles at s = 0 that zeros at s = 0 cancel: a chain free at both ends, whose ``d`` has
+  the factor s², measured in velocity or acceleration; an integrator the output does not
+  see). The coefficients are also exhaustive when
   the realisation is not minimal but, after that division, ``d`` and the numerators
   have no common factor at the point (exact gcd over ℚ): ``d`` is then the least
   common denominator of the entries there, of full degree, so any θ with the same
@@ -623,14 +624,14 @@ def _tf_summary(mats, mkind, output, params):
                 num = _bilinear_adjugate(P, [Cl[i][c] for c in range(n)], [Bl[r][j] for r in range(n)], detP)
                 nums[i, j] = _coeffs_in_s(num * sv**shift, si, 2 * n + shift)
         degree = 2 * n
-    # a power of s that divides the denominator and every numerator for every θ (a rigid-body mode the output
-    # does not see: a chain free at both ends measured in velocity or acceleration) is divided out
-    shift = 0
-    while shift < degree and dcoef[shift] == Rs.zero and all(c[shift] == Rs.zero for c in nums.values()):
-        shift += 1
-    dcoef = dcoef[shift:]
-    nums = {ij: c[shift:] for ij, c in nums.items()}
-    degree -= shift
+    # a power of s that divides the denominator and every numerator for every θ (poles at 0 that zeros at 0 cancel:
+    # a chain free at both ends measured in velocity or acceleration) is divided out
+    common = 0
+    while common < degree and dcoef[common] == Rs.zero and all(c[common] == Rs.zero for c in nums.values()):
+        common += 1
+    dcoef = dcoef[common:]
+    nums = {ij: c[common:] for ij, c in nums.items()}
+    degree -= common
     for k in range(degree):
         entries_n.append(dcoef[k])
         entries_d.append(lead)
@@ -642,7 +643,7 @@ def _tf_summary(mats, mkind, output, params):
             entries_n.append(c)
             entries_d.append(lead)
             labels.append(f"N[{i},{j}] s^{k}")
-    return entries_n, entries_d, labels, shift, (dcoef, tuple(nums.values()))
+    return entries_n, entries_d, labels, common, (dcoef, tuple(nums.values()))
 
 
 def _markov_summary(mats, mkind, output, params):
