@@ -158,7 +158,8 @@ class ExhaustiveSummary:
         denominator and every numerator (it divides them for every θ; 0 usually).
     reduced : tuple or None
         For the transfer-function summary, the coefficients in s (s⁰ first) of the
-        denominator and of each numerator after that division, polynomials of ``ring``.
+        denominator and of each numerator after that division (polynomials of the ring
+        of θ and s they were computed in).
     """
 
     kind: str
@@ -176,7 +177,7 @@ class ExhaustiveSummary:
     def exhaustive_at(self, point: Sequence[object]) -> bool:
         """Whether this transfer-function summary is exhaustive at ``point`` without a minimal realisation
         there: the transfer function (after the common power ``s^shift``) is in lowest terms at it."""
-        return self.kind == KIND_TF and self.reduced is not None and _lowest_terms_at(self.reduced, self.ring, point)
+        return self.kind == KIND_TF and self.reduced is not None and _lowest_terms_at(self.reduced, point)
 
     def __len__(self) -> int:
         return len(self.numerators)
@@ -478,11 +479,9 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
     minimal = is_minimal_at(mats, mkind, output, params, check_point)
     normaliser, shift, reduced = None, 0, None
     if kind in (None, KIND_TF):
-        nums, dens, labels, shift, (dcoef, ncoefs) = _tf_summary(mats, mkind, output, params)
-        reduced = (tuple(_to_ring(c, R, names) for c in dcoef),
-                   tuple(tuple(_to_ring(c, R, names) for c in cs) for cs in ncoefs))
+        nums, dens, labels, shift, reduced = _tf_summary(mats, mkind, output, params)
         if kind is None:
-            kind = KIND_TF if minimal or _lowest_terms_at(reduced, R, check_point) else KIND_MARKOV
+            kind = KIND_TF if minimal or _lowest_terms_at(reduced, check_point) else KIND_MARKOV
     if kind == KIND_TF:
         if dens:
             normaliser = _to_ring(dens[0], R, names)
@@ -511,18 +510,28 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
                              normaliser, shift, reduced)
 
 
-def _lowest_terms_at(reduced, R: PolyRing, point: Sequence[object]) -> bool:
+def _lowest_terms_at(reduced, point: Sequence[object]) -> bool:
     """Whether the transfer function's denominator and numerators (``reduced``: their coefficients in s, s⁰
-    first, polynomials of R) have no common factor at ``point`` (exact, over ℚ) — the denominator is then the
-    least common denominator of the entries, of full degree."""
+    first, polynomials of ℚ[θ, s] or ℤ[θ, s] free of s) have no common factor at ``point`` (exact, over ℚ) — the
+    denominator is then the least common denominator of the entries, of full degree."""
     dcoef, ncoefs = reduced
-    if R.ngens != len(point) and len(point):  # pragma: no cover - the ring matches the free parameters
+    if dcoef[0].ring.ngens != len(point) + 1:  # pragma: no cover - the ring is the free parameters and s
         return False
-    vals = [QQ.from_sympy(sp.Rational(v)) for v in point] if len(point) else [QQ.zero] * R.ngens
+    vals = [Fraction(int(sp.Rational(v).p), int(sp.Rational(v).q)) for v in point]
     s = sp.Dummy("s")
 
+    def value(p: PolyElement) -> sp.Rational:  # p(θ) for a polynomial of θ and s free of s, in exact fractions
+        total = Fraction(0)
+        for monom, coeff in p.items():
+            term = Fraction(int(coeff.numerator), int(coeff.denominator))  # ZZ's int or QQ's fraction
+            for v, e in zip(vals, monom, strict=False):  # the exponent of s (last) is 0
+                if e:
+                    term *= v**e
+            total += term
+        return sp.Rational(total.numerator, total.denominator)
+
     def univariate(coeffs) -> sp.Poly:
-        return sp.Poly([QQ.to_sympy(c(*vals)) for c in reversed(coeffs)], s, domain=QQ)
+        return sp.Poly([value(c) for c in reversed(coeffs)], s, domain=QQ)
 
     g = univariate(dcoef)
     if g.is_zero or g.degree() < 1:
