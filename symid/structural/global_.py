@@ -336,6 +336,7 @@ def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: 
     rng = random.Random(10_007 + 1000 * seed + draw)
     star, minimal = _pick_theta_star(model, mats, kind, output, params, rng, known=known, rank=rank)
     if summary is not None and summary.kind == KIND_TF and (minimal or summary.exhaustive_at(star)):
+        # (a summary built where the realisation was minimal keeps no reduced form: built again here)
         return params, star, minimal, summary, rng
     summ = exhaustive_summary(model, known, check_point=star)
     return params, star, minimal, summ, rng

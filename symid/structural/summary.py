@@ -157,9 +157,10 @@ class ExhaustiveSummary:
         For the transfer-function summary, the power of s divided out of the
         denominator and every numerator (it divides them for every θ; 0 usually).
     reduced : tuple or None
-        For the transfer-function summary, the coefficients in s (s⁰ first) of the
-        denominator and of each numerator after that division (polynomials of the ring
-        of θ and s they were computed in).
+        For the transfer-function summary of a realisation not minimal at the check
+        point, the coefficients in s (s⁰ first) of the denominator and of each numerator
+        after that division (polynomials of the ring of θ and s they were computed in);
+        None otherwise.
     """
 
     kind: str
@@ -176,7 +177,8 @@ class ExhaustiveSummary:
 
     def exhaustive_at(self, point: Sequence[object]) -> bool:
         """Whether this transfer-function summary is exhaustive at ``point`` without a minimal realisation
-        there: the transfer function (after the common power ``s^shift``) is in lowest terms at it."""
+        there: the transfer function (after the common power ``s^shift``) is in lowest terms at it. False when
+        the summary keeps no reduced form (it was built where the realisation is minimal)."""
         return self.kind == KIND_TF and self.reduced is not None and _lowest_terms_at(self.reduced, point)
 
     def __len__(self) -> int:
@@ -482,6 +484,8 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
         nums, dens, labels, shift, reduced = _tf_summary(mats, mkind, output, params)
         if kind is None:
             kind = KIND_TF if minimal or _lowest_terms_at(reduced, check_point) else KIND_MARKOV
+        if minimal:
+            reduced = None  # not needed where the realisation is minimal (10 MB at 8 masses)
     if kind == KIND_TF:
         if dens:
             normaliser = _to_ring(dens[0], R, names)
