@@ -9,6 +9,7 @@ import re
 import string
 import time
 import types
+import warnings
 from fractions import Fraction
 from pathlib import Path
 
@@ -388,3 +389,14 @@ def test_hostile_text_gives_an_expression_or_a_symid_error_fast(sentinel, text, 
         sentinel.times.append(elapsed)
         assert elapsed < TIME_BOUND, (label, text)
         assert list(sentinel.path.iterdir()) == [], (label, text)
+
+
+@pytest.mark.parametrize("text", ["2and 3", "1if 2 else 3", "0x1for"])
+def test_a_number_run_into_a_keyword_is_an_error_without_a_python_warning(text):
+    # Python's parser warns on stderr of "invalid decimal literal" before it fails or parses; the user gets the
+    # ModelError only (found in CI: hypothesis drew such strings and 18 SyntaxWarnings were printed)
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        with pytest.raises(si.ModelError):
+            parse_expression(text)
+    assert not [w for w in seen if issubclass(w.category, SyntaxWarning)]

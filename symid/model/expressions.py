@@ -39,6 +39,7 @@ from __future__ import annotations
 import ast
 import math
 import re
+import warnings
 from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
@@ -372,7 +373,9 @@ def parse_expression(text: str, where: str = "entry", *,
         raise ModelError(f"{where} = {text!r} cannot be parsed: it is empty")
     source = _source(stripped)
     try:
-        tree = ast.parse(source, mode="eval")
+        with warnings.catch_warnings():  # "2and 3": Python warns of the literal on stderr; the error below says it
+            warnings.simplefilter("ignore", SyntaxWarning)
+            tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
         raise ModelError(f"{where} = {text!r} cannot be parsed: {exc.msg}") from None
     except (ValueError, RecursionError, MemoryError) as exc:  # too many digits, too deeply nested
