@@ -63,9 +63,9 @@ coefficients do not vanish there):
 
 - every D_j at θ* has numerator degree 2(n − j) − d_j and denominator degree
   2(n − j − 1) − d_j in lowest terms, d_j the number of elements from node j on that have
-  no spring and join a free sub-chain: each cancels a factor s for every θ (e = c s and
-  D′ = O(s²) at s = 0 in e D′ / (e + D′)), the largest degrees the structure allows
-  (:func:`_degree_drops`);
+  no spring and join a sub-chain with no spring to the ground: each cancels a factor s for
+  every θ (e = c s and D′(0) = 0 in e D′ / (e + D′)), the largest degrees the structure
+  allows (:func:`_degree_drops`);
 - at a node with both c_j and k_j, R has numerator degree 2(n − j) − 1 − d_j in lowest
   terms, and the gcd of step 3 has degree 1.
 
@@ -417,13 +417,13 @@ def peel(D: _RF, ladder: Ladder, m: list, e: list, g: list, subs: Mapping) -> bo
 
 def _degree_drops(ladder: Ladder) -> list[int]:
     """Per node j: how far below 2L and 2L − 2 (L masses from j on) the degrees of D_j's numerator and
-    denominator lie for every θ. An element without a spring (e = c s) joining a free sub-chain (no ground
-    element beyond it: its D′ vanishes like M s² at s = 0) cancels a factor s from e D′ / (e + D′), one
-    degree less for it and every node before it; any other element keeps the degrees."""
+    denominator lie for every θ. An element without a spring (e = c s) joining a sub-chain with no spring to
+    the ground (free, or grounded by a damper alone: its D′ vanishes at s = 0) cancels a factor s from
+    e D′ / (e + D′), one degree less for it and every node before it; any other element keeps the degrees."""
     n = len(ladder.masses)
     drops = [0] * (n + 1)
     for j in range(n - 2, -1, -1):
-        free_beyond = all(g == (0, 0) for g in ladder.grounds[j + 1:])
+        free_beyond = all(g[1] == 0 for g in ladder.grounds[j + 1:])  # no ground spring: D′(0) = 0
         damper_only = ladder.edges[j][0] != 0 and ladder.edges[j][1] == 0
         drops[j] = drops[j + 1] + int(damper_only and free_beyond)
     return drops[:n]
