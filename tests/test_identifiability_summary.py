@@ -48,8 +48,10 @@ def test_free_chain_velocity_uses_the_reduced_transfer_function():
         summ = exhaustive_summary(_free_chain(3, 0, 2, output))
         assert summ.kind == KIND_TF and summ.shift == shift, (output, summ.kind, summ.shift)
         assert summ.minimal == (shift == 0)
-        # after the division the denominator has degree 2n − shift: 6 − shift coefficients below the leading one
-        assert sum(label.startswith("d s^") for label in summ.labels) <= 6 - shift
+        # det = s²·(quartic) for every θ; after dividing by s^shift the denominator's non-constant coefficients
+        # below the leading one are those of s^(2 − shift) … s^(5 − shift)
+        kept = [lab for lab in summ.labels if lab.startswith("d s^")]
+        assert kept == [f"d s^{k}" for k in range(2 - shift, 6 - shift)]
 
 
 def _global_pair(model):

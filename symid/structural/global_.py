@@ -98,6 +98,7 @@ from symid.structural.msolve import MsolveCancelled, MsolveError, input_text, pa
 from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
     KIND_TF,
+    evaluator,
     exhaustive_summary,
     free_parameters,
     is_minimal_at,
@@ -431,33 +432,10 @@ def _in_radical(G, R: PolyRing, f: PolyElement) -> bool:
     return groebner(Gy, Ry) == [Ry.one]
 
 
-def _evaluator(pt):
-    """p ↦ p(pt) for polynomials over ℚ, exactly, with the powers of the coordinates cached (sympy's recursive
-    ``p(*pt)`` builds a polynomial per variable and was most of the time of building a large system)."""
-    powers = [[QQ(1), v] for v in pt]
-
-    def power(i: int, e: int):
-        row = powers[i]
-        while len(row) <= e:
-            row.append(row[-1] * row[1])
-        return row[e]
-
-    def value(p: PolyElement):
-        total = QQ(0)
-        for mono, c in p.terms():
-            for i, e in enumerate(mono):
-                if e:
-                    c = c * power(i, e)
-            total += c
-        return total
-
-    return value
-
-
 def _system(summ, params, pt, modulus: int | None = None) -> tuple[PolyRing, list[PolyElement], int]:
     """The polynomial system summary(θ) = summary(θ*) over ℚ (or GF(modulus)): ring, equations, auxiliary count."""
     dom = QQ if modulus is None else sp.GF(modulus)
-    at = _evaluator(pt)
+    at = evaluator(pt)
 
     def lift(p: PolyElement, R: PolyRing) -> PolyElement:
         if modulus is None:
@@ -573,7 +551,7 @@ def _aux_values(summ, pt) -> list[Fraction]:
     sat = _saturating(summ)
     if sat is None:
         return []
-    v = _evaluator(pt)(sat)
+    v = evaluator(pt)(sat)
     return [Fraction(int(v.denominator), int(v.numerator))]
 
 

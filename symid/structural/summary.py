@@ -50,7 +50,7 @@ from symid.model.expressions import sympify_value
 from symid.structural.modp import PRIME, BadPrime, inverse_mod_p, matmul_mod_p, matrix_mod_p, rank_mod_p
 from symid.structural.order import grevlex_memo
 
-__all__ = ["MAX_TERMS", "ExhaustiveSummary", "SummaryTooLarge", "exhaustive_summary", "free_parameters",
+__all__ = ["MAX_TERMS", "ExhaustiveSummary", "SummaryTooLarge", "evaluator", "exhaustive_summary", "free_parameters",
            "model_matrices", "rational"]
 
 MAX_TERMS = 2_000_000
@@ -514,6 +514,30 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
                              normaliser, shift, reduced)
 
 
+def evaluator(pt):
+    """p ↦ p(pt) for polynomials over ℚ or ℤ, exactly (variables beyond pt must have exponent 0), with the powers
+    of the coordinates cached (sympy's recursive ``p(*pt)`` builds a polynomial per variable and was most of the
+    time of building a large system)."""
+    powers = [[QQ(1), v] for v in pt]
+
+    def power(i: int, e: int):
+        row = powers[i]
+        while len(row) <= e:
+            row.append(row[-1] * row[1])
+        return row[e]
+
+    def value(p: PolyElement):
+        total = QQ(0)
+        for mono, c in p.terms():
+            for i, e in enumerate(mono):
+                if e:
+                    c = c * power(i, e)
+            total += c
+        return total
+
+    return value
+
+
 def _lowest_terms_at(reduced, point: Sequence[object]) -> bool:
     """Whether the transfer function's denominator and numerators (``reduced``: their coefficients in s, s⁰
     first, polynomials of ℚ[θ, s] or ℤ[θ, s] free of s) have no common factor at ``point`` (exact, over ℚ) — the
@@ -521,21 +545,11 @@ def _lowest_terms_at(reduced, point: Sequence[object]) -> bool:
     dcoef, ncoefs = reduced
     if dcoef[0].ring.ngens != len(point) + 1:  # pragma: no cover - the ring is the free parameters and s
         return False
-    vals = [Fraction(int(sp.Rational(v).p), int(sp.Rational(v).q)) for v in point]
+    value = evaluator([QQ.from_sympy(sp.Rational(v)) for v in point])  # s (last variable) has exponent 0
     s = sp.Dummy("s")
 
-    def value(p: PolyElement) -> sp.Rational:  # p(θ) for a polynomial of θ and s free of s, in exact fractions
-        total = Fraction(0)
-        for monom, coeff in p.items():
-            term = Fraction(int(coeff.numerator), int(coeff.denominator))  # ZZ's int or QQ's fraction
-            for v, e in zip(vals, monom, strict=False):  # the exponent of s (last) is 0
-                if e:
-                    term *= v**e
-            total += term
-        return sp.Rational(total.numerator, total.denominator)
-
     def univariate(coeffs) -> sp.Poly:
-        return sp.Poly([value(c) for c in reversed(coeffs)], s, domain=QQ)
+        return sp.Poly([QQ.to_sympy(QQ.convert(value(c))) for c in reversed(coeffs)], s, domain=QQ)
 
     g = univariate(dcoef)
     if g.is_zero or g.degree() < 1:
