@@ -23,7 +23,6 @@ Prints a table and a summary, and writes ``benchmarks/results/noisy_reference.js
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import time
 import warnings
@@ -35,19 +34,10 @@ from population import parameter_error, resolved
 from population_models import make_problem
 
 import symid as si
-from symid.runlog import write_json_atomic
+from symid.runlog import RunLog, write_json_atomic
 
 LOG = RESULTS / "population.jsonl"
 NOISE = 0.01
-
-
-def _records() -> dict[str, dict[str, Any]]:
-    recs: dict[str, dict[str, Any]] = {}
-    with LOG.open() as fh:
-        for line in fh:
-            rec = json.loads(line)
-            recs[rec["key"]] = rec
-    return recs
 
 
 def _fit(p: Any, data: Any, variance: Any) -> Any:
@@ -60,16 +50,16 @@ def _fit(p: Any, data: Any, variance: Any) -> Any:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.parse_args(argv)
-    recs = _records()
+    log = RunLog(LOG)  # the last record of every key, as the benchmark reads it
     rows = []
     t0 = time.perf_counter()
     print(f"{'problem':22s} {'ref misfit':>11s} {'ref error':>10s} {'lm misfit':>11s} {'lm error':>10s} "
           f"{'ML error':>10s}")
-    for key, prob in recs.items():
-        if not key.endswith("/problem"):
+    for prob in log.records():
+        if not prob["key"].endswith("/problem"):
             continue
-        name = key.split("/")[0]
-        ref = recs.get(f"{name}/noise{NOISE:g}/reference")
+        name = prob["key"].split("/")[0]
+        ref = log.get(f"{name}/noise{NOISE:g}/reference")
         if ref is None:
             continue
         p = make_problem(prob["cls"], int(prob["n"]), int(prob["index"]), check=False, draw=prob["info"]["draw"])
