@@ -101,6 +101,7 @@ def test_a_parameter_that_is_a_ratio_of_coefficients_is_proven_global_without_so
     rep = si.identifiability(model, timeout=60)
     assert rep.verdicts["S8"] == "global" and {v for k, v in rep.verdicts.items() if k != "S8"} == {"none"}
     assert rep.verdicts_proven and rep.engine == "formula"
+    assert "global (formula)   : summary(θ) = summary(θ*)" in rep.summary()  # the header names what decided
 
 
 def test_linear_combinations_do_not_depend_on_the_point():

@@ -235,11 +235,15 @@ class IdentifiabilityReport:
                        f"{self.n_solutions_complex} complex")
             if self.engine == "ladder":
                 L.append(f"global (chain)     : summary(θ) = summary(θ*): {sol} (continued-fraction inversion)")
+            elif self.engine == "formula":
+                L.append(f"global (formula)   : summary(θ) = summary(θ*): {sol} (rational formulas, checked exactly)")
             else:
                 L.append(f"global (Gröbner)   : summary(θ) = summary(θ*): {sol}")
             L.append(f"summary            : {self.n_summary} {self.summary_kind}")
             if self.theta_confirm:
                 L.append("confirmed          : at an independent point θ**")
+        elif self.n_solutions_at_least is not None:  # settled by certified witnesses, not by the Gröbner step
+            L.append(f"global (witnesses) : {self.global_status}")
         else:
             L.append(f"global (Gröbner)   : {self.global_status}")
         L.append("")
