@@ -52,6 +52,9 @@ are then run again once by the current commit, the new records superseding the o
 resumed rerun does not repeat it). ``--summary-only`` rebuilds the summary from the log. The summary
 (``benchmarks/results/population.json``, the README table's source) is rewritten from the
 whole log after every problem, so it always describes exactly what the log holds.
+``--recheck`` checks every logged problem's identifiability again with the current code
+(a problem the checker could not decide when it was drawn may be proven globally
+identifiable now, and then its starts are judged by their parameter error alone).
 ``--workers N`` runs the starts in a local process pool; ``--dask ADDRESS`` on a Dask
 cluster (``distributed.Client(ADDRESS).get_executor()``, the optional extra
 ``symid[dask]``).
@@ -280,6 +283,29 @@ def redo_references(log: RunLog, timeout: float) -> None:
               flush=True)
 
 
+def recheck(log: RunLog, timeout: float) -> None:
+    """Every logged problem the grid resolves checked again by this code's :func:`symid.identifiability` (the new
+    problem records supersede the old ones): a verdict the checker could not decide when the problem was drawn may
+    be decided now, and whether a problem is proven globally identifiable selects its success rule."""
+    todo = [r for r in log.records() if r["key"].endswith("/problem") and _logged_resolution(r) > RESOLUTION_FLOOR]
+    for i, rec in enumerate(todo):
+        p = make_problem(rec["cls"], int(rec["n"]), int(rec["index"]), check=False, draw=rec["info"]["draw"])
+        t0 = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            rep = si.identifiability(p.model, timeout=timeout)
+        info = {**rec["info"], "identifiability": rep.verdict,
+                "verdicts": {k: str(v) for k, v in rep.verdicts.items()},
+                "global_determined": bool(rep.global_determined), "n_solutions": rep.n_solutions,
+                "global": bool(rep.global_determined) and all(str(v) == "global" for v in rep.verdicts.values()),
+                "rechecked": git_commit()}
+        seconds = time.perf_counter() - t0
+        log.append(rec["key"], {**{k: v for k, v in rec.items() if k != "key"}, "info": info, "check_time": seconds})
+        print(f"[{i + 1}/{len(todo)}] {rec['key'].removesuffix('/problem')}: {rec['info'].get('identifiability')} "
+              f"-> {rep.verdict} (global: {rec['info'].get('global')} -> {info['global']}; {seconds:.1f} s)",
+              flush=True)
+
+
 def _floats(text: str) -> list[float]:
     return [float(v) for v in text.split(",") if v]
 
@@ -304,6 +330,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--redo-references", action="store_true",
                     help="compute every logged noisy reference (IPOPT started at the truth) again with this code, "
                          "then rebuild the summary: the noisy successes are judged against the new references")
+    ap.add_argument("--recheck", action="store_true",
+                    help="check every logged problem's identifiability again with this code (budget --check-timeout), "
+                         "then rebuild the summary: a problem now proven globally identifiable is judged by its "
+                         "parameter error alone")
     ap.add_argument("--progress", action="store_true", help="progress bars per method")
     ap.add_argument("--rerun", default="", help="methods whose logged starts are run again by this commit "
                     "(e.g. after a change to the method; the new records supersede the old ones)")
@@ -334,6 +364,10 @@ def main(argv: list[str] | None = None) -> int:
         return summary
 
     if args.summary_only:
+        print_table(write_summary())
+        return 0
+    if args.recheck:
+        recheck(log, args.check_timeout)
         print_table(write_summary())
         return 0
     if args.redo_references:
