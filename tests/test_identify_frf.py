@@ -291,7 +291,7 @@ def test_no_free_parameter():
 def test_unknown_method_and_bad_starts():
     model = belt_drive()
     frf = si.simulate_frf(model, BELT_TRUTH, W_BELT)
-    with pytest.raises(si.ModelError, match="unknown method 'pem'"):
+    with pytest.raises(si.OptionError, match="unknown method 'pem'"):
         si.identify(model, frf, method="pem")
     with pytest.raises(si.OptionError, match="starts must be an integer between 1 and 100000; got 0"):
         si.identify(model, frf, method="ipopt", starts=0)

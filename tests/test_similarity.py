@@ -243,7 +243,7 @@ def test_data_options_and_methods_are_checked():
     bb = transformed(model, truth, T_SMALL)
     with pytest.raises(si.OptionError, match="horizon is an N4SID option"):
         si.identify(model, bb, method="scr", horizon=5)
-    with pytest.raises(si.ModelError, match="unknown method 'newton'"):
+    with pytest.raises(si.OptionError, match="unknown method 'newton'"):
         si.identify(model, bb, method="newton")
     with pytest.raises(si.OptionError, match="aux_init must be one of"):
         si.identify(model, bb, method="gb", aux_init="ones")

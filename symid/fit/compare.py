@@ -287,8 +287,8 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     kind = data_kind(data)
     for m in methods:
         if not isinstance(m, str) or m.removesuffix("+polish") not in kind.methods:
-            raise ModelError(f"unknown method {m!r} for {kind.name} data; choose among "
-                             f"{', '.join(kind.methods)} (each also as '<method>+polish' where it has a polish step)")
+            raise OptionError(f"unknown method {m!r} for {kind.name} data; choose among "
+                              f"{', '.join(kind.methods)} (each also as '<method>+polish' where it has a polish step)")
     options = dict(options or {})
     unknown = set(options) - {m.removesuffix("+polish") for m in methods}
     if unknown:

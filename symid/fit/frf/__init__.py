@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from symid.errors import ModelError, OptionError
+from symid.errors import OptionError
 from symid.fit.base import Estimator
 from symid.fit.frf.misfit import check_frf
 from symid.fit.frf.scale import typical_scale
@@ -55,8 +55,8 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     if method == "auto":
         return AutoFRF.create(model, data, options, noise_floor=noise_floor)
     if method != "scr":
-        raise ModelError(f"unknown method {method!r} for frequency-response data; choose one of "
-                         f"{', '.join(METHODS)}")
+        raise OptionError(f"unknown method {method!r} for frequency-response data; choose one of "
+                          f"{', '.join(METHODS)}")
     opts = dict(options)
     force = check_bool("force_scr", opts.pop("force_scr", False))
     check_known_names("method 'scr' (frequency response)", opts, (*ScrFRF.option_names(), "force_scr"))

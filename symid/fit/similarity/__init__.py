@@ -71,7 +71,7 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     runs SCR anyway, and SCR options given without it are refused.
     """
     if method not in METHODS:
-        raise ModelError(f"unknown method {method!r} for black-box data; choose one of {', '.join(METHODS)}")
+        raise OptionError(f"unknown method {method!r} for black-box data; choose one of {', '.join(METHODS)}")
     cls = _estimator_class(model, method)
     opts = dict(options)
     force = check_bool("force_scr", opts.pop("force_scr", False)) if method == "scr" else False

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from symid.errors import ModelError
+from symid.errors import ModelError, OptionError
 from symid.fit.base import Estimator
 
 __all__ = ["METHODS", "prepare"]
@@ -36,4 +36,4 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     if method == "ls":
         raise ModelError("spectral data have no linear least-squares special case (Φyy = H Φuu Hᴴ is quadratic "
                          "in H); use method='scr' or 'ipopt'")
-    raise ModelError(f"unknown method {method!r} for spectral data; choose one of {', '.join(METHODS)}")
+    raise OptionError(f"unknown method {method!r} for spectral data; choose one of {', '.join(METHODS)}")

@@ -29,7 +29,7 @@ from __future__ import annotations
 from typing import Any
 
 from symid.data import IOData
-from symid.errors import DataError, ModelError
+from symid.errors import DataError, OptionError
 from symid.fit.base import Estimator
 
 __all__ = ["BLACK_BOX_METHODS", "METHODS", "prepare"]
@@ -42,7 +42,7 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
             noise_floor: float | None = None) -> Estimator:
     """The estimator of ``method`` for time-series data (see the module table)."""
     if method not in METHODS:
-        raise ModelError(f"unknown method {method!r} for time-series data; choose one of {', '.join(METHODS)}")
+        raise OptionError(f"unknown method {method!r} for time-series data; choose one of {', '.join(METHODS)}")
     if method == "oe":
         from symid.fit.timeseries.oe import OutputError
 
