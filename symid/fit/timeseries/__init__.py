@@ -3,6 +3,8 @@
 =================  ==========  =====================================================================
 data               method      what it fits
 =================  ==========  =====================================================================
+IOData, TimeSeries ``auto``    the default: ``oe`` restarted around the start until the estimate fits
+or a list of them              the samples (:mod:`~symid.fit.timeseries.auto`)
 IOData, TimeSeries ``oe``      output error: the model simulated exactly on the sample times from
 or a list of them              its initial state, against the measured samples
                                (:mod:`~symid.fit.timeseries.oe`, CasADi/IPOPT)
@@ -35,7 +37,7 @@ from symid.fit.base import Estimator
 __all__ = ["BLACK_BOX_METHODS", "METHODS", "prepare"]
 
 BLACK_BOX_METHODS = ("scr", "als", "gb", "ipopt", "ls")
-METHODS = ("oe", "svf", "srivc", *BLACK_BOX_METHODS)
+METHODS = ("auto", "oe", "svf", "srivc", *BLACK_BOX_METHODS)
 
 
 def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
@@ -47,6 +49,10 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
         from symid.fit.timeseries.oe import OutputError
 
         return OutputError.create(model, data, options, noise_floor=noise_floor)
+    if method == "auto":
+        from symid.fit.timeseries.auto import AutoOutputError
+
+        return AutoOutputError.create(model, data, options, noise_floor=noise_floor)
     if method == "svf":
         from symid.fit.timeseries.svf import StateVariableFilter
 

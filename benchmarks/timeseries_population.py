@@ -1,0 +1,169 @@
+"""The time-series methods on generated models nobody tuned for: which should be the default?
+
+Problems come from :mod:`population_models` (this folder), as in ``population.py``:
+mass-spring-damper chains, chains with an actuator and a sensor gain, compartment models
+with a volume, first-order state-space networks; physical values drawn log-uniformly,
+every problem checked with :func:`symid.identifiability` first. Each is simulated with
+:func:`symid.simulate_io` (zero-order hold) under a white Gaussian input, 10 samples per
+period of the fastest mode, over 20 periods of the slowest (500 to 4000 samples),
+noise-free and with 1 % relative output noise.
+
+Methods, from the same starts (informed: within a factor 3 of the truth; uninformed:
+within a factor 10 of the typical values, as in ``population.py``), each with a 60 s
+budget per start: ``scr`` through the N4SID black box (the default for time series
+before), ``oe`` (one output-error run) and ``auto`` (output error restarted until the
+estimate fits, :mod:`symid.fit.timeseries.auto`). Success as in ``population.py``:
+noise-free, the largest relative parameter error ≤ 1e-3 (or, not proven globally
+identifiable, an exact fit with positive parameters); at 1 % noise, an error at most
+twice that of ``oe`` started at the truth (or, not proven global, a misfit at most 1.001
+times its misfit). A method that refuses the problem (an error naming why) fails it.
+
+Run (about 20 minutes on 2 cores)::
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/timeseries_population.py [--workers 2]
+
+Prints a table and writes ``benchmarks/results/timeseries_population.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import platform
+import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+import numpy as np
+from _study import RESULTS, git_commit  # benchmarks/ (the script's folder) is on the path
+from population_models import make_problem
+
+import symid as si
+from symid.fit.success import EXACT_FIT
+from symid.runlog import write_json_atomic
+
+CLASSES = ("chain", "gains", "compartment", "state_space")
+METHODS = ("scr", "oe", "auto")
+NOISES = (0.0, 0.01)
+KINDS = ("informed", "uninformed")
+TIME_LIMIT = 60.0
+
+
+def records(p: Any, noise: float, seed: int = 0) -> Any:
+    """The problem's input/output record (module docstring)."""
+    lam = np.abs(np.linalg.eigvals(p.model.state_space(p.truth).A))
+    lam = lam[lam > 0]
+    dt = 2 * math.pi / (10 * lam.max())
+    n = int(min(4000, max(500, 20 * 2 * math.pi / lam.min() / dt)))
+    u = np.random.default_rng([seed, 7]).standard_normal(n)
+    return si.simulate_io(p.model, p.truth, u, dt, noise=noise or None, seed=seed + 1)
+
+
+def error(theta: Any, truth: np.ndarray) -> float:
+    return float(np.max(np.abs(np.asarray(theta, dtype=float) - truth) / np.abs(truth)))
+
+
+def _fit(cls: str, n: int, draw: int, noise: float, method: str, x0: list[float]) -> dict[str, Any]:
+    p = make_problem(cls, n, 0, check=False, draw=draw)
+    io = records(p, noise)
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = si.identify(p.model, io, method=method, x0=x0, identifiability_check=False,
+                              time_limit=TIME_LIMIT)
+        out = {"theta": res.theta_vector.tolist(), "cost": float(res.cost), "success_reported": bool(res.success),
+               "refused": None}
+    except si.SymidError as exc:
+        out = {"theta": None, "cost": None, "success_reported": False, "refused": f"{type(exc).__name__}: {exc}"}
+    out["seconds"] = time.perf_counter() - t0
+    return out
+
+
+def judged(rec: dict[str, Any], truth: np.ndarray, globally: bool, ref: dict[str, Any] | None) -> bool:
+    if rec["theta"] is None or not np.all(np.isfinite(rec["theta"])):
+        return False
+    err = error(rec["theta"], truth)
+    admissible = bool(np.all(np.asarray(rec["theta"]) > 0))
+    if ref is None:
+        return err <= 1e-3 or (not globally and admissible and rec["cost"] <= EXACT_FIT)
+    return err <= 2 * error(ref["theta"], truth) or (not globally and admissible and rec["cost"] <= 1.001 * ref["cost"])
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", default="2,3")
+    ap.add_argument("--starts", type=int, default=2, help="starts of each kind (default %(default)s)")
+    ap.add_argument("--workers", type=int, default=2)
+    args = ap.parse_args(argv)
+    sizes = [int(v) for v in args.sizes.split(",") if v]
+    t_all = time.perf_counter()
+    problems = []
+    for cls in CLASSES:
+        for n in sizes:
+            p = make_problem(cls, n, 0)
+            problems.append(p)
+            print(f"{p.name}: {p.model.n_parameters} parameters, {p.info['identifiability']}", flush=True)
+    jobs: dict[tuple, Any] = {}
+    with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        for p in problems:
+            for noise in NOISES:
+                if noise:
+                    jobs[(p.name, noise, "reference", 0, "oe")] = pool.submit(
+                        _fit, p.cls, p.n_size, p.info["draw"], noise, "oe", p.truth.tolist())
+                for kind in KINDS:
+                    for i, x0 in enumerate(p.starts(kind, args.starts, seed=0)):
+                        for m in METHODS:
+                            jobs[(p.name, noise, kind, i, m)] = pool.submit(
+                                _fit, p.cls, p.n_size, p.info["draw"], noise, m, x0.tolist())
+        results = {k: f.result() for k, f in jobs.items()}
+    rows = []
+    by = {p.name: p for p in problems}
+    cells: dict[tuple, dict[str, Any]] = {}
+    for (name, noise, kind, i, m), rec in results.items():
+        if kind == "reference":
+            continue
+        p = by[name]
+        ref = results[(name, noise, "reference", 0, "oe")] if noise else None
+        ok = judged(rec, p.truth, bool(p.info.get("global")), ref)
+        rows.append({"problem": name, "noise": noise, "kind": kind, "start": i, "method": m, "success": ok,
+                     "error": None if rec["theta"] is None else error(rec["theta"], p.truth), **rec})
+        for key in ((p.cls, m, noise, kind), ("all", m, noise, kind)):
+            c = cells.setdefault(key, {"starts": 0, "success": 0, "refused": 0, "times": []})
+            c["starts"] += 1
+            c["success"] += ok
+            c["refused"] += rec["refused"] is not None
+            c["times"].append(rec["seconds"])
+    table = []
+    print(f"\n{'class':12s} {'method':6s} {'exact, inf.':>11s} {'exact, uninf.':>13s} {'1 %, inf.':>9s} "
+          f"{'1 %, uninf.':>11s} {'refused':>7s} {'median s':>8s}")
+    for cls in (*CLASSES, "all"):
+        for m in METHODS:
+            cs = [cells.get((cls, m, nz, k)) for nz in NOISES for k in KINDS]
+            if any(c is None for c in cs):
+                continue
+            times = [t for c in cs for t in c["times"]]
+            pairs = [(a, b) for a in NOISES for b in KINDS]
+            counts = {f"{'exact' if nz == 0 else '1 %'}, {k}": f"{c['success']}/{c['starts']}"
+                      for (nz, k), c in zip(pairs, cs, strict=True)}
+            row = {"class": cls, "method": m, **counts, "refused": sum(c["refused"] for c in cs),
+                   "median_s": float(np.median(times))}
+            table.append(row)
+            vals = list(row.values())
+            print(f"{cls:12s} {m:6s} {vals[2]:>11s} {vals[3]:>13s} {vals[4]:>9s} {vals[5]:>11s} {row['refused']:7d} "
+                  f"{row['median_s']:8.2f}")
+    out = RESULTS / "timeseries_population.json"
+    write_json_atomic(out, {"benchmark": "timeseries_population", "command": "benchmarks/timeseries_population.py",
+                            "git_commit": git_commit(), "sizes": sizes, "starts_per_kind": args.starts,
+                            "time_limit": TIME_LIMIT, "table": table, "rows": rows,
+                            "problems": {p.name: {"identifiability": p.info["identifiability"],
+                                                  "global": bool(p.info.get("global"))} for p in problems},
+                            "wall_time": time.perf_counter() - t_all,
+                            "machine": {"platform": platform.platform(), "python": platform.python_version()}})
+    print(f"wrote {out} ({time.perf_counter() - t_all:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
