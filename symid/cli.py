@@ -297,7 +297,7 @@ def _run_identify(identify, model, data, args, x0, opts: dict, from_file: set[st
     from symid.errors import OptionError
     from symid.fit.registry import data_kind
 
-    if args.method is None:  # the data kind's default (auto for a frequency response)
+    if args.method is None:  # the data kind's default (auto for a frequency response or time series)
         args.method = data_kind(data).default_method
     while True:
         try:
@@ -555,7 +555,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     _add_data_arguments(p, "simulate the zoo recipe")
     p.add_argument("--method", choices=all_methods(), default=None,
-                   help="estimator (default: auto for a frequency response, scr for other data); als and gb "
+                   help="estimator (default: auto for a frequency response or time series, scr for spectra and "
+                        "black boxes); als and gb "
                         "(alternating least squares, gradient-based BFGS, thesis appendix C) take black-box or I/O "
                         "data, oe (output error) time series")
     p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=1, metavar="N",

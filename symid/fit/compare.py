@@ -12,7 +12,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from symid.errors import DataError, ModelError, OptionError
-from symid.fit.options import check_choice, check_float
+from symid.fit.options import check_choice, check_float, scale_by_name
 from symid.fit.registry import data_kind, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
@@ -298,7 +298,8 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     param_tol = check_float("param_tol", param_tol, low=0, strict_low=True)
     error_of = _ERRORS[check_choice("param_error", param_error, tuple(_ERRORS))]
     truth_vec = None if truth is None else model.theta_vector(truth)
-    scale = next((o["scale"] for o in options.values() if isinstance(o, dict) and o.get("scale") is not None), None)
+    scale = next((scale_by_name(o, model.parameter_names)["scale"] for o in options.values()
+                  if isinstance(o, dict) and o.get("scale") is not None), None)
     x0s = _start_list(model, data, starts, seed, x0, draws, scale)
     if log is not None and not isinstance(log, RunLog):
         raise ModelError(f"log must be a symid.runlog.RunLog; got {type(log).__name__}")
@@ -395,6 +396,7 @@ def _worker_start(token: str, model: Any, data: Any, method: str, options: dict[
 def _build(model: Any, data: Any, method: str, options: dict[str, Any], noise_floor: float | None
            ) -> tuple[Any, Any]:
     """The estimator of ``method`` and, for ``"<method>+polish"``, its polisher."""
+    options = scale_by_name(options, model.parameter_names)  # a dict by name, as x0 may be
     estimator = prepare(model, data, method.removesuffix("+polish"), options, noise_floor=noise_floor)
     polisher = None
     if method.endswith("+polish"):

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from symid.errors import IdentifiabilityWarning, OptionError
-from symid.fit.options import check_bool
+from symid.fit.options import check_bool, scale_by_name
 from symid.fit.registry import prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
@@ -136,6 +136,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     identifiability_check = check_bool("identifiability_check", identifiability_check)
     if progress is not None:
         progress = check_bool("progress", progress)
+    options = scale_by_name(options, model.parameter_names)  # a dict by name, as x0 may be
     estimator = prepare(model, data, method, options, noise_floor=noise_floor)
     if noise_std is not None and not isinstance(estimator, FisherInformation):
         raise OptionError(f"noise_std is for the uncertainty of the estimate, which method {estimator.method!r} "

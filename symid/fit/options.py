@@ -33,6 +33,7 @@ __all__ = [
     "check_time_limit",
     "moved_onto_bounds",
     "parameter_bounds",
+    "scale_by_name",
 ]
 
 MAX_SEED = 2**63 - 1
@@ -152,6 +153,42 @@ def check_scale(name: str, value: Any, size: int) -> np.ndarray:
         k = int(np.argmax(bad))
         raise OptionError(f"{name}[{k}] = {float(arr[k])!r}; every entry must be a positive finite number")
     return arr.copy()
+
+
+def scale_by_name(options: Mapping[str, Any], parameter_names: Sequence[str]) -> dict[str, Any]:
+    """``options`` with a ``scale`` given as a dict by parameter name (as ``x0`` and ``bounds`` may be) turned
+    into one value per parameter, in θ order; every parameter must be named, and only those.
+
+    Examples
+    --------
+    >>> from symid.fit.options import scale_by_name
+    >>> scale_by_name({"scale": {"k": 1e4, "m": 2.0}}, ["m", "k"])
+    {'scale': [2.0, 10000.0]}
+    >>> scale_by_name({"scale": {"m": 2.0}}, ["m", "k"])
+    Traceback (most recent call last):
+    ...
+    symid.errors.OptionError: scale by name needs every parameter; missing: k
+    """
+    value = options.get("scale")
+    if not isinstance(value, Mapping):
+        return dict(options)
+    names = list(parameter_names)
+    unknown = [k for k in value if k not in names]
+    if unknown:
+        parts = []
+        for k in unknown:
+            close = difflib.get_close_matches(str(k), names, n=1)
+            parts.append(f"{k!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+        raise OptionError(f"scale names {', '.join(parts)}, not a parameter of the model ({', '.join(names)})")
+    missing = [n for n in names if n not in value]
+    if missing:
+        raise OptionError(f"scale by name needs every parameter; missing: {', '.join(missing)}")
+    out = [value[n] for n in names]
+    try:
+        out = [float(v) for v in out]
+    except (TypeError, ValueError):
+        raise OptionError(f"scale must hold numbers; got {value!r}") from None
+    return {**options, "scale": out}
 
 
 def check_bounds(name: str, value: Any, parameter_names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:

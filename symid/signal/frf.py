@@ -418,6 +418,20 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         above the Nyquist frequency; H2 with several inputs, or at a line of zero
         coherence.
 
+    Notes
+    -----
+    Ĥ is the response from the sampled input to the sampled output. Where the input
+    is held between samples (a DAC, or :func:`symid.simulate_io`, which holds it), that
+    is the response of the zero-order-hold discretisation of the system, not its
+    continuous-time H(jω): the hold delays the input by half a sample on average, and an
+    output with a direct feedthrough (acceleration) is sampled as the input jumps. On a
+    1-DOF oscillator measured in acceleration (resonance 10 Hz, sampled at 100 Hz, a
+    held multisine 0.5–30 Hz), Ĥ differs from H(jω) by 20 % at the median line, 300 %
+    at 1 Hz, and a continuous-time model fitted to it is biased. Fit such records as
+    samples instead (``si.identify(model, io)``, output error, which models the hold
+    exactly), or measure an input that is not held (band-limited, anti-alias filtered),
+    as real acquisition systems do, and keep to a band well below the Nyquist frequency.
+
     See Also
     --------
     estimate_coherence : the coherence at the same lines.
