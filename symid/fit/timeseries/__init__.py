@@ -71,6 +71,16 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
     try:
         inner = similarity_prepare(model, data, method, options, noise_floor=noise_floor)
     except DataError as exc:
+        if "band=(0, w_high)" in str(exc):  # d2c's advice, an option of si.d2c that identify() does not take
+            raise DataError(f"{exc}. Through si.identify: method='auto' (the default) or 'oe' fits the samples and "
+                            f"needs no black box; or build the black box yourself (si.n4sid, then si.d2c(..., "
+                            f"band=...)) and identify from it") from None
+        if "the order is too high" in str(exc):  # N4SID at the model's order; the model itself may be non-minimal
+            raise DataError(f"{exc}. Method {method!r} fits an N4SID black box of the model's order "
+                            f"({model.n_states} states), which the samples can only determine if the model's "
+                            f"realisation is minimal (a free rigid-body mode measured in velocity, for one, leaves "
+                            f"its position unseen); method='auto' (the default) or 'oe' fits the samples directly "
+                            f"and needs no such order") from None
         if "persistently exciting" not in str(exc):
             raise
         raise DataError(f"{exc}. Method {method!r} goes through N4SID, which needs such an input; method='oe' "
