@@ -206,3 +206,17 @@ def test_foh_hold_is_exact_for_piecewise_linear_inputs():
     np.testing.assert_allclose(foh.theta, MCK, rtol=1e-10)
     zoh = SimplifiedRIVC(model, rec).run(np.ones(3))
     assert np.max(np.abs(zoh.theta / MCK - 1)) > 1e-3
+
+
+def test_a_non_affine_coefficient_is_named_without_round_off_terms():
+    # a new-user trial: a thermal network with known capacities (floats) — the determinant in floating point
+    # showed "-1.29e-26*G12**2*G23 - ... + 1.11e-10*G12*G23*G3a"; in exact arithmetic the coefficient is
+    # G12·G23·G3a/(C1·C2·C3) = G12·G23·G3a / 9e9
+    G12, G23, G3a = si.parameters("G12 G23 G3a", positive=True)
+    C1, C2, C3 = 2000.0, 3000.0, 1500.0
+    th = si.StateSpaceModel(A=[[-G12 / C1, G12 / C1, 0], [G12 / C2, -(G12 + G23) / C2, G23 / C2],
+                               [0, G23 / C3, -(G23 + G3a) / C3]], B=[[1 / C1], [0], [0]], C=[[0, 0, 1]])
+    io = si.simulate_io(th, {"G12": 5.0, "G23": 3.0, "G3a": 2.0}, np.ones(300), 60.0)
+    with pytest.raises(si.ModelError, match=r"coefficient of s\^0 in D\(s\) = det\(sI − A\) is "
+                                            r"1\.11111e-10\*G12\*G23\*G3a, not affine"):
+        si.identify(th, io, method="srivc", identifiability_check=False)

@@ -201,7 +201,10 @@ def transfer_polynomials(model: Any) -> TransferPolynomials:
     """
     s = sp.Dummy("s")
     params = list(model.parameters)
-    sym = model.symbolic
+    # floats (known values) as the exact rationals they are: a determinant in floating point leaves terms like
+    # 1e-26·G12²·G23 where exact arithmetic cancels them, and an affine coefficient would look quadratic
+    sym = {k: v.applyfunc(lambda e: e.xreplace({f: sp.Rational(f) for f in e.atoms(sp.Float)}))
+           for k, v in model.symbolic.items()}
     if "M" in sym:
         Z = sym["M"] * s**2 + sym["V"] * s + sym["K"]
         den = Z.det(method="berkowitz")
@@ -230,7 +233,7 @@ def transfer_polynomials(model: Any) -> TransferPolynomials:
             if expr == 0:
                 continue
             if any(p in expr.free_symbols for p in params) and sp.Poly(expr, *params).total_degree() > 1:
-                text = str(expr)
+                text = str(sp.N(expr, 6))  # the exact rationals of the known values, shown as decimals
                 text = text if len(text) <= 120 else text[:117] + "..."
                 raise ModelError(f"method 'srivc' needs every coefficient of the transfer function affine in θ: the "
                                  f"coefficient of s^{k} in {what} is {text}, not affine. Use method='oe' (or "
