@@ -16,6 +16,9 @@ and writes ``benchmarks/results/identifiability.json``. Target: each under 2 s.
 up to 24 parameters; ``--max-parameters``), each cold with ``--timeout`` (default there
 10 s), and writes ``benchmarks/results/identifiability_families.json``: per model the
 wall time and whether the report is complete (no "local, global undetermined").
+``--families chain_at`` runs every placement of force and position sensor on chains of 3 to 8
+masses instead (116 models, about 15 minutes) and writes
+``benchmarks/results/identifiability_placements.json``.
 
 Column ``verdict``: the model verdict, with ``(proven by witnesses)`` when certified
 witnesses settled it before the Gröbner basis finished and ``(global undetermined)``
@@ -180,7 +183,8 @@ def _families(args, parser) -> int:
            "cpus_usable": _cpus_usable(),
            "load_average_before": load_before, "load_average_after": load_after, "niceness": os.nice(0),
            "complete": True, "rows": rows}
-    path = Path(__file__).resolve().parent / "results" / "identifiability_families.json"
+    stem = "identifiability_placements" if args.families == ["chain_at"] else "identifiability_families"
+    path = Path(__file__).resolve().parent / "results" / f"{stem}.json"
     write_json_atomic(path, out, indent=2)
     print(f"wrote {path}")
     return 0

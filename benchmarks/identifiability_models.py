@@ -10,6 +10,8 @@ positive; inputs and sensors are unit vectors (known gains). Names: ``family-n-v
 - ``chain_mid``: the same chains driven or measured at an interior mass k = ⌈n/2⌉ (n ≥ 3).
   Variants ``mm`` force and position of mass k; ``1m`` force on mass 1, position of
   mass k.
+- ``chain_at``: the same chains with the force on mass a and the position of mass b
+  measured, every placement a ≤ b (variant ``a.b``); run only when named.
 - ``shear``: a shear building of n storeys (the same topology as the chain, storey 1 on
   the ground), force on the roof, acceleration of the roof measured. 3n parameters.
 - ``rlc``: an RLC ladder of n meshes (mesh charges q): inductance and series resistance
@@ -71,6 +73,19 @@ def chain_mid(n: int, variant: str = "mm"):
                                C=_unit(n, s, False), output="position", name=f"chain_mid-{n}-{variant}")
 
 
+def chain_at(n: int, variant: str = "1.1"):
+    """The chain of :func:`chain` driven at mass a and measured (position) at mass b, variant ``"a.b"`` (1-based)."""
+    a, b = (int(v) - 1 for v in variant.split("."))
+    m, c, k = _names("m", n), _names("c", n), _names("k", n)
+    return si.SecondOrderModel(M=sp.diag(*m), V=_ground_chain(c), K=_ground_chain(k), B=_unit(n, a, True),
+                               C=_unit(n, b, False), output="position", name=f"chain_at-{n}-{variant}")
+
+
+def _pairs(n: int) -> tuple[str, ...]:
+    """Every placement a ≤ b of force and sensor on n masses (H_ba = H_ab: the other half is the same map)."""
+    return tuple(f"{a}.{b}" for a in range(1, n + 1) for b in range(a, n + 1))
+
+
 def shear(n: int, variant: str = "roof"):
     m, c, k = _names("m", n), _names("c", n), _names("k", n)
     return si.SecondOrderModel(M=sp.diag(*m), V=_ground_chain(c), K=_ground_chain(k), B=_unit(n, n - 1, True),
@@ -112,13 +127,18 @@ def _compartments(kind: str, n: int, variant: str):
 FAMILIES = {
     "chain": (chain, range(2, 9), ("11", "nn", "1n")),
     "chain_mid": (chain_mid, range(3, 9), ("mm", "1m")),
+    "chain_at": (chain_at, range(3, 9), _pairs),
     "shear": (shear, range(2, 9), ("roof",)),
     "rlc": (rlc, range(2, 9), ("ladder",)),
     "catenary": (lambda n, v: _compartments("catenary", n, v), range(2, 7), ("leak1", "leak12")),
     "mammillary": (lambda n, v: _compartments("mammillary", n, v), range(2, 7), ("leak1", "leak12")),
     "cycle": (lambda n, v: _compartments("cycle", n, v), range(2, 7), ("leak1", "leak12")),
 }
-"""family → (builder(n, variant), sizes, variants)."""
+"""family → (builder(n, variant), sizes, variants (or a function of n giving them))."""
+
+DEFAULT_FAMILIES = tuple(f for f in FAMILIES if f != "chain_at")
+"""The families ``benchmarks/identifiability.py --families`` runs when none is named (``chain_at``, every
+placement of force and sensor on chains of 3 to 8 masses, 116 models, runs only when named)."""
 
 
 def build(name: str):
@@ -131,10 +151,10 @@ def names(families=None, max_parameters: int = 24) -> list[str]:
     """Every model name of the families, up to ``max_parameters`` parameters."""
     out = []
     for fam, (builder, sizes, variants) in FAMILIES.items():
-        if families and fam not in families:
+        if fam not in (families or DEFAULT_FAMILIES):
             continue
         for n in sizes:
-            for v in variants:
+            for v in variants(n) if callable(variants) else variants:
                 if builder(n, v).n_parameters <= max_parameters:
                     out.append(f"{fam}-{n}-{v}")
     return out
