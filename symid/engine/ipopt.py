@@ -146,7 +146,8 @@ class IpoptSolver:
         opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                 "ipopt.max_iter": int(max_iter), "ipopt.tol": float(tol),
                 "ipopt.acceptable_tol": max(float(tol), 1e-12), "ipopt.acceptable_iter": 25,
-                "error_on_fail": False, "show_eval_warnings": False}
+                "error_on_fail": False, "show_eval_warnings": False,
+                "calc_lam_p": False}
         if hessian == "limited-memory":
             opts["ipopt.hessian_approximation"] = "limited-memory"
         if time_limit is not None:
@@ -437,7 +438,8 @@ class ScaledIpopt:
         opts: dict[str, Any] = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                                 "ipopt.max_iter": max_iter, "ipopt.tol": tol,
                                 "ipopt.acceptable_tol": max(tol, 1e-12), "ipopt.acceptable_iter": 25,
-                                "error_on_fail": False, "show_eval_warnings": False}
+                                "error_on_fail": False, "show_eval_warnings": False,
+                                "calc_lam_p": False}
         if self.hessian == "limited-memory":
             opts["ipopt.hessian_approximation"] = "limited-memory"
         if time_limit is not None:

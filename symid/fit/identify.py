@@ -177,7 +177,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                           f"the finished starts are in the exception's .partial result", partial) from None
     result = IdentificationResult.from_starts(estimator.method, model.parameter_names, outcomes,
                                               cost_kind=estimator.cost_kind, options=options_used)
-    if isinstance(estimator, FisherInformation) and np.all(np.isfinite(result.theta_vector)):
+    if (isinstance(estimator, FisherInformation) and np.all(np.isfinite(result.theta_vector))
+            and np.isfinite(result.cost)):  # not where the model cannot be evaluated (e.g. a mass on its bound 0)
         # declared by the estimator (symid.fit.uncertainty): covariance of θ̂ at the best estimate
         result = dataclasses.replace(result, uncertainty=estimator.uncertainty(
             result.theta_vector, model.parameter_names, noise_std=noise_std))
@@ -191,7 +192,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         polished = IdentificationResult.from_starts(f"{estimator.method}+polish", model.parameter_names, [out],
                                                     cost_kind=estimator.cost_kind,
                                                     options={"polish": polisher.method})
-        if isinstance(polisher, FisherInformation) and np.all(np.isfinite(polished.theta_vector)):
+        if (isinstance(polisher, FisherInformation) and np.all(np.isfinite(polished.theta_vector))
+                and np.isfinite(polished.cost)):
             polished = dataclasses.replace(polished, uncertainty=polisher.uncertainty(
                 polished.theta_vector, model.parameter_names, noise_std=noise_std))
         result = dataclasses.replace(result, polished=polished)

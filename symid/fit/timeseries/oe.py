@@ -414,7 +414,10 @@ class OutputError(Estimator, FisherInformation):
                 status, finished = "Maximum_WallTime_Exceeded", False
             v = run.z
             theta = v[:l]
-            need = self._squarings(theta, q) if np.all(np.isfinite(theta)) else s
+            try:
+                need = self._squarings(theta, q) if np.all(np.isfinite(theta)) else s
+            except (np.linalg.LinAlgError, ValueError):  # e.g. M(θ) singular: IPOPT stopped on the bound m = 0
+                need = s
             if need <= s or self._timed_out or status == "User_Requested_Stop":
                 break
             s = need
