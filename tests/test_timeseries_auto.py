@@ -109,7 +109,7 @@ def test_black_box_route_on_a_non_minimal_model_says_why_and_what_works():
     drive = si.SecondOrderModel(M=[[Jm, 0], [0, Jl]], V=[[c + b, -c], [-c, c]], K=[[k, -k], [-k, k]],
                                 B=[[1], [0]], C=[[1, 0]], output="velocity")
     truth = {"Jm": 0.01, "Jl": 0.05, "k": 500.0, "c": 0.05, "b": 0.01}
-    io = si.simulate_io(drive, truth, np.random.default_rng(0).standard_normal(4000), dt=1e-3)
+    io = si.simulate_io(drive, truth, np.random.default_rng(0).standard_normal(1500), dt=1e-3)
     with pytest.raises(si.DataError, match=r"realisation is minimal.*method='auto' \(the default\) or 'oe'"):
         si.identify(drive, io, method="scr", identifiability_check=False)
     res = si.identify(drive, io, x0={"Jm": 0.02, "Jl": 0.02, "k": 300.0, "c": 0.1, "b": 0.02},
