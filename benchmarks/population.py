@@ -80,6 +80,7 @@ from population_models import (  # benchmarks/ (the script's folder) is on the p
     CLASSES,
     RESOLUTION_FLOOR,
     Problem,
+    identifiability_info,
     make_problem,
     resolution,
 )
@@ -294,11 +295,7 @@ def recheck(log: RunLog, timeout: float) -> None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             rep = si.identifiability(p.model, timeout=timeout)
-        info = {**rec["info"], "identifiability": rep.verdict,
-                "verdicts": {k: str(v) for k, v in rep.verdicts.items()},
-                "global_determined": bool(rep.global_determined), "n_solutions": rep.n_solutions,
-                "global": bool(rep.global_determined) and all(str(v) == "global" for v in rep.verdicts.values()),
-                "rechecked": git_commit()}
+        info = {**rec["info"], **identifiability_info(rep), "rechecked": git_commit()}
         seconds = time.perf_counter() - t0
         log.append(rec["key"], {**{k: v for k, v in rec.items() if k != "key"}, "info": info, "check_time": seconds})
         print(f"[{i + 1}/{len(todo)}] {rec['key'].removesuffix('/problem')}: {rec['info'].get('identifiability')} "

@@ -282,6 +282,14 @@ def _draw(cls: str, n: int, rng: np.random.Generator) -> tuple[Any, np.ndarray, 
     raise ValueError(f"unknown class {cls!r}; choose among {', '.join(CLASSES)}")
 
 
+def identifiability_info(rep: Any) -> dict[str, Any]:
+    """What a problem keeps of its identifiability report (``info``)."""
+    return {"identifiability": rep.verdict, "verdicts": {k: str(v) for k, v in rep.verdicts.items()},
+            "global_determined": bool(rep.global_determined), "n_solutions": rep.n_solutions,
+            # globally identifiable: every parameter proven global (never assumed from an undetermined step)
+            "global": bool(rep.global_determined) and all(str(v) == "global" for v in rep.verdicts.values())}
+
+
 def make_problem(cls: str, n: int, index: int, *, seed: int = 0, check: bool = True, timeout: float = 20.0,
                  max_draws: int = 20, draw: int | None = None) -> Problem:
     """Problem ``index`` of class ``cls`` with size ``n``, drawn until it is locally identifiable.
@@ -304,12 +312,7 @@ def make_problem(cls: str, n: int, index: int, *, seed: int = 0, check: bool = T
         info["draw"] = draw
         if check:
             rep = si.identifiability(model, timeout=timeout)
-            info["identifiability"] = rep.verdict
-            info["verdicts"] = {k: str(v) for k, v in rep.verdicts.items()}
-            info["global_determined"] = bool(rep.global_determined)
-            info["n_solutions"] = rep.n_solutions
-            # globally identifiable: every parameter proven global (never assumed from an undetermined step)
-            info["global"] = bool(rep.global_determined) and all(str(v) == "global" for v in rep.verdicts.values())
+            info.update(identifiability_info(rep))
             if any(str(v) == "none" for v in rep.verdicts.values()):
                 refused.append(rep.verdict)
                 continue

@@ -38,10 +38,11 @@ from typing import Any
 
 import numpy as np
 from _study import RESULTS, git_commit  # benchmarks/ (the script's folder) is on the path
+from population import parameter_error as error
+from population import start_success
 from population_models import make_problem
 
 import symid as si
-from symid.fit.success import EXACT_FIT
 from symid.runlog import write_json_atomic
 
 CLASSES = ("chain", "gains", "compartment", "state_space")
@@ -61,10 +62,6 @@ def records(p: Any, noise: float, seed: int = 0) -> Any:
     return si.simulate_io(p.model, p.truth, u, dt, noise=noise or None, seed=seed + 1)
 
 
-def error(theta: Any, truth: np.ndarray) -> float:
-    return float(np.max(np.abs(np.asarray(theta, dtype=float) - truth) / np.abs(truth)))
-
-
 def _fit(cls: str, n: int, draw: int, noise: float, method: str, x0: list[float]) -> dict[str, Any]:
     p = make_problem(cls, n, 0, check=False, draw=draw)
     io = records(p, noise)
@@ -80,16 +77,6 @@ def _fit(cls: str, n: int, draw: int, noise: float, method: str, x0: list[float]
         out = {"theta": None, "cost": None, "success_reported": False, "refused": f"{type(exc).__name__}: {exc}"}
     out["seconds"] = time.perf_counter() - t0
     return out
-
-
-def judged(rec: dict[str, Any], truth: np.ndarray, globally: bool, ref: dict[str, Any] | None) -> bool:
-    if rec["theta"] is None or not np.all(np.isfinite(rec["theta"])):
-        return False
-    err = error(rec["theta"], truth)
-    admissible = bool(np.all(np.asarray(rec["theta"]) > 0))
-    if ref is None:
-        return err <= 1e-3 or (not globally and admissible and rec["cost"] <= EXACT_FIT)
-    return err <= 2 * error(ref["theta"], truth) or (not globally and admissible and rec["cost"] <= 1.001 * ref["cost"])
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -129,7 +116,8 @@ def main(argv: list[str] | None = None) -> int:
             continue
         p = by[name]
         ref = results[(name, noise, "reference", 0, "oe")] if noise else None
-        ok = judged(rec, p.truth, bool(p.info.get("global")), ref)
+        ok = start_success(rec["theta"], rec["cost"], p.truth, np.ones(p.truth.size, bool), bool(p.info.get("global")),
+                           ref)
         rows.append({"problem": name, "noise": noise, "kind": kind, "start": i, "method": m, "success": ok,
                      "error": None if rec["theta"] is None else error(rec["theta"], p.truth), **rec})
         for key in ((p.cls, m, noise, kind), ("all", m, noise, kind)):
