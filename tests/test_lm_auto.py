@@ -209,19 +209,40 @@ def population_models():
         sys.path.remove(bench)
 
 
-def test_restarts_around_the_typical_values_reach_what_restarts_around_the_start_miss(population_models):
-    """A generated 5-mass chain (15 parameters, SI units; not one of the population benchmark's problems) from an
-    uninformed start: the pass from the start and the restart around it end in other basins (measured: 14 passes
-    around the start, 45 s, all missed), the first restart around the typical values reaches the truth.
-    Reference: the true parameters the exact data are simulated from."""
-    p = population_models.make_problem("chain", 5, 4, check=False)
-    frf = p.data(0.0)
-    x0 = p.starts("uninformed", 2, seed=0)[0]
-    with_scale = AutoFRF(p.model, frf, scale=p.typical, restarts=1).run(x0)
-    around_start = AutoFRF(p.model, frf, restarts=1).run(x0)  # no scale: every restart around the start
-    assert with_scale.success and np.max(np.abs(with_scale.theta - p.truth) / p.truth) <= 1e-6
-    assert np.max(np.abs(around_start.theta - p.truth) / p.truth) > 1e-2
+def test_every_other_restart_is_drawn_around_the_typical_values(population_models, monkeypatch):
+    """Restarts 1, 3, … start within a factor ``spread`` of ``scale=`` (the typical values), restarts 2, 4, … within
+    that factor of the start; without ``scale`` every restart is drawn around the start.
 
+    The passes are replaced by a stub that returns its own start (never a fit), so the test sees where each pass
+    begins whatever the floating-point path of the real passes: whether a restart then reaches the truth depends on
+    the machine's rounding (a generated 5-mass chain reached it from the first restart around the typical values on
+    one machine and from none of 3 passes on another), which is measured on populations in
+    ``benchmarks/auto_restarts.py``, not asserted on one start. Reference: the spread of 10 is ``AutoFRF``'s
+    default; the start is 300 times the typical values, so the two centres are 2.5 decades apart in every parameter."""
+    p = population_models.make_problem("chain", 3, 0, check=False)
+    frf = p.data(0.0)
+    x0 = 300.0 * p.typical
+    starts = []
+
+    def stub(self, phi, centre, unit, deadline):
+        theta = self._theta(phi, centre, unit)
+        starts.append(theta)
+        return theta, 1, False
+
+    monkeypatch.setattr(AutoFRF, "_pass", stub)
+    out = AutoFRF(p.model, frf, scale=p.typical, restarts=4, chain_start=False).run(x0)
+    assert not out.success and len(starts) == 5
+    np.testing.assert_allclose(starts[0], x0, rtol=1e-12)
+    spread = np.log(10.0) * (1 + 1e-12)
+    for k, theta in enumerate(starts[1:], start=1):
+        centre = p.typical if k % 2 == 1 else x0
+        assert np.max(np.abs(np.log(theta / centre))) <= spread, (k, theta / centre)
+        other = x0 if k % 2 == 1 else p.typical
+        assert np.min(np.abs(np.log(theta / other))) >= np.log(300.0) - spread, (k, theta / other)
+    starts.clear()
+    AutoFRF(p.model, frf, restarts=4, chain_start=False).run(x0)
+    assert len(starts) == 5
+    assert all(np.max(np.abs(np.log(theta / x0))) <= spread for theta in starts)
 
 def test_a_fit_a_black_box_beats_tenfold_does_not_stop_the_restarts(population_models):
     """The vector fit of the data with the model's order is at rounding level on exact data and no better than

@@ -102,6 +102,7 @@ def _stack(parts: list[tuple[np.ndarray, np.ndarray]], l: int) -> tuple[np.ndarr
 
 _REWEIGHT_MAX = 50
 """Reweighting rounds of :class:`LinearSimilarity2nd` at most (measured: 3–5 on the 2-DOF from 1 %-noise records)."""
+_ROUND_OFF_BLOCK = 1e-12  # a block this much smaller than the largest holds only round-off
 
 
 def _lin(maps: dict[str, Any], name: str, left: np.ndarray | None = None, right: np.ndarray | None = None
@@ -220,6 +221,13 @@ class LinearSimilarity2nd(SimilarityEstimator):
         sizes = np.sqrt(np.bincount(self._block, weights=terms**2))
         return np.where(sizes > 0, sizes, 1.0)
 
+    def block_weights(self, theta: np.ndarray) -> np.ndarray:
+        """Per block, 1 / its size at θ (:meth:`block_sizes`); 0 for a block whose terms are all at round-off
+        (size ≤ 1e-12 of the largest block's): its equations vanish identically for this black box (C B = 0 when
+        positions are measured), and 1 / size would blow its round-off up to the size of the real equations."""
+        sizes = self.block_sizes(theta)
+        return np.where(sizes > _ROUND_OFF_BLOCK * sizes.max(), 1.0 / sizes, 0.0)
+
     def solve(self, t0: float | None = None) -> tuple[np.ndarray, int, str]:
         """θ, the rounds of reweighting and the status: weighted least squares, every block by the size of its
         terms at the previous estimate (the first unweighted), until the estimate stops changing (to 1e-13
@@ -230,7 +238,7 @@ class LinearSimilarity2nd(SimilarityEstimator):
         report = self.progress_reporter(t0)
         theta = np.linalg.lstsq(self._J / self._columns, -self._r0, rcond=None)[0] / self._columns
         for k in range(1, _REWEIGHT_MAX + 1):
-            w = 1.0 / self.block_sizes(theta)[self._block]
+            w = self.block_weights(theta)[self._block]
             Jw = self._J * w[:, None]
             cols = np.linalg.norm(Jw, axis=0)
             cols = np.where(cols > 0, cols, 1.0)
