@@ -313,6 +313,7 @@ def test_more_bad_input_is_refused(kwargs, match):
 
 # -- end to end: output-only identification (issue 6 item 4) -----------------------------------------------
 
+@pytest.mark.slow  # 29 s; the example psd_output_only.py (tests/test_examples.py) runs the same route in CI
 def test_output_only_frame_identified_within_5_percent(frame_spec):
     model = frame_model()
     res = si.identify(model, frame_spec, method="scr", backend="admm", starts=1, seed=0)

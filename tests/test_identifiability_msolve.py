@@ -105,8 +105,13 @@ def _comparable(rep) -> tuple[dict, list]:
     return d, [[s[p] for p in rep.parameters] for s in rep.solutions]
 
 
+# 11-27 s each with both engines at two seeds: run with -m slow (the suite's 10-minute budget)
+SLOW_PARITY = ("compartment_catenary (not identifiable)", "enose_overparameterized",
+               "cycle-3, two leaks (not identifiable)")
+
+
 @needs_msolve
-@pytest.mark.parametrize("name", list(PARITY))
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_PARITY else n for n in PARITY])
 def test_msolve_and_sympy_give_the_same_report(name, no_ladder):
     build, engine = PARITY[name]
     model = build()

@@ -21,7 +21,10 @@ The outcome of a job is ``(status, value)``:
 A child is always killed and reaped (no zombie) on the way out, Ctrl-C in the parent
 included: the child ignores SIGINT (the parent, which receives it too from the
 terminal, stops the child), and a child whose parent has gone (killed with SIGKILL,
-say) exits by itself within ``_ORPHAN_POLL`` seconds, so no orphan keeps computing.
+say) exits by itself within ``_ORPHAN_POLL`` seconds, so no orphan keeps computing. A
+Ctrl-C that strikes after the child is forked but before its caller holds the
+:class:`Running` leaves it to multiprocessing, which ends daemonic children with
+SIGTERM when the parent exits: the child then removes its directory and its group.
 On POSIX the child leads its own process group, and stopping it kills the whole group:
 a program it runs (msolve, :mod:`~symid.structural.msolve`) is stopped with it, at the
 deadline or when the parent has gone. A child killed at its deadline cannot clean up
@@ -86,27 +89,43 @@ def _child(conn, fn, kwargs, parent, scratch):  # pragma: no cover - runs in the
     # first of all: a Ctrl-C that reaches this process before it leads its own group must not end it between
     # creating its directory and watching for its parent (the parent decides, and stops this process)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _lead_own_group()
-    try:  # created here, not by the parent: a parent killed before the fork leaves no directory behind
-        os.mkdir(scratch, 0o700)
-    except OSError as exc:
-        conn.send(("error", (type(exc).__name__, f"the job's temporary directory: {exc}",
-                             traceback.format_exc(limit=8))))
-        conn.close()
-        return
-    tempfile.tempdir = scratch  # this process's temporary files go where the parent removes them
-    _exit_when_orphaned(parent, scratch)
     try:
-        outcome = ("ok", fn(**kwargs))
-    except BaseException as exc:
-        outcome = ("error", (type(exc).__name__, str(exc), traceback.format_exc(limit=8)))
-    try:
-        conn.send(outcome)  # pickled before anything is written: a failure sends nothing
-    except Exception as exc:  # an unpicklable result or message: say so
-        conn.send(("error", (type(exc).__name__, f"the result could not be sent back: {exc!r:.500}",
-                             traceback.format_exc(limit=8))))
+        _lead_own_group()
+        try:  # created here, not by the parent: a parent killed before the fork leaves no directory behind
+            os.mkdir(scratch, 0o700)
+        except OSError as exc:
+            conn.send(("error", (type(exc).__name__, f"the job's temporary directory: {exc}",
+                                 traceback.format_exc(limit=8))))
+            conn.close()
+            return
+        tempfile.tempdir = scratch  # this process's temporary files go where the parent removes them
+
+        def terminated(signum, frame):
+            # SIGTERM: multiprocessing ends the daemonic children a parent never stopped when it exits (a Ctrl-C
+            # that struck while this child was being started, before the parent held it): clean up on the way out
+            shutil.rmtree(scratch, ignore_errors=True)
+            _kill_own_group()
+            os._exit(70)
+
+        signal.signal(signal.SIGTERM, terminated)
+        _exit_when_orphaned(parent, scratch)
+        try:
+            outcome = ("ok", fn(**kwargs))
+        except BaseException as exc:
+            outcome = ("error", (type(exc).__name__, str(exc), traceback.format_exc(limit=8)))
+        try:
+            conn.send(outcome)  # pickled before anything is written: a failure sends nothing
+        except Exception as exc:  # an unpicklable result or message: say so
+            conn.send(("error", (type(exc).__name__, f"the result could not be sent back: {exc!r:.500}",
+                                 traceback.format_exc(limit=8))))
+        finally:
+            conn.close()
     finally:
-        conn.close()
+        # the result went through the pipe, so the directory is no longer needed; removed here too (not only by
+        # the parent's stop()) for a child its parent never held: a Ctrl-C that struck the parent during the fork
+        # reached this process before it ignored SIGINT, and Python raised it a few instructions later, after
+        # the directory was made (seen under load: an empty symid-job-… directory left behind)
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 def _reason(exitcode: int | None) -> str:
@@ -146,21 +165,26 @@ class Running:
         self.started = time.monotonic()
         try:
             self._proc.start()
+            self.pid = self._proc.pid
+            if hasattr(os, "setpgid"):  # also here, so that no stop() can come before the child's own setpgid
+                try:
+                    os.setpgid(self.pid, self.pid)
+                except OSError:  # the child did it first, or has already exited
+                    pass
         except BaseException:  # e.g. Ctrl-C during the start: a child already forked is stopped first
             self._recv.close()
             if self._proc.pid is not None:
+                if hasattr(os, "killpg"):
+                    try:
+                        os.killpg(self._proc.pid, signal.SIGKILL)
+                    except OSError:
+                        pass
                 self._proc.kill()
                 self._proc.join(5)
             shutil.rmtree(self._scratch, ignore_errors=True)
             raise
         finally:
             send.close()  # only the child writes: its death closes the pipe (EOF here)
-        self.pid = self._proc.pid
-        if hasattr(os, "setpgid"):  # also here, so that no stop() can come before the child's own setpgid
-            try:
-                os.setpgid(self.pid, self.pid)
-            except OSError:  # the child did it first, or has already exited
-                pass
 
     @property
     def connection(self):
