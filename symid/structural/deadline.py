@@ -89,10 +89,12 @@ def _child(conn, fn, kwargs, parent, scratch):  # pragma: no cover - runs in the
     # first of all: a Ctrl-C that reaches this process before it leads its own group must not end it between
     # creating its directory and watching for its parent (the parent decides, and stops this process)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    made = False
     try:
         _lead_own_group()
         try:  # created here, not by the parent: a parent killed before the fork leaves no directory behind
             os.mkdir(scratch, 0o700)
+            made = True
         except OSError as exc:
             conn.send(("error", (type(exc).__name__, f"the job's temporary directory: {exc}",
                                  traceback.format_exc(limit=8))))
@@ -125,7 +127,8 @@ def _child(conn, fn, kwargs, parent, scratch):  # pragma: no cover - runs in the
         # the parent's stop()) for a child its parent never held: a Ctrl-C that struck the parent during the fork
         # reached this process before it ignored SIGINT, and Python raised it a few instructions later, after
         # the directory was made (seen under load: an empty symid-job-… directory left behind)
-        shutil.rmtree(scratch, ignore_errors=True)
+        if made:
+            shutil.rmtree(scratch, ignore_errors=True)
 
 
 def _reason(exitcode: int | None) -> str:
