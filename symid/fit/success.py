@@ -91,8 +91,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BLACK_BOX_MARGIN", "CEILING", "EXACT_FIT", "LOCAL_GAIN_LIMIT", "WHITENESS_LIMIT", "FitTest", "fit_test",
-           "physical_check", "whiteness"]
+__all__ = ["BLACK_BOX_MARGIN", "CEILING", "EXACT_FIT", "LOCAL_GAIN_LIMIT", "WHITENESS_LIMIT", "FitTest",
+           "black_box_ratio", "fit_test", "physical_check", "whiteness"]
 
 EXACT_FIT = 1e-10
 """A relative misfit at or below this reproduces the data as noise-free data are reproduced."""
@@ -322,16 +322,36 @@ def fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndarr
                                                 f"from the estimate predicts a misfit {100 * gain:.0f} % lower: not "
                                                 f"a minimum of the misfit ({test.text})")
         return test
+    ratio = black_box_ratio(bb, n_data=n_data, n_parameters=n_parameters)
+    if ratio is None or cost <= ratio * bb[0]:
+        return test
     floor, b = bb
-    if b > n_data / 2 or not np.isfinite(floor):
-        return test
-    ratio = BLACK_BOX_MARGIN * max(n_data - n_parameters, 1) / (n_data - b)
-    if cost <= ratio * floor:
-        return test
     return FitTest(False, "black box", f"misfit {cost:.2e} > {ratio:.3g} × {floor:.2e}, the misfit of a black box "
                                        f"of the model's order ({b} parameters; {BLACK_BOX_MARGIN:g} × (N − l)/(N − b) "
                                        f"with N = {n_data} data, l = {n_parameters}): the data are cleaner than this "
                                        f"fit ({test.text})")
+
+
+def black_box_ratio(black_box: tuple[float, int] | None, *, n_data: int, n_parameters: int) -> float | None:
+    """How many times the misfit of a black box of the model's order a fit may have before the data are cleaner
+    than the fit: ``BLACK_BOX_MARGIN`` (N − l)/(N − b), N data, l parameters, b the black box's (see
+    :func:`fit_test`); ``None`` when there is no black box to compare with (or it has more than N/2
+    parameters, or no finite misfit).
+
+    Examples
+    --------
+    >>> from symid.fit.success import black_box_ratio
+    >>> round(black_box_ratio((1e-9, 10), n_data=60, n_parameters=4), 3)
+    2.24
+    >>> black_box_ratio(None, n_data=60, n_parameters=4) is None
+    True
+    """
+    if black_box is None:
+        return None
+    floor, b = black_box
+    if b > n_data / 2 or not np.isfinite(floor):
+        return None
+    return BLACK_BOX_MARGIN * max(n_data - n_parameters, 1) / (n_data - b)
 
 
 def _fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndarray | None,

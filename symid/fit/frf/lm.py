@@ -37,7 +37,9 @@ in physical units, whatever their scale (measured on the generated population of
    starts within a factor 3 of the truth had returned such a fit 3–12 % off, and all 4
    now reach the truth, tests/test_lm_auto.py),
    three passes end at the same best misfit (a confirmed minimum, e.g. on noisy data
-   whose residual the whiteness rule rejects), ``restarts`` passes are spent, or
+   whose residual the whiteness rule rejects; not when a black box of the model's order
+   fits the data better than noise explains, item 5: then the minimum found again is a
+   local one, and the restarts go on), ``restarts`` passes are spent, or
    ``time_limit`` is reached. The outcome is the best fit found; every pass's time
    counts in the start's. Why the typical values: a start a decade from them on the
    other side of the truth is up to two decades from the truth, and restarts within a
@@ -115,7 +117,7 @@ from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighte
 from symid.fit.options import check_bool, check_float, check_int, check_scale, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.sensitivity import frf_sensitivity
-from symid.fit.success import EXACT_FIT
+from symid.fit.success import EXACT_FIT, black_box_ratio
 
 __all__ = ["AutoFRF", "LmFRF"]
 
@@ -495,7 +497,8 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             if spent:
                 status = "time_limit"
                 break
-            if repeats >= _REPEATS:  # the same minimum from several points: no restart is likely to beat it
+            if repeats >= _REPEATS and not self._cleaner_than(best):
+                # the same minimum from several points: no restart is likely to beat it
                 status = "repeated"
                 break
         assert best is not None
@@ -512,6 +515,16 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                            iterations=total_nfev, wall_time=wall)
         others = tuple(c for c in visited if c is not best)
         return dataclasses.replace(out, passes=others) if others else out
+
+    def _cleaner_than(self, best: StartOutcome) -> bool:
+        """Whether the data are cleaner than ``best``, a fit the success rule refuses: a black box of the model's
+        order fits them more than :func:`~symid.fit.success.black_box_ratio` times better. The minimum found
+        again is then a local one (measured: 3 passes of a 3-mass chain measured away from the driven mass ended at
+        misfit 2.1e-8 on exact data, 120 % off, and the restarts stopped there after 3 s of a 45 s budget)."""
+        if best.success:
+            return False
+        ratio = black_box_ratio(self.black_box(), n_data=self.n_data(), n_parameters=self.model.n_parameters)
+        return ratio is not None and best.cost > ratio * self.black_box()[0]
 
     def polisher(self) -> Any:
         """IPOPT on the same frequency response and noise weighting (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
