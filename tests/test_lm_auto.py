@@ -244,6 +244,34 @@ def test_every_other_restart_is_drawn_around_the_typical_values(population_model
     assert len(starts) == 5
     assert all(np.max(np.abs(np.log(theta / x0))) <= spread for theta in starts)
 
+def test_a_minimum_found_again_stops_the_restarts_only_where_the_data_are_no_cleaner(population_models, monkeypatch):
+    """Three passes ending at the same misfit stop the restarts (a confirmed minimum) unless a black box of the
+    model's order fits the data better than noise explains: on exact data the minimum found again is a local one.
+
+    Every pass is a stub that ends at the same point, 10 % off in every parameter (misfit about 1e-2), so the
+    test does not depend on the floating-point path of real passes. Reference: the exact data of a generated
+    3-mass chain, which the black box fits to rounding (its misfit ≤ 1e-20 here)."""
+    p = population_models.make_problem("chain", 3, 0, check=False)
+    frf = p.data(0.0)
+    off = 1.1 * p.truth
+    passes = []
+
+    def stub(self, phi, centre, unit, deadline):
+        passes.append(1)
+        return off.copy(), 1, False
+
+    monkeypatch.setattr(AutoFRF, "_pass", stub)
+    est = AutoFRF(p.model, frf, scale=p.typical, restarts=6, chain_start=False)
+    assert est.black_box()[0] <= 1e-20
+    out = est.run(p.typical)
+    assert not out.success and len(passes) == 7 and out.status == "max_restarts", out.message
+    passes.clear()
+    est = AutoFRF(p.model, frf, scale=p.typical, restarts=6, chain_start=False)
+    monkeypatch.setattr(AutoFRF, "black_box", lambda self: None)  # no black box: nothing says the data are cleaner
+    out = est.run(p.typical)
+    assert len(passes) == 3 and out.status == "repeated", out.message
+
+
 def test_a_fit_a_black_box_beats_tenfold_does_not_stop_the_restarts(population_models):
     """The vector fit of the data with the model's order is at rounding level on exact data and no better than
     noise allows on 1 % noise (so a correct noisy fit is never doubted); reference: the misfit of the true
