@@ -74,7 +74,11 @@ def test_auto_from_two_decades_off_on_one_percent_noise_matches_ipopt_from_the_t
     assert res.cost <= ref.cost * (1 + 1e-8)
 
 
-def test_lm_alone_can_miss_where_auto_restarts():
+def test_lm_alone_can_miss_where_auto_does_not():
+    """From 6 starts within a decade of the truth on exact data of a 2-mass chain, ``auto`` reaches the truth from
+    all, ``lm`` (one pass, no continuation over frequency bands, no restarts) misses some (measured: 3 of 6, each of
+    ``auto``'s from its first pass: the band continuation makes the difference here, not the restarts). Reference:
+    the values the exact data are simulated from."""
     model = chain2()
     w = grid(TRUTH)
     frf = si.simulate_frf(model, TRUTH, w)
@@ -82,9 +86,7 @@ def test_lm_alone_can_miss_where_auto_restarts():
     lm = [prepare(model, frf, "lm", {}).run(x) for x in starts]
     auto = [prepare(model, frf, "auto", {"seed": 0}).run(x) for x in starts]
     assert all(o.success and relative_parameter_error(o.theta, TRUTH) <= 1e-6 for o in auto)
-    # the restarts are what makes the difference: at least one start needs them
-    assert sum(o.success for o in lm) <= len(starts)
-    assert max(int(o.message.split(" pass")[0].split()[-1]) for o in auto) >= 1
+    assert sum(relative_parameter_error(o.theta, TRUTH) > 1e-3 for o in lm) >= 1
 
 
 def test_time_limit_and_callback_stop_a_start():
