@@ -246,6 +246,7 @@ def test_every_other_restart_is_drawn_around_the_typical_values(population_model
     assert len(starts) == 5
     assert all(np.max(np.abs(np.log(theta / x0))) <= spread for theta in starts)
 
+
 def test_a_minimum_found_again_stops_the_restarts_only_where_the_data_are_no_cleaner(population_models, monkeypatch):
     """Three passes ending at the same misfit stop the restarts (a confirmed minimum) unless a black box of the
     model's order fits the data better than noise explains: on exact data the minimum found again is a local one.
