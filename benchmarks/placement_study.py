@@ -83,7 +83,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         for n in sizes:
             for p in _problems(n, args.problems, args.first, args.check_timeout):
                 globally = p.info.get("identifiability") == "global"
-                positive = np.ones(p.truth.size, dtype=bool)
+                positive = np.asarray(p.model.positive, dtype=bool)
                 for k in range(args.starts):
                     fut = pool.submit(_run, p.cls, n, int(p.name.rsplit("-", 1)[1]), p.info["draw"], k, args.starts,
                                       args.time_limit)

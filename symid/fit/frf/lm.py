@@ -523,8 +523,9 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         misfit 2.1e-8 on exact data, 120 % off, and the restarts stopped there after 3 s of a 45 s budget)."""
         if best.success:
             return False
-        ratio = black_box_ratio(self.black_box(), n_data=self.n_data(), n_parameters=self.model.n_parameters)
-        return ratio is not None and best.cost > ratio * self.black_box()[0]
+        bb = self.black_box()
+        ratio = black_box_ratio(bb, n_data=self.n_data(), n_parameters=self.model.n_parameters)
+        return ratio is not None and best.cost > ratio * bb[0]
 
     def polisher(self) -> Any:
         """IPOPT on the same frequency response and noise weighting (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
