@@ -335,7 +335,9 @@ def test_admm_warm_start_and_tightening():
     assert sol.success, sol.message
     inner = sol.info["inner_iterations"]
     # warm start across SCR iterations: the cold first sub-problem costs far more ADMM steps than the next ones
-    assert inner[0] > 10 * np.median(inner[1:10])
+    # (measured 545 against a median of 50; an ADMM step count moves with the machine's rounding, so the margin
+    # asserted is wide)
+    assert inner[0] > 3 * np.median(inner[1:10])
     # with loose ADMM tolerances the reachable bilinear residual is capped near them, unless the
     # tolerances are tightened to the residual as SCR converges (ADMMOptions.tighten)
     loose = {"eps_rel": 1e-4, "eps_abs": 1e-5}

@@ -8,8 +8,9 @@ import pytest
 
 import symid as si
 from symid.fit.frf.modal import black_box_start
-from symid.fit.frf.scale import parameter_roles, typical_scale
+from symid.fit.frf.scale import ZETA0, parameter_roles, typical_scale
 from symid.fit.starts import draw_starts
+from symid.fit.timeseries.scale import typical_scale as ts_typical_scale
 
 
 def chain(n_units=1.0, t_units=1.0):
@@ -80,8 +81,62 @@ def test_bad_draws_are_named(kwargs, match):
 def test_data_without_typical_values_need_a_scale():
     k, g = si.parameters("k g", positive=True)
     model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    t = np.cumsum(np.random.default_rng(1).uniform(0.05, 0.15, 200))  # non-uniform samples: no frequency response
     io = si.simulate_io(model, [0.5, 2.0], np.random.default_rng(0).standard_normal(200), dt=0.1)
+    ts = si.TimeSeries(t=t, u=io.u, y=io.y)
+    assert ts_typical_scale(model, ts) is None
     with pytest.raises(si.OptionError, match="needs typical values: give scale="):
-        draw_starts(model, io, 3, seed=0, draws="scale")
-    x = np.array(draw_starts(model, io, 3, seed=0, draws="scale", scale=[0.5, 2.0]))
+        draw_starts(model, ts, 3, seed=0, draws="scale")
+    x = np.array(draw_starts(model, ts, 3, seed=0, draws="scale", scale=[0.5, 2.0]))
     assert np.all(np.abs(np.log(x / [0.5, 2.0])) <= np.log(3) + 1e-12)
+    normal = np.array(draw_starts(model, ts, 50, seed=0))  # the default there: the thesis's N(0, 1) draws
+    assert np.all(normal >= 0) and np.max(normal) < 6
+
+
+def _record(model, truth, noise=None):
+    """A white-noise record of ``model``: 10 samples per period of the fastest mode, 20 periods of the slowest
+    (as benchmarks/timeseries_population.py draws them)."""
+    lam = np.abs(np.linalg.eigvals(model.state_space(truth).A))
+    lam = lam[lam > 0]
+    dt = 2 * np.pi / (10 * lam.max())
+    n = int(min(4000, max(500, 20 * 2 * np.pi / lam.min() / dt)))
+    u = np.random.default_rng(3).standard_normal(n)
+    return si.simulate_io(model, truth, u, dt, noise=noise, seed=4)
+
+
+@pytest.mark.parametrize(("n_units", "t_units"), [(1.0, 1.0), (1e-3, 1.0), (1e6, 1e-3), (1.0, 1e3)])
+def test_time_series_give_typical_values_within_a_factor_ten_in_any_units(n_units, t_units):
+    model, truth = chain(n_units, t_units)
+    io = _record(model, truth, noise=0.01)
+    typ = ts_typical_scale(model, io)
+    # the frequency response of the record (Welch H1), then the dimensional analysis tested above: masses and
+    # springs within a factor 10; a damper's guess assumes a damping ratio ZETA0 = 0.05, and this chain's modes
+    # have less (the smallest ratio zeta_min), so its dampers may be off by ZETA0 / zeta_min more
+    lam = np.linalg.eigvals(model.state_space(truth).A)
+    zeta_min = float(np.min(-lam.real / np.abs(lam)))
+    off = np.abs(np.log10(typ / truth))
+    dampers = np.array([name.startswith("c") for name in model.parameter_names])
+    assert np.all(off[~dampers] < 1)
+    assert np.all(off[dampers] < 1 + np.log10(ZETA0 / zeta_min))
+    np.testing.assert_allclose(ts_typical_scale(model, si.TimeSeries.from_iodata(io)), typ, rtol=1e-12)
+    np.testing.assert_allclose(ts_typical_scale(model, [io, io]), typ, rtol=1e-9)  # records averaged
+
+
+def test_time_series_with_zero_input_give_no_typical_values():
+    model, truth = chain()
+    io = _record(model, truth)
+    free = si.IOData(u=np.zeros_like(io.u), y=io.y, dt=io.dt)
+    assert ts_typical_scale(model, free) is None
+
+
+def test_default_draws_on_time_series_are_at_the_data_scale():
+    model, truth = chain()
+    io = _record(model, truth)
+    typ = ts_typical_scale(model, io)
+    x = np.array(draw_starts(model, io, 50, seed=0))
+    assert np.all(np.abs(np.log(x / typ)) <= np.log(3) + 1e-12)  # log-uniform within a factor 3, not N(0, 1)
+    only = draw_starts(model, io, 1, seed=0, x0=truth)  # a user's start alone: nothing drawn
+    assert len(only) == 1
+    np.testing.assert_array_equal(only[0], truth)
+    given = np.array(draw_starts(model, io, 20, seed=0, scale=truth))  # the user's scale= wins
+    assert np.all(np.abs(np.log(given / truth)) <= np.log(3) + 1e-12)

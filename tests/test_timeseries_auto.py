@@ -10,6 +10,7 @@ import pytest
 
 import symid as si
 from symid.data.timeseries import TimeSeries
+from symid.fit.success import EXACT_FIT
 from symid.fit.timeseries.response import simulate_output
 
 PK_TRUTH = {"k10": 0.3, "k12": 0.8, "k21": 0.2, "q": 0.05}
@@ -40,8 +41,11 @@ def test_the_default_method_for_non_uniform_samples_is_auto():
     A, B, C, D = model.state_space(PK_TRUTH)
     y = simulate_output(A, B, C, D, t, np.zeros((t.size, 1)), model.initial_state(PK_TRUTH))
     ts = TimeSeries(t, np.zeros(t.size), y)
-    res = si.identify(model, ts, x0={"k10": 1.0, "k12": 1.0, "k21": 1.0, "q": 1.0}, identifiability_check=False)
+    # a start within a factor 2 of the truth: from all-ones the passes are chaotic (a start 1e-12 away took 1 to 7
+    # passes, and 1 of 65 such starts ended at a 0.56 % misfit that the whiteness rule of 15 samples accepts)
+    res = si.identify(model, ts, x0={"k10": 0.6, "k12": 0.4, "k21": 0.4, "q": 0.1}, identifiability_check=False)
     assert res.method == "auto" and res.success
+    assert res.cost <= EXACT_FIT  # noise-free samples: an exact fit, not one the whiteness rule lets pass
     for name, value in PK_TRUTH.items():  # noise-free samples: the truth to the solver's tolerance
         assert res.theta[name] == pytest.approx(value, rel=1e-6)
 

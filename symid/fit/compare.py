@@ -245,7 +245,7 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     draws : {"scale", "normal"}, optional
         How the random starts are drawn, as in :func:`symid.identify`; with ``"scale"``,
         the typical values are the first compared method's ``scale=`` option, else the
-        data's (frequency responses).
+        data's (frequency responses; time series through their frequency response).
     executor : concurrent.futures.Executor, optional
         Run the starts of each method as tasks of this executor: a
         ``concurrent.futures.ProcessPoolExecutor`` on one machine, or a Dask cluster's

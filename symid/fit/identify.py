@@ -62,8 +62,13 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         On a frequency response without ``x0``, the first start is the black-box start
         (:func:`symid.fit.frf.modal.black_box_start`: the model's poles placed on those
         of a vector fit of the data), and the draws are around its magnitudes.
-        ``"normal"`` (default for other data): N(0, 1), positive parameters in absolute
-        value, and θ = 0 first for a state-space model, as in the thesis (ch. 3-4).
+        On time series the draws are ``"scale"`` too by default when there are typical
+        values: ``scale=``, else those read off the records' frequency response
+        (:func:`symid.fit.timeseries.scale.typical_scale`: Welch H1, then the same
+        dimensional analysis; none for non-uniform samples or a zero input).
+        ``"normal"`` (default for other data, and for time series without typical
+        values): N(0, 1), positive parameters in absolute value, and θ = 0 first for a
+        state-space model, as in the thesis (ch. 3-4).
     seed : int, optional
         Seed of the random starts (``None``: a fresh one).
     polish : bool

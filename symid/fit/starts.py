@@ -7,7 +7,8 @@ declares its parameters, and whatever other parameters it has. Two distributions
 - ``"normal"``: N(0, 1), in absolute value for parameters declared positive (the
   thesis's starts, chapters 3-4);
 - ``"scale"``, around typical values s (the user's ``scale=``, or
-  :func:`symid.fit.frf.scale.typical_scale` from a frequency response): s · 3^U(−1, 1)
+  :func:`symid.fit.frf.scale.typical_scale` from a frequency response, or
+  :func:`symid.fit.timeseries.scale.typical_scale` from time series): s · 3^U(−1, 1)
   for parameters declared positive (log-uniform within a factor 3 of s), s · N(0, 1) for
   the others — starts of the right physical order of magnitude, no wider than the
   typical values are uncertain (the restarts of method ``"auto"`` search wider).
@@ -130,7 +131,9 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         (:func:`symid.fit.frf.modal.black_box_start`) first when there is one, and its
         magnitudes as the typical values unless ``scale`` is given.
         ``"normal"``: N(0, 1), with θ = 0 first for a state-space model (the thesis).
-        Default: ``"scale"`` for a frequency response, ``"normal"`` for other data.
+        Default: ``"scale"`` for a frequency response, or when ``scale`` is given, or
+        when the data give typical values of their own (time series, unless there is
+        only ``x0`` to return); ``"normal"`` otherwise.
     scale : float or array_like, optional
         The user's typical values (the methods' ``scale=`` option).
     black_box : bool, optional
@@ -153,14 +156,23 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
     from symid.fit.registry import data_kind
 
     kind = data_kind(data)
+    typical = None
     if draws is None:
-        draws = "scale" if kind.name == "frequency response" else "normal"
+        if kind.name == "frequency response" or scale is not None:
+            draws = "scale"
+        elif x0 is None or starts > 1:
+            # data that give typical values of their own (time series, through their frequency response): starts at
+            # the data's physical scale rather than N(0, 1) (measured: benchmarks/timeseries_defaults.py)
+            typical = kind.typical_scale(model, data)
+            draws = "normal" if typical is None else "scale"
+        else:
+            draws = "normal"  # the user's start alone
     draws = check_choice("draws", draws, DRAWS)
     if draws == "normal":
         return make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
     if scale is not None:
         typical = np.abs(check_scale("scale", scale, model.n_parameters))
-    else:
+    elif typical is None:
         typical = kind.typical_scale(model, data)
         if typical is None:
             raise OptionError(f"draws='scale' needs typical values: give scale= (one value or one per parameter); "

@@ -33,8 +33,9 @@ from typing import Any
 from symid.data import IOData
 from symid.errors import DataError, OptionError
 from symid.fit.base import Estimator
+from symid.fit.timeseries.scale import typical_scale
 
-__all__ = ["BLACK_BOX_METHODS", "METHODS", "prepare"]
+__all__ = ["BLACK_BOX_METHODS", "METHODS", "prepare", "typical_scale"]
 
 BLACK_BOX_METHODS = ("scr", "als", "gb", "ipopt", "ls")
 METHODS = ("auto", "oe", "svf", "srivc", *BLACK_BOX_METHODS)
