@@ -85,7 +85,8 @@ def main(argv: list[str] | None = None) -> int:
     out = RESULTS / "timeseries_defaults.json"
     kept = []  # rows of the ways not run now, from the last results
     if set(run_draws) != set(DRAWS) and out.exists():
-        kept = [r for r in json.loads(out.read_text())["rows"] if r["draws"] not in run_draws]
+        last = json.loads(out.read_text())
+        kept = [{"commit": last["git_commit"], **r} for r in last["rows"] if r["draws"] not in run_draws]
     t_all = time.perf_counter()
     problems = []
     for cls in CLASSES:
@@ -144,7 +145,8 @@ def main(argv: list[str] | None = None) -> int:
             table.append(row)
             print(f"{cls:12s} {d:6s} {row['exact']:>7s} {row['1 %']:>7s} {row['median_s']:8.1f}")
     write_json_atomic(out, {"benchmark": "timeseries_defaults", "command": "benchmarks/timeseries_defaults.py",
-                            "git_commit": commit, "commits": sorted({r.get("commit", "?") for r in rows}), "sizes": sizes, "seeds": seeds,
+                            "git_commit": commit, "commits": sorted({r["commit"] for r in rows}), "sizes": sizes,
+                            "seeds": seeds,
                             "time_limit": args.time_limit, "table": table, "rows": rows,
                             "wall_time": time.perf_counter() - t_all,
                             "machine": {"platform": platform.platform(), "python": platform.python_version()}})

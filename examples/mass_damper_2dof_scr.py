@@ -63,7 +63,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  random starts: {ok}/{n_random} reach relative error ≤ 1e-3 (thesis: 6 of 10 within 200 iterations, "
               "8 eventually)")
         print(f"  zero start: relative error {err:.1e} after {res.iterations} iterations; {res.message}")
-        assert ok >= (2 if quick else 8), ok
+        # the full run's claim is the thesis's rate (8 of 10); three quick starts only show that SCR reaches the
+        # truth: at a rate of 8/10, 2 of 3 would fail one machine in ten by chance, 1 of 3 one in a hundred
+        assert ok >= (1 if quick else 8), ok
         best[output] = min(rows[:n_random], key=lambda r: r[1].cost)[1].theta_vector
     if quick:
         return 0
