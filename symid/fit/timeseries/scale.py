@@ -5,8 +5,9 @@ says at which frequencies the system answers and how strongly, and that is all t
 dimensional analysis of :func:`symid.fit.frf.scale.typical_scale` needs (the band centre
 and the response level). So the records are turned into a frequency response
 (:func:`symid.estimate_frf`, Welch's H1 with its default segments, the lines where the
-input is excited) and the typical values are read off it as for measured frequency
-responses. The estimate is coarse (its resolution smooths lightly damped modes, and the
+input is excited, below half the Nyquist frequency where the zero-order hold and
+aliasing bend it little) and the typical values are read off it as for measured
+frequency responses. The estimate is coarse (its resolution smooths lightly damped modes, and the
 zero-order hold bends it near the Nyquist frequency), which does not matter here: the
 result is an order of magnitude to draw starts around, never a start itself (fitting
 that estimate as a start for output error was measured and not kept, see
@@ -90,9 +91,9 @@ def typical_scale(model: Any, data: Any) -> np.ndarray | None:
     if frf.w.size < 3 or not np.any(np.abs(frf.H) > 0):
         return None
     # near the Nyquist frequency π/dt the samples' response is not the model's: the zero-order hold scales it by
-    # sinc(ω dt / 2) (0.64 at π/dt) and aliasing folds the rest back (measured: an acceleration output 8 times
-    # low at π/dt, springs and dampers then 1.2-2.3 decades off on benchmarks/timeseries_population.py's
-    # records). Below π/(2 dt) the hold's factor is above 0.9
+    # sinc(ω dt / 2) (0.64 at π/dt) and aliasing folds the rest back; below π/(2 dt) the hold's factor is above
+    # 0.9. Measured on the 2-mass chain of benchmarks/timeseries_population.py (acceleration output, 8 times low
+    # at π/dt): its springs came out 1.7 and 1.2 decades off with every line, 1.0 and 0.5 with these
     w = np.asarray(frf.w, dtype=float)
     keep = w <= _HOLD_BAND * np.pi / common
     if np.count_nonzero(keep) < 3:
