@@ -48,7 +48,9 @@ def test_single_bolus_identifies_the_two_compartment_model_noise_free():
     """Non-uniform samples, u ≡ 0, x0 = dose in compartment 1: θ to 1e-6 (measured 2.4e-11)."""
     model = pk_model()
     res = si.identify(model, pk_record(model), method="oe", x0=START, identifiability_check=False)
-    assert res.success and res.status == "Solve_Succeeded"
+    # success, θ and the misfit, not IPOPT's status: the first run often stops at max_iter and the status is then
+    # that of its rerun from the best iterate (a start 1e-12 away took 41 to 522 iterations in all)
+    assert res.success
     for name, value in TRUTH.items():
         assert res.theta[name] == pytest.approx(value, rel=1e-6)
     assert res.cost <= 1e-18  # measured 2.5e-24
