@@ -31,7 +31,6 @@ import argparse
 import json
 import platform
 import time
-import warnings
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from typing import Any
@@ -40,32 +39,11 @@ import numpy as np
 from _study import RESULTS, git_commit  # benchmarks/ (the script's folder) is on the path
 from population import parameter_error as error
 from population import start_success
-from population_models import make_problem
-from timeseries_population import CLASSES, NOISES, records
+from timeseries_population import CLASSES, NOISES, fit, problem_list
 
-import symid as si
 from symid.runlog import write_json_atomic
 
 DRAWS = ("normal", "scale")
-
-
-def _fit(cls: str, n: int, draw: int, noise: float, draws: str | None, seed: int, x0: list[float] | None,
-         time_limit: float) -> dict[str, Any]:
-    p = make_problem(cls, n, 0, check=False, draw=draw)
-    io = records(p, noise)
-    t0 = time.perf_counter()
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            res = si.identify(p.model, io, x0=x0, seed=seed, draws=draws, identifiability_check=False,
-                              time_limit=time_limit, **({"method": "oe"} if x0 is not None else {}))
-        out = {"theta": res.theta_vector.tolist(), "cost": float(res.cost), "success_reported": bool(res.success),
-               "status": res.status, "refused": None}
-    except si.SymidError as exc:
-        out = {"theta": None, "cost": None, "success_reported": False, "status": "refused",
-               "refused": f"{type(exc).__name__}: {exc}"}
-    out["seconds"] = time.perf_counter() - t0
-    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -88,12 +66,7 @@ def main(argv: list[str] | None = None) -> int:
         last = json.loads(out.read_text())
         kept = [{"commit": last["git_commit"], **r} for r in last["rows"] if r["draws"] not in run_draws]
     t_all = time.perf_counter()
-    problems = []
-    for cls in CLASSES:
-        for n in sizes:
-            p = make_problem(cls, n, 0)
-            problems.append(p)
-            print(f"{p.name}: {p.model.n_parameters} parameters, {p.info['identifiability']}", flush=True)
+    problems = problem_list(sizes)
     jobs: dict[tuple, Any] = {}
     # a fresh process per fit: CasADi keeps what an output-error solver built (timeseries_population.py)
     with ProcessPoolExecutor(max_workers=args.workers, mp_context=get_context("spawn"), max_tasks_per_child=1) as pool:
@@ -101,11 +74,12 @@ def main(argv: list[str] | None = None) -> int:
             for noise in NOISES:
                 if noise:
                     jobs[(p.name, noise, "reference", 0)] = pool.submit(
-                        _fit, p.cls, p.n_size, p.info["draw"], noise, None, 0, p.truth.tolist(), args.time_limit)
+                        fit, p.cls, p.n_size, p.info["draw"], noise, "oe", p.truth.tolist(), time_limit=args.time_limit)
                 for d in run_draws:
                     for s in seeds:
                         jobs[(p.name, noise, d, s)] = pool.submit(
-                            _fit, p.cls, p.n_size, p.info["draw"], noise, d, s, None, args.time_limit)
+                            fit, p.cls, p.n_size, p.info["draw"], noise, None, None, time_limit=args.time_limit,
+                            seed=s, draws=d)
         results = {}
         for k, f in jobs.items():
             results[k] = f.result()

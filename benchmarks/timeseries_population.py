@@ -62,21 +62,35 @@ def records(p: Any, noise: float, seed: int = 0) -> Any:
     return si.simulate_io(p.model, p.truth, u, dt, noise=noise or None, seed=seed + 1)
 
 
-def _fit(cls: str, n: int, draw: int, noise: float, method: str, x0: list[float]) -> dict[str, Any]:
+def fit(cls: str, n: int, draw: int, noise: float, method: str | None, x0: list[float] | None, *,
+        time_limit: float = TIME_LIMIT, seed: int | None = None, draws: str | None = None) -> dict[str, Any]:
+    """One ``si.identify`` on the problem's record (``method=None``: the default), as a JSON-able record."""
     p = make_problem(cls, n, 0, check=False, draw=draw)
     io = records(p, noise)
     t0 = time.perf_counter()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            res = si.identify(p.model, io, method=method, x0=x0, identifiability_check=False,
-                              time_limit=TIME_LIMIT)
+            res = si.identify(p.model, io, method=method, x0=x0, seed=seed, draws=draws, identifiability_check=False,
+                              time_limit=time_limit)
         out = {"theta": res.theta_vector.tolist(), "cost": float(res.cost), "success_reported": bool(res.success),
-               "refused": None}
+               "status": res.status, "refused": None}
     except si.SymidError as exc:
-        out = {"theta": None, "cost": None, "success_reported": False, "refused": f"{type(exc).__name__}: {exc}"}
+        out = {"theta": None, "cost": None, "success_reported": False, "status": "refused",
+               "refused": f"{type(exc).__name__}: {exc}"}
     out["seconds"] = time.perf_counter() - t0
     return out
+
+
+def problem_list(sizes: list[int]) -> list[Any]:
+    """The benchmark's problems (one per class and size, each checked with si.identifiability), printed."""
+    problems = []
+    for cls in CLASSES:
+        for n in sizes:
+            p = make_problem(cls, n, 0)
+            problems.append(p)
+            print(f"{p.name}: {p.model.n_parameters} parameters, {p.info['identifiability']}", flush=True)
+    return problems
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -87,12 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     sizes = [int(v) for v in args.sizes.split(",") if v]
     t_all = time.perf_counter()
-    problems = []
-    for cls in CLASSES:
-        for n in sizes:
-            p = make_problem(cls, n, 0)
-            problems.append(p)
-            print(f"{p.name}: {p.model.n_parameters} parameters, {p.info['identifiability']}", flush=True)
+    problems = problem_list(sizes)
     jobs: dict[tuple, Any] = {}
     # a fresh process per fit: CasADi keeps what an output-error solver built (1.7 GB for 4000 samples of a 3-mass
     # chain, 3 GB for auto's restarts), and a long-lived worker grew past the machine's 24 GB
@@ -101,12 +110,12 @@ def main(argv: list[str] | None = None) -> int:
             for noise in NOISES:
                 if noise:
                     jobs[(p.name, noise, "reference", 0, "oe")] = pool.submit(
-                        _fit, p.cls, p.n_size, p.info["draw"], noise, "oe", p.truth.tolist())
+                        fit, p.cls, p.n_size, p.info["draw"], noise, "oe", p.truth.tolist())
                 for kind in KINDS:
                     for i, x0 in enumerate(p.starts(kind, args.starts, seed=0)):
                         for m in METHODS:
                             jobs[(p.name, noise, kind, i, m)] = pool.submit(
-                                _fit, p.cls, p.n_size, p.info["draw"], noise, m, x0.tolist())
+                                fit, p.cls, p.n_size, p.info["draw"], noise, m, x0.tolist())
         results = {k: f.result() for k, f in jobs.items()}
     rows = []
     by = {p.name: p for p in problems}
