@@ -66,6 +66,27 @@ def test_time_limit_stops_the_start_after_the_iteration_that_exceeds_it(io):
     assert OutputError(oscillator(), io, time_limit=60.0).run(START).status == "Solve_Succeeded"
 
 
+def test_building_the_solver_counts_in_the_time_limit(io):
+    # a build of 1 s (slept, standing in for CasADi's, which takes 2-10 s on 4000 samples of a 3-mass chain) and a
+    # budget of 1.2 s: the start stops after the first iteration that ends past 1.2 s, 1.3 s in (0.3 s per
+    # iteration), not 1.2 s after the build (2.2 s and more)
+    def crawl(info):
+        time.sleep(0.3)
+        return False
+
+    est = OutputError(oscillator(), io, time_limit=1.2, callback=crawl)
+    build = est._solver
+
+    def slow_build(s_max):
+        time.sleep(1.0)
+        return build(s_max)
+
+    est._solver = slow_build
+    out = est.run(START)
+    assert out.status == "Maximum_WallTime_Exceeded"
+    assert 1.2 <= out.wall_time < 2.0, out.wall_time
+
+
 def test_bad_progress_options_are_named(io):
     with pytest.raises(OptionError, match="callback"):
         OutputError(oscillator(), io, callback=3)

@@ -141,8 +141,8 @@ class OutputError(Estimator, FisherInformation):
         "Search_Direction_Becomes_Too_Small" at the optimum); divided by the start's
         decade of the objective as :class:`~symid.engine.ipopt.ScaledIpopt` does.
     time_limit : float, optional
-        Wall-time budget of one start in seconds from its first IPOPT iteration (the
-        first start also builds the solver), checked after every iteration (status
+        Wall-time budget of one start in seconds, building its solver included (the
+        first start builds it), checked after every iteration (status
         ``"Maximum_WallTime_Exceeded"``). Default: none.
     callback : callable, optional
         Called after every IPOPT iteration with a
@@ -215,6 +215,7 @@ class OutputError(Estimator, FisherInformation):
         self._lower = positivity_bounds(model.positive, self._positivity, np.ones(l))[0]
         self._solvers: dict[int, ScaledIpopt] = {}
         self._residual_fns: dict[int, Any] = {}
+        self._graphs: dict[int, tuple[Any, Any, Any]] = {}  # (v, q, r) per number of squarings, built once
 
     # -- the data kind's part ------------------------------------------------------------------
     def _matrices(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -281,7 +282,12 @@ class OutputError(Estimator, FisherInformation):
     def _symbolic(self, s_max: int) -> tuple[Any, Any, Any]:
         """Unknowns v = (θ, estimated initial states) in their own units, the balancing q = (d, e) of the
         exponential (:func:`~symid.fit.timeseries.response.balancing`) and the weighted residual vector
-        r(v, q) (cost = ‖r‖²)."""
+        r(v, q) (cost = ‖r‖²); built once per ``s_max``, shared by the solver and :meth:`jacobian`."""
+        if s_max not in self._graphs:
+            self._graphs[s_max] = self._build_symbolic(s_max)
+        return self._graphs[s_max]
+
+    def _build_symbolic(self, s_max: int) -> tuple[Any, Any, Any]:
         l, n, m = self.model.n_parameters, self.model.n_states, self.model.n_inputs
         E = len(self.records)
         v = ca.SX.sym("v", l + (n * E if self._estimate_x0 else 0))
@@ -400,13 +406,11 @@ class OutputError(Estimator, FisherInformation):
         v = self._unknowns(start)
         scale = self._unknown_scale(v)
         theta, iters, status, finished = start, 0, "not run", False
-        self._deadline = None
+        self._deadline = None if self._time_limit is None else t0 + self._time_limit  # building counts
         self._timed_out = False
         for _ in range(3):
             self._iterations_before = iters  # a new round starts where the last ended: the same iterate, number
             solver = self._solver(s)
-            if self._deadline is None and self._time_limit is not None:  # from the first solve, once it is built
-                self._deadline = time.perf_counter() + self._time_limit
             run = solver.solve(v, scale=scale, values=q)
             iters += run.iterations
             status, finished = run.status, run.finished
