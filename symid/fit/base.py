@@ -34,7 +34,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from symid.errors import OptionError
+from symid.errors import OptionError, SymidError
 from symid.fit.options import (
     check_bool,
     check_callback,
@@ -120,9 +120,34 @@ class Estimator(abc.ABC):
         return 0
 
     def local_gain(self, theta: np.ndarray) -> float | None:
-        """The fraction of the misfit one Gauss–Newton step from θ predicts to remove, for data kinds without a black
-        box (:mod:`symid.fit.success`); ``None`` (default) when not computed."""
-        return None
+        """‖P_J r‖² / ‖r‖²: the fraction of the misfit one Gauss–Newton step from θ predicts to remove, for data kinds
+        without a black box (:mod:`symid.fit.success`), from the residual r (cost ∝ ‖r‖²) and its Jacobian J of the
+        estimator's ``jacobian`` (columns of parameters at their bound 0 left out, directions below 1e-8 of the
+        largest singular value ignored); ``None`` when the estimator has no ``jacobian`` or it cannot be evaluated."""
+        jacobian = getattr(self, "jacobian", None)
+        if jacobian is None:
+            return None
+        th = np.asarray(theta, dtype=float).reshape(-1)
+        try:
+            r, J = jacobian(th)
+        except (SymidError, ValueError, ArithmeticError, np.linalg.LinAlgError):  # a pole on a line, singular M
+            return None
+        r, J = np.asarray(r, dtype=float).reshape(-1), np.asarray(J, dtype=float)
+        if not (np.all(np.isfinite(r)) and np.all(np.isfinite(J))) or not np.any(r):
+            return None
+        pos = np.asarray(self.model.positive, dtype=bool)
+        at_bound = pos & (th <= 1e-9 * float(np.max(np.abs(th), initial=0.0)))
+        free = np.concatenate([~at_bound, np.ones(J.shape[1] - th.size, dtype=bool)])  # nuisance unknowns: free
+        J = J[:, free]
+        if J.shape[1] == 0:
+            return None
+        norms = np.linalg.norm(J, axis=0)
+        J = J / np.where(norms > 0, norms, 1.0)
+        U, S, _ = np.linalg.svd(J, full_matrices=False)
+        if S.size == 0 or S[0] == 0:
+            return None
+        U = U[:, S > 1e-8 * S[0]]
+        return float(np.sum((U.T @ r) ** 2) / np.sum(r**2))
 
     def black_box(self) -> tuple[float, int] | None:
         """``(misfit, b)`` of a black box of the model's order fitted to the data, in the same misfit, with its

@@ -212,30 +212,6 @@ class SpectraEstimator(Estimator, SpectraFisher):
         """:func:`spectral_residuals` at θ."""
         return spectral_residuals(self.model, self.data, theta)
 
-    def local_gain(self, theta: np.ndarray) -> float | None:
-        """‖P_J r‖² / ‖r‖²: the fraction of the misfit one Gauss–Newton step predicts to remove (r and J of the
-        misfit, :meth:`jacobian`; columns of parameters at their bound 0 left out, directions below 1e-8 of the
-        largest singular value ignored); ``None`` if not evaluable."""
-        th = np.asarray(theta, dtype=float).reshape(-1)
-        try:
-            r, J = self.jacobian(th)
-        except (ModelError, ValueError, ArithmeticError, np.linalg.LinAlgError):  # a pole on a line, singular M
-            return None
-        if not (np.all(np.isfinite(r)) and np.all(np.isfinite(J))) or not np.any(r):
-            return None
-        pos = np.asarray(self.model.positive, dtype=bool)
-        free = ~(pos & (th <= 1e-9 * float(np.max(np.abs(th), initial=0.0))))
-        J = J[:, free]
-        if J.shape[1] == 0:
-            return None
-        norms = np.linalg.norm(J, axis=0)
-        J = J / np.where(norms > 0, norms, 1.0)
-        U, S, _ = np.linalg.svd(J, full_matrices=False)
-        if S.size == 0 or S[0] == 0:
-            return None
-        U = U[:, S > 1e-8 * S[0]]
-        return float(np.sum((U.T @ r) ** 2) / np.sum(r**2))
-
     def n_data(self) -> int:
         """s·p² real values (a Hermitian p×p spectrum per frequency)."""
         Phi = np.asarray(self.data.Phi_yy)
