@@ -435,7 +435,7 @@ def _fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndar
                                                f"floor given")
         ok = z <= WHITENESS_LIMIT
         reach = whiteness_reach(residuals)
-        if ok and reach < WHITENESS_POWER:  # a verdict only a black box can back (fit_test)
+        if ok and reach < WHITENESS_POWER:  # a verdict a black box or a Gauss–Newton step must back (fit_test)
             return FitTest(True, "weak whiteness", f"misfit {cost:.2e} with a residual too short to tell from noise "
                                                    f"(lag-1 statistic {z:.1f}, at most {reach:.1f} for any residual "
                                                    f"of these sizes, below {WHITENESS_POWER:g}); no noise floor "
