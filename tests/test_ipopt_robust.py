@@ -15,7 +15,7 @@ import pytest
 import sympy as sp
 
 import symid as si
-from symid.engine.ipopt import ScaledIpopt
+from symid.engine.ipopt import IpoptRun, ScaledIpopt
 from symid.fit.frf.ipopt import IpoptFRF, frf_objective
 from symid.fit.frf.misfit import relative_misfit
 from symid.fit.registry import prepare
@@ -263,3 +263,23 @@ def test_ipopt_does_not_end_above_its_best_iterate():
     assert out.cost <= ref.cost * (1 + 1e-6)
     np.testing.assert_allclose(out.theta, ref.theta, rtol=1e-3)
     assert "run again from there" in out.message
+
+
+def test_a_run_its_callback_stopped_returns_its_best_iterate():
+    # an output-error start on a 3-mass chain with gains, cut by its 60 s budget (the callback's stop), ended at misfit
+    # 2.5e11 from a start at 6.6e6 (benchmarks/timeseries_population.py). IPOPT's path to such an end is long, so the
+    # run is replaced here by one that stops at z = (3, 3) after visiting z = (1.1, 1): the engine's choice alone
+    z = ca.SX.sym("z", 2)
+    f = (z[0] - 1.0) ** 2 + (z[1] - 1.0) ** 2
+    solver = ScaledIpopt("stopped", z, f, lower=np.zeros(2), upper=np.full(2, np.inf), max_iter=50, tol=1e-10,
+                         hessian="exact", start_scaling=False, objective_scaling=False)
+
+    def stopped(theta0, s, q, decade, mu, iters, limit, t0, first=0, left=None):
+        solver._context = {"iteration": 3, "c": 1.0, "s": s, "t0": t0, "best": (0.01, np.array([1.1, 1.0]) / s)}
+        return IpoptRun(np.array([3.0, 3.0]), "User_Requested_Stop", 3, False, 0.0)
+
+    solver._run = stopped
+    run = solver.solve(np.array([2.0, 2.0]))
+    assert run.status == "User_Requested_Stop" and not run.finished
+    np.testing.assert_allclose(run.z, [1.1, 1.0], rtol=1e-12)
+    assert "best iterate" in run.note

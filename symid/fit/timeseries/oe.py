@@ -405,7 +405,7 @@ class OutputError(Estimator, FisherInformation):
             s = 0
         v = self._unknowns(start)
         scale = self._unknown_scale(v)
-        theta, iters, status, finished = start, 0, "not run", False
+        theta, iters, status, finished, note = start, 0, "not run", False, ""
         self._deadline = None if self._time_limit is None else t0 + self._time_limit  # building counts
         self._timed_out = False
         for _ in range(3):
@@ -413,7 +413,7 @@ class OutputError(Estimator, FisherInformation):
             solver = self._solver(s)
             run = solver.solve(v, scale=scale, values=q)
             iters += run.iterations
-            status, finished = run.status, run.finished
+            status, finished, note = run.status, run.finished, run.note
             if self._timed_out:
                 status, finished = "Maximum_WallTime_Exceeded", False
             v = run.z
@@ -425,7 +425,7 @@ class OutputError(Estimator, FisherInformation):
             if need <= s or self._timed_out or status == "User_Requested_Stop":
                 break
             s = need
-        return self.outcome(start, theta, finished=finished, status=status, message=status, iterations=iters,
+        return self.outcome(start, theta, finished=finished, status=status, message=status + note, iterations=iters,
                             wall_time=time.perf_counter() - t0)
 
     def residual_channels(self) -> np.ndarray:
