@@ -25,9 +25,10 @@ log gains are the least-squares fit of the data's log |H| to the response at gai
 (otherwise the rule above). Before, all gains took one common value, and where they
 reach the entries to different powers (an actuator gain b on every row, a sensor gain
 g on one: b and b·g) the analysis fell back to gains of 1 with the level in the
-springs: on the 12 chains with gains of ``benchmarks/population.py`` (n = 2, 3, 5, 8)
-springs and dampers were up to 3.8 decades off, gains up to 1.8; now every value is
-within 1.3 decades. Before, the stiffnesses took
+springs: on 12 problems drawn from the gains class of ``benchmarks/population_models.py``
+(n = 2, 3, 5, 8) springs and dampers were up to 3.8 decades off, gains up to 1.8; now
+every value is within 1.3 decades (``benchmarks/typical_scale.py``). Earlier still, before
+L centred the natural frequencies, the stiffnesses took
 the level of |H| and the modes left the band (the F-16 modal model of
 ``examples/f16_gvt.py``, M = I: every k = 1.3e6, modes at 185 Hz for a band of 2–15 Hz;
 now k = 1.2e3, 5.5 Hz).
