@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 import symid as si
 from symid import scr
-from symid.errors import SymidError
+from symid.errors import ModelError, SymidError
 from symid.model.expressions import MAX_DEPTH, MAX_LENGTH, parse_expression, sympify_value
 from symid.model.symbols import parse_entry
 from symid.structural.summary import rational
@@ -400,3 +400,11 @@ def test_a_number_run_into_a_keyword_is_an_error_without_a_python_warning(text):
         with pytest.raises(si.ModelError):
             parse_expression(text)
     assert not [w for w in seen if issubclass(w.category, SyntaxWarning)]
+
+
+def test_an_invalid_escape_in_a_string_is_a_named_error_without_a_warning():
+    # found by the hostile-text property test: Python 3.11 warns of "\o" (DeprecationWarning) while parsing
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ModelError, match="str constant"):
+            parse_expression("'\\o'")

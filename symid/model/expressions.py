@@ -373,8 +373,9 @@ def parse_expression(text: str, where: str = "entry", *,
         raise ModelError(f"{where} = {text!r} cannot be parsed: it is empty")
     source = _source(stripped)
     try:
-        with warnings.catch_warnings():  # "2and 3": Python warns of the literal on stderr; the error below says it
+        with warnings.catch_warnings():  # "2and 3", "'\\o'": Python warns of the literal; the errors below say it
             warnings.simplefilter("ignore", SyntaxWarning)
+            warnings.simplefilter("ignore", DeprecationWarning)  # Python 3.11's word for an invalid escape
             tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
         raise ModelError(f"{where} = {text!r} cannot be parsed: {exc.msg}") from None
