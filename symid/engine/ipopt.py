@@ -508,15 +508,22 @@ class ScaledIpopt:
         far above the best iterate: an output-error start on a 3-mass chain with gains, cut by its 60 s budget
         mid-way, ended at misfit 2.5e11 from a start at 6.6e6. The best iterate is returned instead when it lies
         lower (no rerun: the caller asked to stop), and the note says so."""
-        f_best, z_best = self._context["best"]
-        if z_best is None:
+        below = self._best_below_end(run, s, q)
+        if below is None:
             return run
-        best = np.clip(z_best * s, self.lower, self.upper)
-        f_end, f_best = self._f(run.z, q), self._f(best, q)
-        if not f_best < f_end * (1 - _FROM_BEST):
-            return run
+        best, f_best, f_end = below
         return IpoptRun(best, run.status, run.iterations, False, time.perf_counter() - t0,
                         f"; stopped at objective {f_end:.6g}, above its best iterate's {f_best:.6g}: that iterate kept")
+
+    def _best_below_end(self, run: IpoptRun, s: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, float, float] | None:
+        """(best iterate within the bounds, its objective, the end's objective) when the best iterate the last solve
+        visited lies below the end by more than ``_FROM_BEST`` (relative), else ``None``."""
+        f_best, z_best = self._context["best"]
+        if z_best is None:
+            return None
+        best = np.clip(z_best * s, self.lower, self.upper)
+        f_end, f_best = self._f(run.z, q), self._f(best, q)
+        return (best, f_best, f_end) if f_best < f_end * (1 - _FROM_BEST) else None
 
     def _run(self, theta0: np.ndarray, s: np.ndarray, q: np.ndarray, decade: int, mu: int, iters: int,
              limit: float | None, t0: float, first: int = 0,
@@ -555,13 +562,10 @@ class ScaledIpopt:
         that best iterate with a small barrier (μ₀ = 1e-9); the better of the two, or the best iterate itself,
         is kept, and the note says so. The rerun takes at most twice the iterations of the first run (at least
         100) and what is left of the time limit."""
-        f_best, z_best = self._context["best"]
-        if z_best is None:
+        below = self._best_below_end(run, s, q)
+        if below is None:
             return run
-        best = np.clip(z_best * s, self.lower, self.upper)
-        f_end, f_best = self._f(run.z, q), self._f(best, q)
-        if not f_best < f_end * (1 - _FROM_BEST):
-            return run
+        best, f_best, f_end = below
         left = None if limit is None else limit - (time.perf_counter() - t0)
         if left is not None and left <= 0:
             return IpoptRun(best, run.status, run.iterations, False, time.perf_counter() - t0,
