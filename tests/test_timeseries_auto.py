@@ -74,10 +74,12 @@ def test_no_restart_is_one_output_error_run():
     io = si.simulate_io(model, truth, u, dt, noise=0.01, seed=2)
     x0 = {"m": 1.5, "c": 2.0, "k": 6000.0}
     one = si.identify(model, io, method="oe", x0=x0, identifiability_check=False)
-    auto = si.identify(model, io, method="auto", x0=x0, restarts=0, identifiability_check=False)
+    auto = si.identify(model, io, method="auto", x0=x0, restarts=0, black_box_start=False,
+                       identifiability_check=False)
     np.testing.assert_allclose(auto.theta_vector, one.theta_vector, rtol=1e-12)  # the same IPOPT run
     assert auto.cost == pytest.approx(one.cost, rel=1e-12)
     assert auto.options["restarts"] == 0 and auto.options["time_limit"] == 120.0
+    assert auto.options["black_box_start"] is False
 
 
 def test_auto_options_are_checked():

@@ -39,8 +39,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from symid.fit.options import check_float, check_int, check_seed, check_time_limit
+from symid.fit.options import check_bool, check_float, check_int, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
+from symid.fit.success import EXACT_FIT
+from symid.fit.timeseries.bbstart import black_box_start
 from symid.fit.timeseries.oe import OutputError
 
 __all__ = ["AutoOutputError"]
@@ -66,6 +68,12 @@ class AutoOutputError(OutputError):
         Seed of the restarts (with the start itself: the same start gives the same passes).
     time_limit : float, optional
         Wall-time budget of the whole start in seconds, every pass included (default 120).
+    black_box_start : bool, optional
+        On one uniformly sampled record, one more pass starts from the model fitted to
+        an N4SID black box's response (:mod:`symid.fit.timeseries.bbstart`), within
+        a quarter of the budget (at most ``BLACK_BOX_LIMIT`` s): the first pass, unless
+        the start already fits exactly and no worse; the start gets the second unless the
+        first fits to rounding (default True).
 
     Examples
     --------
@@ -83,11 +91,13 @@ class AutoOutputError(OutputError):
     method: ClassVar[str] = "auto"
     DRAW_TRIES: ClassVar[int] = 100
     """Draws tried for a restart at which the model's response is finite (module notes)."""
+    BLACK_BOX_LIMIT: ClassVar[float] = 15.0
+    """Seconds at most for the black-box start's response fit (and a quarter of the start's budget)."""
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "exact", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = 120.0, callback: Any = None, verbose: bool = False,
-                 restarts: int = 10, spread: float = 10.0, seed: int = 0):
+                 restarts: int = 10, spread: float = 10.0, seed: int = 0, black_box_start: bool = True):
         budget = check_time_limit("time_limit", time_limit)
         super().__init__(model, data, initial_state=initial_state, scale=scale, positivity=positivity,
                          hessian=hessian, max_iter=max_iter, tol=tol, time_limit=budget, callback=callback,
@@ -97,9 +107,10 @@ class AutoOutputError(OutputError):
         self._spread = check_float("spread", spread, low=1.0)
         self._seed = check_seed("seed", seed)
         self._verbose_passes = bool(verbose)
+        self._black_box_start = check_bool("black_box_start", black_box_start)
         self._positive = np.asarray(model.positive, dtype=bool) & self._positivity
         self.options = {**self.options, "time_limit": budget, "restarts": self._restarts, "spread": self._spread,
-                        "seed": self._seed}
+                        "seed": self._seed, "black_box_start": self._black_box_start}
 
     def _draw(self, rng: np.random.Generator, centre: np.ndarray) -> np.ndarray:
         half = math.log(self._spread)
@@ -119,6 +130,25 @@ class AutoOutputError(OutputError):
             theta = self._draw(rng, centre)
         return theta
 
+    def _special_starts(self, start: np.ndarray, t0: float) -> tuple[list[np.ndarray], str]:
+        """The passes before the random restarts: from the start, and from the black box's fit (``black_box_start``),
+        that one first unless the start already fits exactly and no worse; and the note for the message."""
+        if not self._black_box_start:
+            return [start], ""
+        limit = self.BLACK_BOX_LIMIT if self._budget is None else min(self.BLACK_BOX_LIMIT, 0.25 * self._budget)
+        found = black_box_start(self.model, self.data, start, scale=self.scale, time_limit=limit)
+        if self._verbose_passes:
+            print(f"auto: {found.note}, {time.perf_counter() - t0:.2f} s", flush=True)
+        if found.theta is None:
+            return [start], f"; {found.note}"
+        at_bb = self.misfit(found.theta)
+        if not np.isfinite(at_bb):
+            return [start], "; no black-box start: the model cannot be simulated at its response fit"
+        at_start = self.misfit(start)
+        if at_start <= EXACT_FIT and at_start <= at_bb:
+            return [start, found.theta], f"; pass 1 from {found.note}"
+        return [found.theta, start], f"; pass 0 from {found.note}"
+
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Output-error passes from ``x0`` and restarts around it until the estimate fits or the budget is spent."""
         t0 = time.perf_counter()
@@ -128,14 +158,19 @@ class AutoOutputError(OutputError):
         best: StartOutcome | None = None
         visited: list[StartOutcome] = []
         iterations, passes, status = 0, 0, "max_restarts"
-        for k in range(self._restarts + 1):
-            if k == 0:
-                theta0 = start
+        specials, note = self._special_starts(start, t0)  # the start, and the black box's fit (first or second)
+        for k in range(self._restarts + len(specials)):
+            if k < len(specials):
+                if k > 0 and deadline is not None and time.perf_counter() >= deadline:
+                    status = "time_limit"
+                    break
+                theta0 = specials[k]
             else:
                 if deadline is not None and time.perf_counter() >= deadline:
                     status = "time_limit"
                     break
-                around = self.scale if (self.scale is not None and k % 2 == 1) else start
+                j = k - len(specials) + 1  # the first random restart is drawn around the typical values
+                around = self.scale if (self.scale is not None and j % 2 == 1) else start
                 theta0 = self._finite_draw(rng, np.asarray(around, dtype=float))
             self._time_limit = None if deadline is None else max(deadline - time.perf_counter(), 1e-3)
             try:
@@ -150,7 +185,9 @@ class AutoOutputError(OutputError):
             if self._verbose_passes:
                 print(f"auto pass {k}: misfit {cand.cost:.3e}, {'fits' if cand.success else 'does not fit'}, "
                       f"{time.perf_counter() - t0:.2f} s", flush=True)
-            if best.success:
+            if best.success and (k + 1 >= len(specials) or best.cost <= EXACT_FIT):
+                # with a second special start to come, only a fit to rounding stops before it: on noisy records
+                # the first fit may be a worse minimum that the whiteness rule accepts
                 status = "fits"
                 break
         assert best is not None
@@ -158,7 +195,7 @@ class AutoOutputError(OutputError):
                 "max_restarts": f"no fit in {passes} output-error pass(es) (restarts={self._restarts})",
                 "time_limit": f"time limit of {self._budget:g} s reached after {passes} pass(es)"}[status]
         out = self.outcome(start, best.theta, finished=status != "time_limit", status=status,
-                           message=f"{what}; best pass: {best.status}", iterations=iterations,
+                           message=f"{what}; best pass: {best.status}{note}", iterations=iterations,
                            wall_time=time.perf_counter() - t0)
         others = tuple(c for c in visited if c is not best)
         return dataclasses.replace(out, passes=others) if others else out

@@ -1,0 +1,145 @@
+"""A start for output error read off a black box of the record: N4SID, its response mode by mode, a response fit.
+
+Output error from a start a factor of a few off often ends in a local minimum (a mode of
+the model beside the measured one leaves a misfit that barely changes until they meet),
+while the frequency-response ``auto`` (:class:`symid.fit.frf.lm.AutoFRF`: continuation
+over frequency, chain starts, restarts) reaches the structured parameters of a noise-free
+frequency response from starts a decade off. This module gives the records to that
+method through a black box:
+
+1. **Black box.** N4SID of the model's order (:func:`symid.n4sid`; feedthrough only when
+   the model has one at the start) on the one uniformly sampled record.
+2. **Its continuous-time response, mode by mode.** With Ad = V Λ V⁻¹ (simple
+   eigenvalues zᵢ), the zero-order-hold sampling of H(s) = D + Σᵢ ρᵢ / (s − sᵢ) has
+   zᵢ = e^{sᵢ Δt} and Bd's modal rows (zᵢ − 1)/sᵢ times B's, so
+
+       H(jω) = D + Σᵢ (Cd vᵢ)(wᵢᵀ Bd) · sᵢ / (zᵢ − 1) / (jω − sᵢ),   sᵢ = log(zᵢ) / Δt
+
+   (principal logarithm; Δt in place of sᵢ/(zᵢ − 1) as sᵢ → 0). This is the exact
+   continuous-time response of the sampled black box; unlike :func:`symid.d2c` it needs
+   no real matrix logarithm, so a pole N4SID put on the negative real axis (a mode near
+   the Nyquist frequency) costs nothing but that mode's accuracy.
+3. **Structured fit.** The model is fitted to that response on 100 log-spaced lines from
+   0.3 times the slowest to 3 times the fastest black-box mode by the frequency-response
+   ``auto`` from the start (with the typical values ``scale``), within a share of the
+   start's budget; its estimate is the start of an output-error pass.
+
+On noise-free records the response is the model's own, and the fit recovers θ; on noisy
+ones N4SID can misplace a weakly observable mode, and the fit is only a start like any
+other (the output-error pass decides, and :class:`~symid.fit.timeseries.auto.AutoOutputError`
+runs a pass from the caller's start as well). Records N4SID cannot take (several records,
+non-uniform sample times, an input that is not persistently exciting, too few samples, a
+realisation that is not minimal) give no start, and say why.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from symid.data import FrequencyData, IOData
+from symid.errors import SymidError
+
+__all__ = ["BlackBoxStart", "black_box_start", "modal_response"]
+
+LINES = 100
+"""Frequency lines of the black box's response that the structured fit sees."""
+BAND = (0.3, 3.0)
+"""The lines span these multiples of the slowest and the fastest black-box mode (rad/s)."""
+
+
+@dataclass(frozen=True)
+class BlackBoxStart:
+    """The structured fit to a black box's response: ``theta`` (None when there is no start) and why."""
+
+    theta: np.ndarray | None
+    note: str
+    misfit: float = math.nan
+    """The structured fit's misfit to the black box's response (relative, squared)."""
+
+
+def modal_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, dt: float,
+                   w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous-time response whose zero-order-hold sampling at ``dt`` is (A, B, C, D), mode by mode (module notes).
+
+    Returns
+    -------
+    H : ndarray, shape (s, p, m)
+        The response at ``w`` (rad/s).
+    poles : ndarray, shape (n,)
+        The continuous-time poles sᵢ = log(zᵢ)/Δt (principal logarithm).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        When A's eigenvectors are singular (a defective A: repeated poles without a basis).
+
+    Examples
+    --------
+    >>> import numpy as np, scipy.signal
+    >>> from symid.fit.timeseries.bbstart import modal_response
+    >>> A, B, C, D = np.array([[0.0, 1.0], [-4.0, -0.4]]), np.array([[0.0], [1.0]]), np.array([[1.0, 0.0]]), np.zeros((1, 1))
+    >>> Ad, Bd, Cd, Dd, _ = scipy.signal.cont2discrete((A, B, C, D), 0.1, method="zoh")
+    >>> H, _ = modal_response(Ad, Bd, Cd, Dd, 0.1, np.array([1.0, 2.0]))
+    >>> bool(np.allclose(H[:, 0, 0], 1 / ((1j * np.array([1.0, 2.0])) ** 2 + 0.4j * np.array([1.0, 2.0]) + 4)))
+    True
+    """
+    z, V = np.linalg.eig(np.asarray(A, dtype=float))
+    W = np.linalg.inv(V)
+    s = np.log(z.astype(complex)) / dt
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gain = np.where(np.abs(s) * dt > 1e-12, s / (z - 1), 1.0 / dt)
+    CV, WB = np.asarray(C) @ V, W @ np.asarray(B)
+    w = np.asarray(w, dtype=float)
+    H = np.broadcast_to(np.asarray(D, dtype=complex), (w.size, *np.shape(D))).copy()
+    for i in range(z.size):
+        H += (np.outer(CV[:, i], WB[i]) * gain[i])[None] / (1j * w[:, None, None] - s[i])
+    return H, s
+
+
+def _feedthrough(model: Any, theta: np.ndarray) -> bool:
+    try:
+        return bool(np.any(np.asarray(model.state_space(theta).D) != 0))
+    except (SymidError, ValueError, ZeroDivisionError, np.linalg.LinAlgError):
+        return True
+
+
+def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray | None,
+                    time_limit: float | None) -> BlackBoxStart:
+    """The frequency-response ``auto`` fit of the model to the N4SID black box's response (module notes).
+
+    Never raises for records or models the route cannot take: the start is then None and
+    ``note`` says why.
+    """
+    from symid.fit.frf.lm import AutoFRF
+    from symid.signal.subspace import n4sid
+
+    if not isinstance(data, IOData):
+        return BlackBoxStart(None, "no black-box start: N4SID takes one uniformly sampled record (IOData)")
+    x0 = np.asarray(x0, dtype=float).reshape(-1)
+    try:
+        dss = n4sid(data, model.n_states, feedthrough=_feedthrough(model, x0))
+        _, poles = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, np.zeros(0))
+    except (SymidError, np.linalg.LinAlgError, ValueError) as exc:
+        return BlackBoxStart(None, f"no black-box start: {exc}")
+    size = np.abs(poles)
+    size = size[np.isfinite(size) & (size > 0)]
+    if size.size == 0:
+        return BlackBoxStart(None, "no black-box start: the black box has no mode of nonzero frequency")
+    w = np.logspace(math.log10(BAND[0] * size.min()), math.log10(BAND[1] * size.max()), LINES)
+    H, _ = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, w)
+    if not np.all(np.isfinite(H)) or not np.any(H != 0):
+        return BlackBoxStart(None, "no black-box start: the black box's response is not finite")
+    try:
+        fit = AutoFRF(model, FrequencyData(w, H), scale=scale, time_limit=time_limit)
+        fit.check_start(x0)
+        out = fit.run(x0)
+    except SymidError as exc:
+        return BlackBoxStart(None, f"no black-box start: {exc}")
+    if not np.all(np.isfinite(out.theta)):
+        return BlackBoxStart(None, "no black-box start: the response fit did not end at finite values")
+    return BlackBoxStart(out.theta, f"the N4SID black box's response fitted to misfit {out.cost:.2e} "
+                                    f"({out.wall_time:.1f} s)", float(out.cost))
