@@ -81,10 +81,12 @@ def modal_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, d
     --------
     >>> import numpy as np, scipy.signal
     >>> from symid.fit.timeseries.bbstart import modal_response
-    >>> A, B, C, D = np.array([[0.0, 1.0], [-4.0, -0.4]]), np.array([[0.0], [1.0]]), np.array([[1.0, 0.0]]), np.zeros((1, 1))
+    >>> A, B = np.array([[0.0, 1.0], [-4.0, -0.4]]), np.array([[0.0], [1.0]])
+    >>> C, D = np.array([[1.0, 0.0]]), np.zeros((1, 1))
     >>> Ad, Bd, Cd, Dd, _ = scipy.signal.cont2discrete((A, B, C, D), 0.1, method="zoh")
-    >>> H, _ = modal_response(Ad, Bd, Cd, Dd, 0.1, np.array([1.0, 2.0]))
-    >>> bool(np.allclose(H[:, 0, 0], 1 / ((1j * np.array([1.0, 2.0])) ** 2 + 0.4j * np.array([1.0, 2.0]) + 4)))
+    >>> w = np.array([1.0, 2.0])
+    >>> H, _ = modal_response(Ad, Bd, Cd, Dd, 0.1, w)
+    >>> bool(np.allclose(H[:, 0, 0], 1 / ((1j * w) ** 2 + 0.4j * w + 4)))   # 1 / (s² + 0.4 s + 4)
     True
     """
     z, V = np.linalg.eig(np.asarray(A, dtype=float))
