@@ -59,7 +59,8 @@ class AutoOutputError(OutputError):
         Typical magnitude of each parameter: every other restart is drawn around it (and
         IPOPT works on θ / scale). Default: restarts around the start only.
     restarts : int, optional
-        Passes after the first, at most (default 10).
+        Passes from random restarts after the pass from the start (and the one from the
+        black box, ``black_box_start``), at most (default 10).
     spread : float, optional
         Restarts are drawn log-uniformly within this factor of the start (or of ``scale``);
         parameters that may be negative get the start ± spread × their magnitude (1

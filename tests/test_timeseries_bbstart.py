@@ -1,0 +1,103 @@
+"""The black-box start of the time-series default (symid.fit.timeseries.bbstart) and where auto runs it.
+
+Reference values: the parameters the records were simulated from; the exact zero-order-hold sampling of a
+continuous model by scipy.signal.cont2discrete.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.signal
+
+import symid as si
+from symid.data.timeseries import TimeSeries
+from symid.fit.timeseries import auto as auto_module
+from symid.fit.timeseries.bbstart import BlackBoxStart, black_box_start, modal_response
+
+TRUTH = np.array([2.0, 0.5, 3.0, 1.0, 4000.0, 2500.0])  # m1, m2, c1, c2, k1, k2
+
+
+def _chain():
+    """Two masses, force on the free mass 2, position of the grounded mass 1 (not collocated)."""
+    m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+    return si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
+                               K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[1, 0]])
+
+
+def _records(model, samples=800, noise=None):
+    lam = np.abs(np.linalg.eigvals(model.state_space(TRUTH).A))
+    dt = 2 * np.pi / (10 * lam.max())  # ten samples per period of the fastest mode
+    return si.simulate_io(model, TRUTH, np.random.default_rng(0).standard_normal(samples), dt, noise=noise, seed=1)
+
+
+def test_modal_response_is_the_continuous_response_of_the_sampled_model():
+    model = _chain()
+    ss = model.state_space(TRUTH)
+    dt = 0.01
+    Ad, Bd, Cd, Dd, _ = scipy.signal.cont2discrete((ss.A, ss.B, ss.C, ss.D), dt, method="zoh")
+    w = np.logspace(0, np.log10(np.pi / dt), 60)
+    H, poles = modal_response(Ad, Bd, Cd, Dd, dt, w)
+    expected = si.simulate_frf(model, TRUTH, w).H
+    # both exact; the eigenvector basis of Ad costs a few digits (condition number of V ~ 1e2)
+    np.testing.assert_allclose(H, expected, rtol=1e-9, atol=0)
+    np.testing.assert_allclose(np.sort_complex(poles), np.sort_complex(np.linalg.eigvals(ss.A)), rtol=1e-10)
+
+
+def test_a_pole_on_the_negative_real_axis_needs_no_real_logarithm():
+    # z = -0.5 has no real logarithm (symid.d2c refuses it without band=); mode by mode it is the pole
+    # log(0.5)/dt + j pi/dt, and the response stays finite
+    Ad, Bd, Cd, Dd = np.array([[-0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1))
+    H, poles = modal_response(Ad, Bd, Cd, Dd, 0.1, np.array([1.0, 10.0]))
+    assert np.all(np.isfinite(H))
+    assert poles[0] == pytest.approx(complex(np.log(0.5) / 0.1, np.pi / 0.1), rel=1e-12)
+
+
+def test_noise_free_records_give_the_truth():
+    model = _chain()
+    x0 = TRUTH * np.array([10.0, 0.1, 10.0, 0.1, 0.2, 5.0])  # every parameter a factor 5 to 10 off
+    found = black_box_start(model, _records(model), x0, scale=None, time_limit=20.0)
+    assert found.theta is not None, found.note
+    # the black box of noise-free records is the model's own response: the fit is exact (measured 2e-11)
+    np.testing.assert_allclose(found.theta, TRUTH, rtol=1e-6)
+    assert found.misfit < 1e-20 and "N4SID black box's response fitted" in found.note
+
+
+def test_records_n4sid_cannot_take_give_no_start_and_say_why():
+    model = _chain()
+    io = _records(model)
+    series = TimeSeries(io.t, io.u, io.y)  # the time-series container, not one uniformly sampled record
+    found = black_box_start(model, series, TRUTH, scale=None, time_limit=5.0)
+    assert found.theta is None and "one uniformly sampled record" in found.note
+    step = si.simulate_io(model, TRUTH, np.ones(800), io.dt)  # a constant input is not persistently exciting
+    found = black_box_start(model, step, TRUTH, scale=None, time_limit=5.0)
+    assert found.theta is None and found.note.startswith("no black-box start:")
+
+
+@pytest.mark.parametrize("start_fits", [False, True])
+def test_auto_runs_the_black_box_start_first_unless_the_start_fits(monkeypatch, start_fits):
+    model = _chain()
+    io = _records(model, samples=300)
+    x0 = TRUTH if start_fits else TRUTH * 3.0
+    calls = []
+
+    def stub(model_, data, start, *, scale, time_limit):
+        calls.append(time_limit)
+        return BlackBoxStart(TRUTH.copy(), "the stub's fit", 0.0)
+
+    monkeypatch.setattr(auto_module, "black_box_start", stub)
+    res = si.identify(model, io, x0=x0, restarts=0, time_limit=40.0, identifiability_check=False)
+    assert calls == [pytest.approx(10.0)]  # a quarter of the budget (BLACK_BOX_LIMIT = 15 s caps longer ones)
+    assert res.success
+    np.testing.assert_allclose(res.theta_vector, TRUTH, rtol=1e-8)
+    # a pass that fits to rounding ends the start: the other special pass is not run
+    assert f"pass {1 if start_fits else 0} from the stub's fit" in res.message
+    assert "a fit after 1 output-error pass(es)" in res.message
+
+
+def test_without_the_black_box_start_auto_does_not_call_it(monkeypatch):
+    model = _chain()
+    io = _records(model, samples=300)
+    monkeypatch.setattr(auto_module, "black_box_start", lambda *a, **k: pytest.fail("called"))
+    res = si.identify(model, io, x0=TRUTH, restarts=0, black_box_start=False, identifiability_check=False)
+    assert res.success and "black box" not in res.message
