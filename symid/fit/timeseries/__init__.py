@@ -4,7 +4,9 @@
 data               method      what it fits
 =================  ==========  =====================================================================
 IOData, TimeSeries ``auto``    the default: ``oe`` restarted around the start until the estimate fits
-or a list of them              the samples (:mod:`~symid.fit.timeseries.auto`)
+or a list of them              the samples, with one pass from the model fitted to an N4SID black box's
+                               response on one IOData (:mod:`~symid.fit.timeseries.auto`,
+                               :mod:`~symid.fit.timeseries.bbstart`)
 IOData, TimeSeries ``oe``      output error: the model simulated exactly on the sample times from
 or a list of them              its initial state, against the measured samples
                                (:mod:`~symid.fit.timeseries.oe`, CasADi/IPOPT)
