@@ -146,24 +146,27 @@ class AutoOutputError(OutputError):
             theta = self._draw(rng, centre)
         return theta
 
-    def _special_starts(self, start: np.ndarray, t0: float) -> tuple[list[np.ndarray], str]:
+    def _special_starts(self, start: np.ndarray, t0: float) -> tuple[list[np.ndarray], int | None, str]:
         """The passes before the random restarts: from the start, and from the black box's fit (``black_box_start``),
-        that one first unless the start already fits exactly and no worse; and the note for the message."""
+        that one first unless the start already fits exactly and no worse; which of them is the black box's
+        (None: no such pass), and what the black-box step found."""
         if not self._black_box_start:
-            return [start], ""
+            return [start], None, ""
         limit = self.BLACK_BOX_LIMIT if self._budget is None else min(self.BLACK_BOX_LIMIT, 0.25 * self._budget)
+        if self._verbose_passes:
+            print(f"auto: fitting the model to an N4SID black box's response (at most {limit:g} s)", flush=True)
         found = black_box_start(self.model, self.data, start, scale=self.scale, time_limit=limit)
         if self._verbose_passes:
             print(f"auto: {found.note}, {time.perf_counter() - t0:.2f} s", flush=True)
         if found.theta is None:
-            return [start], f"; {found.note}"
+            return [start], None, found.note
         at_bb = self.misfit(found.theta)
         if not np.isfinite(at_bb):
-            return [start], "; no black-box start: the model cannot be simulated at its response fit"
+            return [start], None, "no black-box start: the model cannot be simulated at its response fit"
         at_start = self.misfit(start)
         if at_start <= EXACT_FIT and at_start <= at_bb:
-            return [start, found.theta], f"; pass 1 from {found.note}"
-        return [found.theta, start], f"; pass 0 from {found.note}"
+            return [start, found.theta], 1, found.note
+        return [found.theta, start], 0, found.note
 
     def run(self, x0: np.ndarray) -> StartOutcome:
         """Output-error passes from ``x0`` and restarts around it until the estimate fits or the budget is spent."""
@@ -174,7 +177,7 @@ class AutoOutputError(OutputError):
         best: StartOutcome | None = None
         visited: list[StartOutcome] = []
         iterations, passes, status = 0, 0, "max_restarts"
-        specials, note = self._special_starts(start, t0)  # the start, and the black box's fit (first or second)
+        specials, bb_pass, bb_note = self._special_starts(start, t0)  # the start, and the black box's fit
         for k in range(self._restarts + len(specials)):
             if k < len(specials):
                 if k > 0 and deadline is not None and time.perf_counter() >= deadline:
@@ -207,6 +210,13 @@ class AutoOutputError(OutputError):
                 status = "fits"
                 break
         assert best is not None
+        if bb_pass is None:
+            note = f"; {bb_note}" if bb_note else ""
+        elif bb_pass < passes:
+            note = f"; pass {bb_pass} from {bb_note}"
+        else:
+            why = "the budget was spent" if status == "time_limit" else "pass 0 from the start fitted to rounding"
+            note = f"; {bb_note}, not run: {why}"
         what = {"fits": f"a fit after {passes} output-error pass(es)",
                 "max_restarts": f"no fit in {passes} output-error pass(es) (restarts={self._restarts})",
                 "time_limit": f"time limit of {self._budget:g} s reached after {passes} pass(es)"}[status]
