@@ -91,22 +91,27 @@ def modal_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, d
     """
     z, V = np.linalg.eig(np.asarray(A, dtype=float))
     W = np.linalg.inv(V)
-    s = np.log(z.astype(complex)) / dt
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gain = np.where(np.abs(s) * dt > 1e-12, s / (z - 1), 1.0 / dt)
-    CV, WB = np.asarray(C) @ V, W @ np.asarray(B)
     w = np.asarray(w, dtype=float)
     H = np.broadcast_to(np.asarray(D, dtype=complex), (w.size, *np.shape(D))).copy()
-    for i in range(z.size):
-        H += (np.outer(CV[:, i], WB[i]) * gain[i])[None] / (1j * w[:, None, None] - s[i])
+    CV, WB = np.asarray(C) @ V, W @ np.asarray(B)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.log(z.astype(complex)) / dt
+        gain = np.where(np.abs(s) * dt > 1e-12, s / (z - 1), 1.0 / dt)
+        for i in range(z.size):
+            if z[i] == 0:  # s = −∞: its term s/(z − 1)/(jω − s) tends to 1/(1 − z) = 1 at every finite ω
+                H += np.outer(CV[:, i], WB[i])[None]
+            else:
+                H += (np.outer(CV[:, i], WB[i]) * gain[i])[None] / (1j * w[:, None, None] - s[i])
     return H, s
 
 
-def _feedthrough(model: Any, theta: np.ndarray) -> bool:
-    try:
-        return bool(np.any(np.asarray(model.state_space(theta).D) != 0))
-    except (SymidError, ValueError, ZeroDivisionError, np.linalg.LinAlgError):
-        return True
+def _feedthrough(model: Any) -> bool:
+    """Whether the model has a direct feedthrough for some θ: a D entry not identically 0, or an acceleration
+    output of a second-order model."""
+    sym = model.symbolic
+    if "M" in sym:
+        return model.output == "acceleration"
+    return any(entry != 0 for entry in sym["D"])
 
 
 def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray | None,
@@ -123,7 +128,7 @@ def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray 
         return BlackBoxStart(None, "no black-box start: N4SID takes one uniformly sampled record (IOData)")
     x0 = np.asarray(x0, dtype=float).reshape(-1)
     try:
-        dss = n4sid(data, model.n_states, feedthrough=_feedthrough(model, x0))
+        dss = n4sid(data, model.n_states, feedthrough=_feedthrough(model))
         _, poles = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, np.zeros(0))
     except (SymidError, np.linalg.LinAlgError, ValueError) as exc:
         return BlackBoxStart(None, f"no black-box start: {exc}")
