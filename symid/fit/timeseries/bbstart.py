@@ -139,7 +139,7 @@ def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray 
     w = np.logspace(math.log10(BAND[0] * size.min()), math.log10(BAND[1] * size.max()), LINES)
     H, _ = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, w)
     if not np.all(np.isfinite(H)) or not np.any(H != 0):
-        return BlackBoxStart(None, "no black-box start: the black box's response is not finite")
+        return BlackBoxStart(None, "no black-box start: the black box's response is zero or not finite")
     try:
         fit = AutoFRF(model, FrequencyData(w, H), scale=scale, time_limit=time_limit)
         fit.check_start(x0)
