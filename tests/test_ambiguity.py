@@ -60,6 +60,9 @@ def test_equal_misfits_count_whether_or_not_they_pass_the_fit_test():
                                                                   start([2.1, 1.07e4], 9e-5)], cost_kind="misfit")
     assert [s.cost for s in res.alternatives()] == [4.5394e-5]  # the third fits worse by a factor 2
     assert "up to 100 % in c2" in res.ambiguity()
+    # none fits: the sentence says so instead of "fit the data as well" (a new user read that on misfit 0.9988)
+    assert "end at the best estimate's misfit (4.54e-05, which does not fit the data) with different" in res.ambiguity()
+    assert "fit the data as well" not in res.ambiguity()
 
 
 def test_passes_of_one_start_count_as_alternatives():

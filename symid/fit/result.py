@@ -347,7 +347,11 @@ class IdentificationResult:
         ref = np.asarray(self.best_start.theta, dtype=float)
         rel = np.max([_relative_difference(np.asarray(s.theta, dtype=float), ref) for s in alts], axis=0)
         k = int(np.argmax(rel))
-        return (f"{len(alts)} other estimate(s) from other starts or restarts fit the data as well with different "
+        if self.success:
+            how = "fit the data as well"
+        else:  # equally good is not good: the sentence must not read as if anything fitted
+            how = f"end at the best estimate's misfit ({self.best_start.cost:.3g}, which does not fit the data)"
+        return (f"{len(alts)} other estimate(s) from other starts or restarts {how} with different "
                 f"parameters (up to {100 * rel[k]:.3g} % in {self.parameter_names[k]}): the data do not single out "
                 "one estimate. The model may have several exact solutions (symid.identifiability gives the global "
                 "verdict) or the data may not pin these parameters down; compare them in .alternatives(), or fix "
