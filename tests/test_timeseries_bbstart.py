@@ -104,3 +104,27 @@ def test_without_the_black_box_start_auto_does_not_call_it(monkeypatch):
     monkeypatch.setattr(auto_module, "black_box_start", lambda *a, **k: pytest.fail("called"))
     res = si.identify(model, io, x0=TRUTH, restarts=0, black_box_start=False, identifiability_check=False)
     assert res.success and "black box" not in res.message
+
+
+def test_a_black_box_start_that_predicts_nothing_is_not_used(monkeypatch):
+    # a new user's 3-mass chain at 1 %: the response fit ended with every mass near 0 (misfit 2e68 to the black
+    # box's response, 1.00000005 to the samples), and its pass took the whole budget before the start's could run
+    model = _chain()
+    io = _records(model, samples=300)
+    far = TRUTH * np.array([1.0, 1.0, 1.0, 1.0, 1e-3, 1e-3])  # springs 1000 times too soft: slow, large, unrelated
+    monkeypatch.setattr(auto_module, "black_box_start", lambda *a, **k: BlackBoxStart(far, "the stub's fit", 0.5))
+    res = si.identify(model, io, x0=TRUTH, restarts=0, identifiability_check=False)
+    assert "no black-box start: its response fit predicts the samples no better than zero" in res.message
+    np.testing.assert_allclose(res.theta_vector, TRUTH, rtol=1e-8)
+
+
+def test_a_response_fit_no_better_than_zero_gives_no_start(monkeypatch):
+    import dataclasses
+
+    from symid.fit.frf import lm
+
+    model = _chain()
+    real_run = lm.AutoFRF.run
+    monkeypatch.setattr(lm.AutoFRF, "run", lambda self, x0: dataclasses.replace(real_run(self, x0), cost=2e68))
+    found = black_box_start(model, _records(model), TRUTH, scale=None, time_limit=5.0)
+    assert found.theta is None and "no better than zero (misfit 2.00e+68)" in found.note

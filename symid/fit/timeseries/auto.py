@@ -163,6 +163,9 @@ class AutoOutputError(OutputError):
         at_bb = self.misfit(found.theta)
         if not np.isfinite(at_bb):
             return [start], None, "no black-box start: the model cannot be simulated at its response fit"
+        if at_bb >= 1:  # the relative misfit of predicting zero: a pass from there would start from nothing
+            return [start], None, (f"no black-box start: its response fit predicts the samples no better than zero "
+                                   f"(misfit {at_bb:.3g})")
         at_start = self.misfit(start)
         if at_start <= EXACT_FIT and at_start <= at_bb:
             return [start, found.theta], 1, found.note

@@ -148,5 +148,8 @@ def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray 
         return BlackBoxStart(None, f"no black-box start: {exc}")
     if not np.all(np.isfinite(out.theta)):
         return BlackBoxStart(None, "no black-box start: the response fit did not end at finite values")
+    if not out.cost < 1:  # a relative misfit of 1 is that of predicting zero: such a fit says nothing
+        return BlackBoxStart(None, f"no black-box start: the model fitted the black box's response no better than "
+                                   f"zero (misfit {out.cost:.2e})", float(out.cost))
     return BlackBoxStart(out.theta, f"the N4SID black box's response fitted to misfit {out.cost:.2e} "
                                     f"({out.wall_time:.1f} s)", float(out.cost))
