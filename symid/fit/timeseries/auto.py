@@ -26,7 +26,7 @@ minimum the whiteness rule accepts). Measured on ``benchmarks/timeseries_populat
 (chains, chains with gains, compartment and state-space models, n = 2 and 3, one informed
 and one uninformed start each, noise-free and 1 %, 60 s per start): ``auto`` met the
 success rule from 29 of 32 starts with it (noise-free 16/16, 1 % 13/16), 24 of 32
-without (noise-free 12/16), in a median 7.5 s per start against 13.8 s. The frequency-response
+without (noise-free 12/16), in a median 8.1 s per start against 13.8 s. The frequency-response
 fit is what ``auto`` does best (continuation over frequency, chain starts), and the black
 box of noise-free records is the model's own response: every noise-free start met the
 rule, where without it output error's restarts had ended at near-fits within the budget
