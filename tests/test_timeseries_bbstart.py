@@ -81,7 +81,7 @@ def test_auto_runs_the_black_box_start_first_unless_the_start_fits(monkeypatch, 
     x0 = TRUTH if start_fits else TRUTH * 3.0
     calls = []
 
-    def stub(model_, data, start, *, scale, time_limit):
+    def stub(model_, data, start, *, scale, time_limit, response=None):
         calls.append(time_limit)
         return BlackBoxStart(TRUTH.copy(), "the stub's fit", 0.0)
 
@@ -128,3 +128,18 @@ def test_a_response_fit_no_better_than_zero_gives_no_start(monkeypatch):
     monkeypatch.setattr(lm.AutoFRF, "run", lambda self, x0: dataclasses.replace(real_run(self, x0), cost=2e68))
     found = black_box_start(model, _records(model), TRUTH, scale=None, time_limit=5.0)
     assert found.theta is None and "no better than zero (misfit 2.00e+68)" in found.note
+
+
+def test_the_black_box_is_estimated_once_for_every_start(monkeypatch):
+    from symid.fit.timeseries.auto import AutoOutputError
+
+    model = _chain()
+    io = _records(model, samples=300)
+    responses = []
+    real = auto_module.black_box_response
+    monkeypatch.setattr(auto_module, "black_box_response", lambda m, d: responses.append(1) or real(m, d))
+    monkeypatch.setattr(auto_module, "black_box_start", lambda *a, **k: BlackBoxStart(TRUTH.copy(), "the stub's fit"))
+    est = AutoOutputError(model, io, restarts=0)
+    for factor in (2.0, 3.0):  # two starts of one estimator (as identify runs them)
+        assert est.run(TRUTH * factor).success
+    assert len(responses) == 1

@@ -82,7 +82,9 @@ class SimilarityData:
         return float(np.mean(np.sum(np.abs((H - Hm) / scale) ** 2, axis=(1, 2)) / den))
 
 
-def _model_has_feedthrough(model: Any) -> bool:
+def model_has_feedthrough(model: Any) -> bool:
+    """Whether the model has a direct feedthrough for some θ (a D that is not the constant 0, or an acceleration
+    output of a second-order model): N4SID then estimates D too."""
     maps = model.maps
     if "D" in maps:
         return not (maps["D"].is_constant and not np.any(maps["D"].X0))
@@ -143,7 +145,7 @@ def similarity_data(model: Any, data: Any, *, horizon: int | None = None, allow_
         from symid.signal.subspace import n4sid
 
         _check_sizes(model, model.n_states, data.n_inputs, data.n_outputs, "the I/O data")
-        dss = n4sid(data, model.n_states, horizon=horizon, feedthrough=_model_has_feedthrough(model))
+        dss = n4sid(data, model.n_states, horizon=horizon, feedthrough=model_has_feedthrough(model))
         bb, source = dss.to_continuous(), "io"
         where = f"the black box estimated from the I/O data (N4SID order {model.n_states} + d2c)"
     elif isinstance(data, BlackBox):

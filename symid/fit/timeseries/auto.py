@@ -57,7 +57,7 @@ import numpy as np
 from symid.fit.options import check_bool, check_float, check_int, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.success import EXACT_FIT
-from symid.fit.timeseries.bbstart import black_box_start
+from symid.fit.timeseries.bbstart import black_box_response, black_box_start
 from symid.fit.timeseries.oe import OutputError
 
 __all__ = ["AutoOutputError"]
@@ -124,6 +124,7 @@ class AutoOutputError(OutputError):
         self._seed = check_seed("seed", seed)
         self._verbose_passes = bool(verbose)
         self._black_box_start = check_bool("black_box_start", black_box_start)
+        self._bb_response: tuple[Any, str] | None = None  # black_box_response's answer, computed once
         self._positive = np.asarray(model.positive, dtype=bool) & self._positivity
         self.options = {**self.options, "time_limit": budget, "restarts": self._restarts, "spread": self._spread,
                         "seed": self._seed, "black_box_start": self._black_box_start}
@@ -155,7 +156,10 @@ class AutoOutputError(OutputError):
         limit = self.BLACK_BOX_LIMIT if self._budget is None else min(self.BLACK_BOX_LIMIT, 0.25 * self._budget)
         if self._verbose_passes:
             print(f"auto: fitting the model to an N4SID black box's response (at most {limit:g} s)", flush=True)
-        found = black_box_start(self.model, self.data, start, scale=self.scale, time_limit=limit)
+        if self._bb_response is None:  # the black box's response is the records', the same for every start
+            self._bb_response = black_box_response(self.model, self.data)
+        found = black_box_start(self.model, self.data, start, scale=self.scale, time_limit=limit,
+                                response=self._bb_response)
         if self._verbose_passes:
             print(f"auto: {found.note}, {time.perf_counter() - t0:.2f} s", flush=True)
         if found.theta is None:

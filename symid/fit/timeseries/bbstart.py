@@ -43,7 +43,7 @@ import numpy as np
 from symid.data import FrequencyData, IOData
 from symid.errors import SymidError
 
-__all__ = ["BlackBoxStart", "black_box_start", "modal_response"]
+__all__ = ["BlackBoxStart", "black_box_response", "black_box_start", "modal_response"]
 
 LINES = 100
 """Frequency lines of the black box's response that the structured fit sees."""
@@ -105,43 +105,47 @@ def modal_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, d
     return H, s
 
 
-def _feedthrough(model: Any) -> bool:
-    """Whether the model has a direct feedthrough for some θ: a D entry not identically 0, or an acceleration
-    output of a second-order model."""
-    sym = model.symbolic
-    if "M" in sym:
-        return model.output == "acceleration"
-    return any(entry != 0 for entry in sym["D"])
-
-
-def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray | None,
-                    time_limit: float | None) -> BlackBoxStart:
-    """The frequency-response ``auto`` fit of the model to the N4SID black box's response (module notes).
-
-    Never raises for records or models the route cannot take: the start is then None and
-    ``note`` says why.
-    """
-    from symid.fit.frf.lm import AutoFRF
+def black_box_response(model: Any, data: Any) -> tuple[FrequencyData | None, str]:
+    """The continuous-time response of an N4SID black box of the model's order on ``LINES`` lines (module notes),
+    or ``(None, why)`` for records or models the route cannot take (never raises for those)."""
+    from symid.fit.similarity.data import model_has_feedthrough
     from symid.signal.subspace import n4sid
 
     if not isinstance(data, IOData):
-        return BlackBoxStart(None, "no black-box start: N4SID takes one uniformly sampled record (IOData)")
-    x0 = np.asarray(x0, dtype=float).reshape(-1)
+        return None, "no black-box start: N4SID takes one uniformly sampled record (IOData)"
     try:
-        dss = n4sid(data, model.n_states, feedthrough=_feedthrough(model))
+        dss = n4sid(data, model.n_states, feedthrough=model_has_feedthrough(model))
         _, poles = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, np.zeros(0))
     except (SymidError, np.linalg.LinAlgError, ValueError) as exc:
-        return BlackBoxStart(None, f"no black-box start: {exc}")
+        return None, f"no black-box start: {exc}"
     size = np.abs(poles)
     size = size[np.isfinite(size) & (size > 0)]
     if size.size == 0:
-        return BlackBoxStart(None, "no black-box start: the black box has no mode of nonzero frequency")
+        return None, "no black-box start: the black box has no mode of nonzero frequency"
     w = np.logspace(math.log10(BAND[0] * size.min()), math.log10(BAND[1] * size.max()), LINES)
     H, _ = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, w)
     if not np.all(np.isfinite(H)) or not np.any(H != 0):
-        return BlackBoxStart(None, "no black-box start: the black box's response is zero or not finite")
+        return None, "no black-box start: the black box's response is zero or not finite"
+    return FrequencyData(w, H), ""
+
+
+def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray | None,
+                    time_limit: float | None,
+                    response: tuple[FrequencyData | None, str] | None = None) -> BlackBoxStart:
+    """The frequency-response ``auto`` fit of the model to the N4SID black box's response (module notes).
+
+    Never raises for records or models the route cannot take: the start is then None and
+    ``note`` says why. ``response`` is :func:`black_box_response`'s answer when the caller
+    has it already (it does not depend on the start; computed here otherwise).
+    """
+    from symid.fit.frf.lm import AutoFRF
+
+    frf, why = black_box_response(model, data) if response is None else response
+    if frf is None:
+        return BlackBoxStart(None, why)
+    x0 = np.asarray(x0, dtype=float).reshape(-1)
     try:
-        fit = AutoFRF(model, FrequencyData(w, H), scale=scale, time_limit=time_limit)
+        fit = AutoFRF(model, frf, scale=scale, time_limit=time_limit)
         fit.check_start(x0)
         out = fit.run(x0)
     except SymidError as exc:
