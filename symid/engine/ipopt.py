@@ -24,6 +24,10 @@ __all__ = ["HESSIANS", "IPOPT_SUCCESS", "IpoptIteration", "IpoptRun", "IpoptSolv
 HESSIANS = ("exact", "limited-memory")
 """IPOPT's Hessian choices: exact (CasADi's automatic differentiation) or L-BFGS."""
 
+GAUSS_NEWTON = "gauss-newton"
+"""The Hessian choice of a least-squares objective f = ‖r‖² given with its residual's Jacobian
+(:class:`ScaledIpopt`'s ``residual_jacobian=``): 2 JᵀJ, J = ∂r/∂θ, first derivatives only."""
+
 IPOPT_SUCCESS = frozenset({"Solve_Succeeded", "Solved_To_Acceptable_Level"})
 """IPOPT return statuses counted as finished (its stopping rule was met)."""
 
@@ -374,7 +378,7 @@ class ScaledIpopt:
                  callback: Callable[[IpoptIteration], Any] | None = None,
                  ipopt_options: dict[str, Any] | None = None, start_scaling: bool = True,
                  objective_scaling: bool = True, barrier_from_start: bool = True, parameters: Any = None,
-                 from_best: bool = True):
+                 from_best: bool = True, residual_jacobian: Any = None):
         self.name = name
         self.lower = np.asarray(lower, dtype=float)
         self.upper = np.asarray(upper, dtype=float)
@@ -384,6 +388,9 @@ class ScaledIpopt:
         q = (ca.MX if isinstance(theta, ca.MX) else ca.SX)(0, 1) if parameters is None else parameters
         self.objective = ca.Function(f"{name}_f", [theta, q], [f])
         self.gradient = ca.Function(f"{name}_g", [theta, q], [ca.gradient(f, theta)]) if barrier_from_start else None
+        if hessian == GAUSS_NEWTON and residual_jacobian is None:
+            raise ValueError(f"{name}: hessian={GAUSS_NEWTON!r} needs the residual's Jacobian (f = ‖r‖²)")
+        self.residual_jacobian = residual_jacobian if hessian == GAUSS_NEWTON else None
         self.max_iter, self.tol, self.hessian, self.time_limit = int(max_iter), float(tol), hessian, time_limit
         self.ipopt_options = dict(ipopt_options or {})
         self.start_scaling, self.objective_scaling = bool(start_scaling), bool(objective_scaling)
@@ -462,8 +469,14 @@ class ScaledIpopt:
         s = ca.MX.sym("s", self.l)
         q = ca.MX.sym("q", self.n_values)
         nlp = {"x": z, "p": ca.vertcat(s, q), "f": self.objective(z * s, q) / 10.0**decade}
-        solver = ca.nlpsol(f"{self.name}_{len(self._solvers)}", "ipopt", nlp,
-                           self._options(decade, mu, max_iter, time_limit))
+        opts = self._options(decade, mu, max_iter, time_limit)
+        if self.residual_jacobian is not None:  # 2 JᵀJ in z: first derivatives of r only
+            lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", 0)
+            Jz = self.residual_jacobian(z * s, q) @ ca.diag(s)
+            H = 2 * lam_f / 10.0**decade * (Jz.T @ Jz)
+            opts["hess_lag"] = ca.Function(f"{self.name}_hess", [z, ca.vertcat(s, q), lam_f, lam_g], [ca.triu(H)],
+                                           ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
+        solver = ca.nlpsol(f"{self.name}_{len(self._solvers)}", "ipopt", nlp, opts)
         if keep:
             self._solvers[key] = solver
         return solver

@@ -111,7 +111,7 @@ class AutoOutputError(OutputError):
     """Seconds at most for the black-box start's response fit (and a quarter of the start's budget)."""
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
-                 positivity: bool = True, hessian: str = "exact", max_iter: int = 500, tol: float = 1e-12,
+                 positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = 120.0, callback: Any = None, verbose: bool = False,
                  restarts: int = 10, spread: float = 10.0, seed: int = 0, black_box_start: bool = True):
         budget = check_time_limit("time_limit", time_limit)

@@ -32,7 +32,9 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from symid.engine.ipopt import HESSIANS, IpoptIteration, ScaledIpopt, iteration_reporter, positivity_bounds, start_scale
+from symid.engine.ipopt import (
+    GAUSS_NEWTON, HESSIANS, IpoptIteration, ScaledIpopt, iteration_reporter, positivity_bounds, start_scale,
+)
 from symid.errors import DataError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.options import (
@@ -49,7 +51,17 @@ from symid.fit.timeseries.records import as_records
 from symid.fit.timeseries.response import balancing, casadi_output, simulate_output, squarings, state_transitions
 from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
-__all__ = ["OutputError"]
+__all__ = ["EXACT_BUILD_RATE", "SQUARING_MARGIN", "OutputError"]
+
+SQUARING_MARGIN = 2
+"""Squarings of the matrix exponential added to what a start needs, so that one graph (and solver) serves the
+estimates it leads to (:meth:`OutputError._graph_for`)."""
+
+EXACT_BUILD_RATE = 5.5e-6
+"""Seconds per (graph node × unknown) CasADi takes to build the exact Hessian of the output-error cost, for
+``hessian="auto"``: measured 3.5e-6 to 5.9e-6 on 7 problems of the time-series population, from 24 k nodes × 6
+unknowns (0.5 s) to 857 k × 12 (59 s), on the project's 2-core machine. A size rule, not a clock: the same
+problem and time limit choose the same Hessian on any machine."""
 
 
 def _sx_matrix(amap: Any, theta: Any) -> Any:
@@ -131,8 +143,15 @@ class OutputError(Estimator, FisherInformation):
         depend on the units of θ.
     positivity : bool, optional
         Bound parameters declared ``positive=True`` below by 0. Default True.
-    hessian : {"exact", "limited-memory"}, optional
-        Exact Hessian (default, CasADi) or L-BFGS.
+    hessian : {"auto", "exact", "gauss-newton", "limited-memory"}, optional
+        IPOPT's Hessian: CasADi's exact one, Gauss–Newton 2 JᵀJ from the residual's
+        Jacobian J (first derivatives only), or L-BFGS. ``"auto"`` (default): exact,
+        unless building it would take more than a quarter of ``time_limit``
+        (:data:`EXACT_BUILD_RATE` × graph nodes × unknowns; 9 s for 2300 samples of a
+        3-mass chain with gains, 59 s for 3900 samples of 5 masses, and the build cannot
+        be interrupted), then Gauss–Newton (3 s and 16 s to build there). The exact
+        Hessian converges from more starts (time-series population, n = 2, 3: one
+        output-error run 18 of 32 against 12 of 32), Gauss–Newton fits in the budget.
     max_iter : int, optional
         IPOPT iteration limit (default 500).
     tol : float, optional
@@ -171,7 +190,7 @@ class OutputError(Estimator, FisherInformation):
     cost_kind: ClassVar[str] = "relative output misfit to the measured samples (1/p) Σⱼ ‖yⱼ − ŷⱼ‖² / ‖yⱼ‖²"
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
-                 positivity: bool = True, hessian: str = "exact", max_iter: int = 500, tol: float = 1e-12,
+                 positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = None, callback: Any = None, verbose: bool = False):
         self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
         self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
@@ -181,10 +200,12 @@ class OutputError(Estimator, FisherInformation):
         l = model.n_parameters
         self.scale = None if scale is None else check_scale("scale", scale, l)
         self._positivity = check_bool("positivity", positivity)
-        self._hessian = check_choice("hessian", hessian, HESSIANS)
+        self._hessian = check_choice("hessian", hessian, ("auto", *HESSIANS, GAUSS_NEWTON))
+        self._hessian_note: dict[int, str] = {}  # per number of squarings: why "auto" chose Gauss–Newton
         self._max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         self._tol = check_float("tol", tol, low=0, strict_low=True)
         self._time_limit = check_time_limit("time_limit", time_limit)
+        self._hessian_budget = self._time_limit  # the start's whole budget, for hessian="auto" (not the time left)
         verbose = check_bool("verbose", verbose)
         check_callback("callback", callback, "IpoptIteration")
         self._report = iteration_reporter(callback, verbose)
@@ -215,6 +236,7 @@ class OutputError(Estimator, FisherInformation):
         self._lower = positivity_bounds(model.positive, self._positivity, np.ones(l))[0]
         self._solvers: dict[int, ScaledIpopt] = {}
         self._residual_fns: dict[int, Any] = {}
+        self._jacobian_fns: dict[int, Any] = {}
         self._graphs: dict[int, tuple[Any, Any, Any]] = {}  # (v, q, r) per number of squarings, built once
 
     # -- the data kind's part ------------------------------------------------------------------
@@ -311,12 +333,38 @@ class OutputError(Estimator, FisherInformation):
             res.append(ca.vec(R))
         return v, q, ca.vertcat(*res)
 
+    def _jacobian_function(self, s_max: int) -> Any:
+        """CasADi function (v, q) ↦ ∂r/∂v for ``s_max`` squarings (built once; the Gauss–Newton Hessian and
+        :meth:`jacobian` share it)."""
+        if s_max not in self._jacobian_fns:
+            v, q, r = self._symbolic(s_max)
+            self._jacobian_fns[s_max] = ca.Function("symid_oe_jacobian", [v, q], [ca.jacobian(r, v)])
+        return self._jacobian_fns[s_max]
+
     def _residual_function(self, s_max: int) -> Any:
         """CasADi function (v, q) ↦ (r, ∂r/∂v) for ``s_max`` squarings (built once)."""
         if s_max not in self._residual_fns:
             v, q, r = self._symbolic(s_max)
-            self._residual_fns[s_max] = ca.Function("symid_oe_residual", [v, q], [r, ca.jacobian(r, v)])
+            vm, qm = ca.MX.sym("v", v.numel()), ca.MX.sym("q", q.numel())
+            r_fn = ca.Function("symid_oe_r", [v, q], [r])
+            self._residual_fns[s_max] = ca.Function("symid_oe_residual", [vm, qm],
+                                                    [r_fn(vm, qm), self._jacobian_function(s_max)(vm, qm)])
         return self._residual_fns[s_max]
+
+    def _hessian_for(self, v: Any, q: Any, r: Any, s_max: int) -> str:
+        """The Hessian the solver for ``s_max`` squarings uses: the option, or for ``"auto"`` exact unless its
+        predicted build time exceeds a quarter of ``time_limit`` (the note of :meth:`run` then says so)."""
+        if self._hessian != "auto":
+            return self._hessian
+        if self._hessian_budget is None:
+            return "exact"
+        size = ca.Function("symid_oe_size", [v, q], [r]).n_nodes() * v.numel()
+        if EXACT_BUILD_RATE * size <= self._hessian_budget / 4:
+            return "exact"
+        self._hessian_note[s_max] = (f"; Gauss–Newton Hessian (hessian='auto': the exact one's build, "
+                                     f"{size:.3g} graph nodes × unknowns, would take more than a quarter of the "
+                                     f"time limit)")
+        return GAUSS_NEWTON
 
     def _solver(self, s_max: int) -> ScaledIpopt:
         """IPOPT on ‖r‖² for ``s_max`` squarings, scaled per start (built once)."""
@@ -324,9 +372,12 @@ class OutputError(Estimator, FisherInformation):
             v, q, r = self._symbolic(s_max)
             extra = v.numel() - self._lower.size
             lower = np.concatenate([self._lower, np.full(extra, -np.inf)])
+            hessian = self._hessian_for(v, q, r, s_max)
             self._solvers[s_max] = ScaledIpopt(f"symid_oe_{s_max}", v, ca.sumsqr(r), lower=lower,
                                                upper=np.full(v.numel(), np.inf), max_iter=self._max_iter,
-                                               tol=self._tol, hessian=self._hessian, parameters=q,
+                                               tol=self._tol, hessian=hessian, parameters=q,
+                                               residual_jacobian=self._jacobian_function(s_max)
+                                               if hessian == GAUSS_NEWTON else None,
                                                callback=None if self._report is None and self._time_limit is None
                                                else self._progress)
         return self._solvers[s_max]
@@ -355,6 +406,18 @@ class OutputError(Estimator, FisherInformation):
         A, B, _, _ = self._matrices(theta)
         n = self.model.n_states
         return squarings(A, B, self._h_max, (q[:n], q[n:]))
+
+    def _graph_for(self, need: int) -> int:
+        """The squarings of the graph to use where θ needs ``need``: the fewest of a graph already built that has
+        at least that many (more squarings are only more accurate), else ``need + SQUARING_MARGIN``.
+
+        Each number of squarings is a graph of its own, with its Jacobian and solver: 15 s to build for 2500
+        samples of a 5-mass chain, uninterruptible, and a second one (an estimate whose ‖A‖ grew past the
+        start's squarings) took a third of a 60 s budget. The squarings themselves cost almost nothing in the
+        graph (one exponential per distinct sample interval), so the margin lets ‖A Δt‖ grow 4 times first.
+        """
+        built = [k for k in self._graphs if k >= need]
+        return min(built) if built else need + SQUARING_MARGIN
 
     def _unknowns(self, theta: np.ndarray) -> np.ndarray:
         """v at θ: θ, then (``x0="estimate"``) the least-squares initial state of every record."""
@@ -400,9 +463,9 @@ class OutputError(Estimator, FisherInformation):
         q = self._balance(start) if np.all(np.isfinite(start)) else np.ones(self.model.n_states
                                                                             + self.model.n_inputs)
         try:
-            s = self._squarings(start, q)
+            s = self._graph_for(self._squarings(start, q))
         except (np.linalg.LinAlgError, ValueError):
-            s = 0
+            s = self._graph_for(0)
         v = self._unknowns(start)
         scale = self._unknown_scale(v)
         theta, iters, status, finished, note = start, 0, "not run", False, ""
@@ -413,7 +476,7 @@ class OutputError(Estimator, FisherInformation):
             solver = self._solver(s)
             run = solver.solve(v, scale=scale, values=q)
             iters += run.iterations
-            status, finished, note = run.status, run.finished, run.note
+            status, finished, note = run.status, run.finished, run.note + self._hessian_note.get(s, "")
             if self._timed_out:
                 status, finished = "Maximum_WallTime_Exceeded", False
             v = run.z
@@ -424,7 +487,7 @@ class OutputError(Estimator, FisherInformation):
                 need = s
             if need <= s or self._timed_out or status == "User_Requested_Stop":
                 break
-            s = need
+            s = self._graph_for(need)
         return self.outcome(start, theta, finished=finished, status=status, message=status + note, iterations=iters,
                             wall_time=time.perf_counter() - t0)
 
@@ -460,5 +523,5 @@ class OutputError(Estimator, FisherInformation):
         """
         theta = self.model.theta_vector(theta)
         q = self._balance(theta)
-        r, J = self._residual_function(self._squarings(theta, q))(self._unknowns(theta), q)
+        r, J = self._residual_function(self._graph_for(self._squarings(theta, q)))(self._unknowns(theta), q)
         return np.asarray(r).reshape(-1), np.asarray(J)
