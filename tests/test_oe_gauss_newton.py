@@ -64,7 +64,7 @@ def test_gauss_newton_hessian_is_two_jtj_of_the_residual(oscillator):
         solver = est._solver(s)
         # one Jacobian function, shared by the Hessian and the covariance (built once: the costly part at n ≥ 5)
         assert solver.residual_jacobian is est._jacobian_function(s)
-        r, J = est.jacobian(theta)
+        _, J = est.jacobian(theta)
         np.testing.assert_allclose(np.asarray(solver.residual_jacobian(theta, q)), J, rtol=1e-12, atol=0)
         v, qq, rr = est._symbolic(s)
         exact = np.asarray(ca.Function("H", [v, qq], [ca.hessian(ca.sumsqr(rr), v)[0]])(theta, q))

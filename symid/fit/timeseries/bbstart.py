@@ -131,7 +131,7 @@ def black_box_response(model: Any, data: Any) -> tuple[FrequencyData | None, str
 
 def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray | None,
                     time_limit: float | None,
-                    response: tuple[FrequencyData | None, str] | None = None, floor: bool = False) -> BlackBoxStart:
+                    response: tuple[FrequencyData | None, str] | None = None) -> BlackBoxStart:
     """The frequency-response ``auto`` fit of the model to the N4SID black box's response (module notes).
 
     Never raises for records or models the route cannot take: the start is then None and
@@ -145,18 +145,7 @@ def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray 
         return BlackBoxStart(None, why)
     x0 = np.asarray(x0, dtype=float).reshape(-1)
     try:
-        if floor:
-            import sys
-            sys.path.insert(0, "/tmp/bbf")
-            from measure_helpers import bb_sample_misfit
-
-            class _Fit(AutoFRF):
-                def black_box(self):
-                    return None
-            fit = _Fit.create(model, frf, {"scale": scale, "time_limit": time_limit},
-                              noise_floor=bb_sample_misfit(model, data))
-        else:
-            fit = AutoFRF(model, frf, scale=scale, time_limit=time_limit)
+        fit = AutoFRF(model, frf, scale=scale, time_limit=time_limit)
         fit.check_start(x0)
         out = fit.run(x0)
     except SymidError as exc:

@@ -33,7 +33,13 @@ import casadi as ca
 import numpy as np
 
 from symid.engine.ipopt import (
-    GAUSS_NEWTON, HESSIANS, IpoptIteration, ScaledIpopt, iteration_reporter, positivity_bounds, start_scale,
+    GAUSS_NEWTON,
+    HESSIANS,
+    IpoptIteration,
+    ScaledIpopt,
+    iteration_reporter,
+    positivity_bounds,
+    start_scale,
 )
 from symid.errors import DataError, OptionError
 from symid.fit.base import Estimator
