@@ -358,6 +358,11 @@ class ScaledIpopt:
         When IPOPT ends above the best objective its iterates reached, run it again from
         that iterate with a small barrier and keep the better (default True; see
         :meth:`_from_best`).
+    residual_jacobian : casadi.Function, optional
+        For ``hessian="gauss-newton"`` (:data:`GAUSS_NEWTON`; required then): (θ, parameters)
+        ↦ ∂r/∂θ of the residual r of f = ‖r‖². IPOPT then uses 2 JᵀJ (in z = θ / s), which
+        needs first derivatives of r only: cheaper to build than the exact Hessian, and
+        exact at a zero-residual fit.
 
     Examples
     --------
