@@ -74,6 +74,30 @@ def test_auto_from_two_decades_off_on_one_percent_noise_matches_ipopt_from_the_t
     assert res.cost <= ref.cost * (1 + 1e-8)
 
 
+def test_a_noisy_fit_is_confirmed_by_a_second_pass():
+    """On 1 % noise the first fit is accepted by the noise rule; ``auto`` goes on until a second pass ends at the
+    same misfit (``confirm``), ``confirm=0`` stops at the first. Reference: IPOPT from the truth, the least-squares
+    estimate both reach."""
+    model = chain2("acceleration")
+    frf = si.simulate_frf(model, TRUTH, grid(TRUTH), noise=0.01, seed=3)
+    start = TRUTH * np.array([2.0, 0.5, 3.0, 0.4, 0.6, 1.7])
+    seen = {}
+    for confirm in (0, 4):
+        misfits = []
+        # chain_start=False: one pass from the start, not two (the chain's values, then the start)
+        est = prepare(model, frf, "auto", {"seed": 0, "confirm": confirm, "chain_start": False,
+                                           "callback": lambda k, info, m=misfits: m.append(info["misfit"])})
+        out = est.run(start)
+        assert out.success
+        seen[confirm] = misfits
+    assert len(seen[0]) == 1
+    # the second pass ends at the first's misfit (the same minimum, to the stopping rule's 1e-6)
+    assert len(seen[4]) == 2
+    np.testing.assert_allclose(seen[4][1], seen[4][0], rtol=1e-6)
+    ref = si.identify(model, frf, method="ipopt", x0=TRUTH, identifiability_check=False)
+    assert min(seen[4]) <= ref.cost * (1 + 1e-8)
+
+
 def test_lm_alone_can_miss_where_auto_does_not():
     """From 6 starts within a decade of the truth on exact data of a 2-mass chain, ``auto`` reaches the truth from
     all, ``lm`` (one pass, no continuation over frequency bands, no restarts) misses some (measured: 3 of 6, each of
@@ -115,6 +139,7 @@ def test_verbose_prints_one_line_per_pass(capsys):
     ({"scale": [1.0, -2.0, 1.0, 1.0, 1.0, 1.0]}, "scale"),
     ({"spread": 0.5}, "spread"),
     ({"restarts": -1}, "restarts"),
+    ({"confirm": -1}, "confirm"),
     ({"bands": 0}, "bands"),
     ({"time_limit": 0}, "time_limit"),
     ({"callback": 3}, "callback must be callable"),

@@ -70,6 +70,18 @@ in physical units, whatever their scale (measured on the generated population of
    off (the peeling amplifies the noise), and the pass is only a start like any other
    (``benchmarks/chain_start.py``; numbers in the README).
 
+7. **A noisy fit is confirmed** (``confirm``, ``auto`` only). A fit that only the noise
+   rule accepts (misfit above 1e-10) can be a local minimum above the least-squares one:
+   the whiteness test cannot tell two fits apart that are both as good as the truth's.
+   The restarts go on until a second pass ends at the best misfit, or 4 passes after the
+   first fit. On the population benchmark's noisy problems (1 %, 27 problems, n = 2 to 8,
+   two informed and two uninformed starts each, 45 s per start), 51 of 54 uninformed
+   starts met its rule against 49 with the first fit (a 5-compartment model and an
+   8-mass chain with gains, each at the reference's misfit instead of 1.2 % and 4.3
+   times above it), 54 of 54 informed either way; the median time per start grew from
+   0.42 to 0.54 s, the mean from 3.1 to 6.2 s (an experiment's script, not kept; the
+   benchmark's rerun is in the README).
+
 Measured on generated 5-mass chains the population benchmark does not use (noise-free,
 uninformed starts, 45 s each; ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python
 benchmarks/auto_restarts.py``): the truth from 4 of 8 starts with every restart around
@@ -173,6 +185,11 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     callback : callable, optional
         ``callback(pass_index, info)`` after every pass, with ``info`` holding ``theta``,
         ``misfit``, ``fits``, ``elapsed``; a true return stops the restarts.
+    confirm : int, optional
+        Further passes after a fit that only the noise rule accepts (misfit above
+        1e-10): restarts go on until a second pass ends at the best misfit (a confirmed
+        minimum) or ``confirm`` passes have been spent since the first fit; the outcome is
+        the best (default 0 for ``"lm"``, 4 for ``"auto"``).
     chain_start : bool, optional
         For a chain of masses driven and measured at one mass, one pass starts from the
         chain's values read off the response by continued fractions
@@ -199,12 +216,14 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     default_bands: ClassVar[int] = 1
     default_time_limit: ClassVar[float | None] = None
     default_chain_start: ClassVar[bool] = False
+    default_confirm: ClassVar[int] = 0
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, restarts: int | None = None,
                  spread: float = 10.0, max_iter: int = 300, positivity: bool = True, tol: float = 1e-12,
                  time_limit: float | None = None, bands: int | None = None, seed: int = 0,
                  variance: Any = "data", verbose: bool = False,
-                 callback: Callable[[int, dict[str, Any]], Any] | None = None, chain_start: bool | None = None):
+                 callback: Callable[[int, dict[str, Any]], Any] | None = None, chain_start: bool | None = None,
+                 confirm: int | None = None):
         self.model, self.data = model, data
         l = model.n_parameters
         self.scale = None if scale is None else check_scale("scale", scale, l)
@@ -221,6 +240,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         seed = check_seed("seed", seed)
         verbose = check_bool("verbose", verbose)
         chain_start = self.default_chain_start if chain_start is None else check_bool("chain_start", chain_start)
+        confirm = self.default_confirm if confirm is None else check_int("confirm", confirm, low=0, high=10**6)
         if callback is not None and not callable(callback):
             raise OptionError(f"callback must be callable (pass_index, info) -> bool; got {type(callback).__name__}")
         label = self.set_variance(variance)  # weights, the given noise and the noise floor it declares
@@ -231,7 +251,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                         "spread": spread, "max_iter": max_iter,
                         "positivity": positivity, "tol": tol, "time_limit": time_limit, "seed": seed,
                         "variance": label,
-                        "verbose": verbose, "chain_start": chain_start}
+                        "verbose": verbose, "chain_start": chain_start, "confirm": confirm}
         H = np.asarray(data.H)
         self._H = H
         self._mask = np.abs(H) > 0
@@ -488,12 +508,14 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 # an exact fit only at the 1e-10 level on data that look noise-free can be a near-solution
                 # in a sloppy direction (measured: chains of 5 masses, misfit 4e-15 at 47 % parameter error):
                 # a few more passes look for a fit to rounding before settling for it
+                first_fit = min(first_fit, k)
                 loose = _EXACT_STOP < best.cost <= EXACT_FIT
                 settled = not loose or k >= first_fit + _EXTRA_PASSES
+                if best.cost > EXACT_FIT:  # accepted by the noise rule: confirmed, or `confirm` passes spent
+                    settled = repeats >= 2 or k >= first_fit + opts["confirm"]
                 if settled and (pending is None or best.cost <= EXACT_FIT):
                     status = "fits"
                     break
-                first_fit = min(first_fit, k)
             if spent:
                 status = "time_limit"
                 break
@@ -544,6 +566,7 @@ class AutoFRF(LmFRF):
     default_bands: ClassVar[int] = 8
     default_time_limit: ClassVar[float | None] = 120.0
     default_chain_start: ClassVar[bool] = True
+    default_confirm: ClassVar[int] = 4
 
 
 LmFRF.__doc__ = (LmFRF.__doc__ or "").format(variance=VARIANCE_OPTION_DOC)
