@@ -36,6 +36,9 @@ from symid.runlog import write_json_atomic
 CLASSES = ("chain", "gains", "compartment", "state_space")
 NOISES = (0.0, 0.01)
 HESSIANS = ("auto", "exact")
+VARIANTS = {"auto": {}, "exact": {"hessian": "exact"}, "trf": {"solver": "trf"}}
+"""What ``--variants`` may compare: the default, IPOPT with the exact Hessian, trust-region least squares on the
+numpy sensitivities (``solver="trf"``, no CasADi graph)."""
 TIME_LIMIT = 60.0
 
 
@@ -44,7 +47,7 @@ def fit(cls: str, n: int, noise: float, hessian: str) -> dict[str, Any]:
     p = make_problem(cls, n, 0, check=False)
     io = records(p, noise)
     x0 = p.starts("uninformed", 1, seed=0)[0]
-    opts = {} if hessian == "auto" else {"hessian": hessian}
+    opts = VARIANTS[hessian]
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -58,10 +61,15 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=5)
     ap.add_argument("--workers", type=int, default=1, help="default 1: the times are what is measured")
+    ap.add_argument("--variants", default=",".join(HESSIANS), help=f"default %(default)s; from {list(VARIANTS)}")
+    ap.add_argument("--out", default="timeseries_hessian.json", help="file name in benchmarks/results/")
     args = ap.parse_args(argv)
+    variants = [v for v in args.variants.split(",") if v]
+    if any(v not in VARIANTS for v in variants):
+        ap.error(f"--variants: choose from {list(VARIANTS)}")
     t_all = time.perf_counter()
     with ProcessPoolExecutor(max_workers=args.workers, mp_context=get_context("spawn"), max_tasks_per_child=1) as pool:
-        jobs = [pool.submit(fit, c, args.size, nz, h) for c in CLASSES for nz in NOISES for h in HESSIANS]
+        jobs = [pool.submit(fit, c, args.size, nz, h) for c in CLASSES for nz in NOISES for h in variants]
         rows = [j.result() for j in jobs]
     print(f"{'problem':18s} {'noise':>5s} {'hessian':7s} {'seconds':>7s} {'success':7s} {'misfit':>9s} {'error':>9s}")
     for r in rows:
@@ -69,10 +77,10 @@ def main(argv: list[str] | None = None) -> int:
               f"{r['cost']:9.3e} {r['error']:9.3g}")
     summary = {h: {"success": sum(r["success"] for r in rows if r["hessian"] == h),
                    "runs": sum(r["hessian"] == h for r in rows),
-                   "max_seconds": max(r["seconds"] for r in rows if r["hessian"] == h)} for h in HESSIANS}
+                   "max_seconds": max(r["seconds"] for r in rows if r["hessian"] == h)} for h in variants}
     for h, s in summary.items():
         print(f"{h}: {s['success']}/{s['runs']} fit, longest start {s['max_seconds']:.1f} s (budget {TIME_LIMIT:g} s)")
-    out = RESULTS / "timeseries_hessian.json"
+    out = RESULTS / args.out
     write_json_atomic(out, {"benchmark": "timeseries_hessian", "command": "benchmarks/timeseries_hessian.py",
                             "git_commit": git_commit(), "size": args.size, "time_limit": TIME_LIMIT,
                             "rows": rows, "summary": summary, "wall_time": time.perf_counter() - t_all,

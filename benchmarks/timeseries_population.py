@@ -12,7 +12,9 @@ Methods, from the same starts (informed: within a factor 3 of the truth; uninfor
 within a factor 10 of the typical values, as in ``population.py``), each with a 60 s
 budget per start: ``scr`` through the N4SID black box (the default for time series
 before), ``oe`` (one output-error run) and ``auto`` (output error restarted until the
-estimate fits, :mod:`symid.fit.timeseries.auto`). Success as in ``population.py``:
+estimate fits, :mod:`symid.fit.timeseries.auto`); ``--methods`` may add ``oe-trf`` and
+``auto-trf``, the same with ``solver="trf"`` (trust-region least squares on the numpy
+sensitivities instead of IPOPT on CasADi's graph). Success as in ``population.py``:
 noise-free, the largest relative parameter error ≤ 1e-3 (or, not proven globally
 identifiable, an exact fit with positive parameters); at 1 % noise, an error at most
 twice that of ``oe`` started at the truth (or, not proven global, a misfit at most 1.001
@@ -47,6 +49,8 @@ from symid.runlog import write_json_atomic
 
 CLASSES = ("chain", "gains", "compartment", "state_space")
 METHODS = ("scr", "oe", "auto")
+VARIANTS = {"oe-trf": ("oe", {"solver": "trf"}), "auto-trf": ("auto", {"solver": "trf"})}
+"""Method labels beyond symid's own: (method, options)."""
 NOISES = (0.0, 0.01)
 KINDS = ("informed", "uninformed")
 TIME_LIMIT = 60.0
@@ -67,12 +71,13 @@ def fit(cls: str, n: int, draw: int, noise: float, method: str | None, x0: list[
     """One ``si.identify`` on the problem's record (``method=None``: the default), as a JSON-able record."""
     p = make_problem(cls, n, 0, check=False, draw=draw)
     io = records(p, noise)
+    method, options = VARIANTS.get(method, (method, {}))  # type: ignore[arg-type]
     t0 = time.perf_counter()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             res = si.identify(p.model, io, method=method, x0=x0, seed=seed, draws=draws, identifiability_check=False,
-                              time_limit=time_limit)
+                              time_limit=time_limit, **options)
         out = {"theta": res.theta_vector.tolist(), "cost": float(res.cost), "success_reported": bool(res.success),
                "status": res.status, "refused": None}
     except si.SymidError as exc:
@@ -98,8 +103,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", default="2,3")
     ap.add_argument("--starts", type=int, default=1, help="starts of each kind (default %(default)s)")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--methods", default=",".join(METHODS), help="default %(default)s; also oe-trf, auto-trf")
+    ap.add_argument("--out", default="timeseries_population.json", help="file name in benchmarks/results/")
     args = ap.parse_args(argv)
     sizes = [int(v) for v in args.sizes.split(",") if v]
+    methods = [m for m in args.methods.split(",") if m]
+    unknown = [m for m in methods if m not in (*METHODS, *VARIANTS)]
+    if unknown:
+        ap.error(f"unknown method(s) {unknown}: choose from {[*METHODS, *VARIANTS]}")
     t_all = time.perf_counter()
     problems = problem_list(sizes)
     jobs: dict[tuple, Any] = {}
@@ -113,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
                         fit, p.cls, p.n_size, p.info["draw"], noise, "oe", p.truth.tolist())
                 for kind in KINDS:
                     for i, x0 in enumerate(p.starts(kind, args.starts, seed=0)):
-                        for m in METHODS:
+                        for m in methods:
                             jobs[(p.name, noise, kind, i, m)] = pool.submit(
                                 fit, p.cls, p.n_size, p.info["draw"], noise, m, x0.tolist())
         results = {k: f.result() for k, f in jobs.items()}
@@ -136,10 +147,10 @@ def main(argv: list[str] | None = None) -> int:
             c["refused"] += rec["refused"] is not None
             c["times"].append(rec["seconds"])
     table = []
-    print(f"\n{'class':12s} {'method':6s} {'exact, inf.':>11s} {'exact, uninf.':>13s} {'1 %, inf.':>9s} "
+    print(f"\n{'class':12s} {'method':8s} {'exact, inf.':>11s} {'exact, uninf.':>13s} {'1 %, inf.':>9s} "
           f"{'1 %, uninf.':>11s} {'refused':>7s} {'median s':>8s}")
     for cls in (*CLASSES, "all"):
-        for m in METHODS:
+        for m in methods:
             cs = [cells.get((cls, m, nz, k)) for nz in NOISES for k in KINDS]
             if any(c is None for c in cs):
                 continue
@@ -151,12 +162,12 @@ def main(argv: list[str] | None = None) -> int:
                    "median_s": float(np.median(times))}
             table.append(row)
             vals = list(row.values())
-            print(f"{cls:12s} {m:6s} {vals[2]:>11s} {vals[3]:>13s} {vals[4]:>9s} {vals[5]:>11s} {row['refused']:7d} "
+            print(f"{cls:12s} {m:8s} {vals[2]:>11s} {vals[3]:>13s} {vals[4]:>9s} {vals[5]:>11s} {row['refused']:7d} "
                   f"{row['median_s']:8.2f}")
-    out = RESULTS / "timeseries_population.json"
+    out = RESULTS / args.out
     write_json_atomic(out, {"benchmark": "timeseries_population", "command": "benchmarks/timeseries_population.py",
                             "git_commit": git_commit(), "sizes": sizes, "starts_per_kind": args.starts,
-                            "time_limit": TIME_LIMIT, "table": table, "rows": rows,
+                            "methods": methods, "time_limit": TIME_LIMIT, "table": table, "rows": rows,
                             "problems": {p.name: {"identifiability": p.info["identifiability"],
                                                   "global": bool(p.info.get("global"))} for p in problems},
                             "wall_time": time.perf_counter() - t_all,

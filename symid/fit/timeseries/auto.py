@@ -68,7 +68,7 @@ class AutoOutputError(OutputError):
 
     Parameters
     ----------
-    model, data, initial_state, positivity, hessian, max_iter, tol, callback, verbose
+    model, data, initial_state, positivity, solver, hessian, max_iter, tol, callback, verbose
         As for :class:`~symid.fit.timeseries.oe.OutputError` (each pass is one output-error run).
     scale : array_like, optional
         Typical magnitude of each parameter: every other restart is drawn around it (and
@@ -113,11 +113,12 @@ class AutoOutputError(OutputError):
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = 120.0, callback: Any = None, verbose: bool = False,
-                 restarts: int = 10, spread: float = 10.0, seed: int = 0, black_box_start: bool = True):
+                 restarts: int = 10, spread: float = 10.0, seed: int = 0, black_box_start: bool = True,
+                 solver: str = "ipopt"):
         budget = check_time_limit("time_limit", time_limit)
         super().__init__(model, data, initial_state=initial_state, scale=scale, positivity=positivity,
                          hessian=hessian, max_iter=max_iter, tol=tol, time_limit=budget, callback=callback,
-                         verbose=verbose)
+                         verbose=verbose, solver=solver)
         self._budget = budget
         self._restarts = check_int("restarts", restarts, low=0, high=10**6)
         self._spread = check_float("spread", spread, low=1.0)

@@ -26,11 +26,13 @@ units does not change its rounding.
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any, ClassVar
 
 import casadi as ca
 import numpy as np
+from scipy.optimize import least_squares
 
 from symid.engine.ipopt import (
     GAUSS_NEWTON,
@@ -41,7 +43,7 @@ from symid.engine.ipopt import (
     positivity_bounds,
     start_scale,
 )
-from symid.errors import DataError, OptionError
+from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.options import (
     check_bool,
@@ -58,7 +60,12 @@ from symid.fit.timeseries.response import balancing, casadi_output, simulate_out
 from symid.fit.timeseries.sensitivity import output_sensitivity, state_space_derivatives
 from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
-__all__ = ["EXACT_BUILD_RATE", "SQUARING_MARGIN", "OutputError"]
+__all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "OutputError"]
+
+SOLVERS = ("ipopt", "trf")
+"""The ``solver`` choices of :class:`OutputError`."""
+
+_LOG_BOX = math.log(1e8)  # "trf": |φₖ| ≤ log 1e8 for a parameter kept positive, no estimate beyond 1e8 × its start
 
 SQUARING_MARGIN = 2
 """Squarings of the matrix exponential added to what a start needs, so that one graph (and solver) serves the
@@ -159,8 +166,17 @@ class OutputError(Estimator, FisherInformation):
         be interrupted), then Gauss–Newton (3 s and 16 s to build there). The exact
         Hessian converges from more starts (time-series population, n = 2, 3: one
         output-error run 18 of 32 against 12 of 32), Gauss–Newton fits in the budget.
+    solver : {"ipopt", "trf"}, optional
+        ``"ipopt"`` (default): IPOPT on CasADi's graph of the cost, with the Hessian
+        ``hessian`` says. ``"trf"``: SciPy's trust-region reflective least squares
+        (``scipy.optimize.least_squares``) on log-parameters (θₖ = sₖ·exp(φₖ) for a
+        parameter kept positive, sₖ its start or ``scale``; the others and estimated
+        initial states in units of their scale), with the exact residual Jacobian of the
+        sensitivity recursion in numpy (:mod:`symid.fit.timeseries.sensitivity`): no
+        graph to build, so a start begins at once whatever the record's length;
+        ``hessian`` does not apply.
     max_iter : int, optional
-        IPOPT iteration limit (default 500).
+        IPOPT iteration limit, or residual evaluations of ``"trf"`` (default 500).
     tol : float, optional
         IPOPT tolerance on the relative objective (default 1e-12: the two-compartment
         study fits noise-free samples to 2e-11 in θ; 1e-14 stops noisy fits with
@@ -198,7 +214,8 @@ class OutputError(Estimator, FisherInformation):
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
-                 time_limit: float | None = None, callback: Any = None, verbose: bool = False):
+                 time_limit: float | None = None, callback: Any = None, verbose: bool = False,
+                 solver: str = "ipopt"):
         self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
         self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
         if self._x0_mode == "known":
@@ -208,6 +225,10 @@ class OutputError(Estimator, FisherInformation):
         self.scale = None if scale is None else check_scale("scale", scale, l)
         self._positivity = check_bool("positivity", positivity)
         self._hessian = check_choice("hessian", hessian, ("auto", *HESSIANS, GAUSS_NEWTON))
+        self._solver_kind = check_choice("solver", solver, SOLVERS)
+        if self._solver_kind == "trf" and self._hessian != "auto":
+            raise OptionError(f"hessian={self._hessian!r} is IPOPT's; solver='trf' builds no Hessian (its steps use "
+                              f"the residual's Jacobian): leave hessian out, or use solver='ipopt'")
         self._hessian_note: dict[int, str] = {}  # per number of squarings: why "auto" chose Gauss–Newton
         self._max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         self._tol = check_float("tol", tol, low=0, strict_low=True)
@@ -220,7 +241,7 @@ class OutputError(Estimator, FisherInformation):
         self._deadline: float | None = None  # of the start under way (time_limit), checked every iteration
         self._timed_out = False
         self.options = {"scale": "start" if self.scale is None else self.scale.tolist(),
-                        "positivity": self._positivity, "hessian": self._hessian,
+                        "positivity": self._positivity, "solver": self._solver_kind, "hessian": self._hessian,
                         "max_iter": self._max_iter, "tol": self._tol, "time_limit": self._time_limit,
                         "callback": None if callback is None else "given", "verbose": verbose,
                         "records": len(self.records),
@@ -453,6 +474,8 @@ class OutputError(Estimator, FisherInformation):
         needs more squarings, IPOPT runs again from it with the larger number (at most
         three rounds), with the start's scaling.
         """
+        if self._solver_kind == "trf":
+            return self._run_trf(np.asarray(x0, dtype=float))
         start = np.asarray(x0, dtype=float)
         t0 = time.perf_counter()
         l = self.model.n_parameters
@@ -486,6 +509,97 @@ class OutputError(Estimator, FisherInformation):
             s = self._graph_for(need)
         return self.outcome(start, theta, finished=finished, status=status, message=status + note, iterations=iters,
                             wall_time=time.perf_counter() - t0)
+
+    def _run_trf(self, start: np.ndarray) -> StartOutcome:
+        """``solver="trf"``: trust-region least squares on φ with the exact Jacobian (see ``solver``)."""
+        t0 = time.perf_counter()
+        deadline = None if self._time_limit is None else t0 + self._time_limit
+        l = self.model.n_parameters
+        v0 = self._unknowns(start)
+        unit = self._unknown_scale(v0)
+        positive = np.zeros(v0.size, dtype=bool)
+        positive[:l] = np.isfinite(self._lower) & (self._lower >= 0)  # kept positive (positivity)
+        centre = np.where(positive, np.where(v0 > 0, v0, unit), v0)
+        big = 1e3 * math.sqrt(self.n_data())
+        best = {"cost": math.inf, "v": v0.copy(), "evals": 0}
+
+        class _Spent(Exception):
+            pass
+
+        def v_of(phi: np.ndarray) -> np.ndarray:
+            return np.where(positive, centre * np.exp(np.clip(phi, -_LOG_BOX, _LOG_BOX)), centre + unit * phi)
+
+        memo: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+        def value(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            key = phi.tobytes()
+            if key in memo:
+                return memo[key]
+            if deadline is not None and time.perf_counter() > deadline:
+                raise _Spent
+            v = v_of(phi)
+            try:
+                with np.errstate(all="ignore"):
+                    r, J = self._residual_and_jacobian(v)
+                ok = bool(np.all(np.isfinite(r)) and np.all(np.isfinite(J)))
+            except (ModelError, np.linalg.LinAlgError, ValueError):
+                ok = False
+            if not ok:
+                r, J = np.full(self.n_data(), big), np.zeros((self.n_data(), v.size))
+            else:
+                inside = np.abs(phi) < _LOG_BOX
+                J = J * np.where(positive, np.where(inside, v, 0.0), unit)[None, :]  # chain rule to φ
+                cost = float(r @ r)
+                best["evals"] += 1
+                if cost < best["cost"]:
+                    best["cost"], best["v"] = cost, v
+                    if self._report is not None and self._report(IpoptIteration(
+                            best["evals"] + self._iterations_before, cost, time.perf_counter() - t0, v[:l].copy())):
+                        raise _Spent
+            memo.clear()
+            memo[key] = (r, J)
+            return r, J
+
+        phi0 = np.zeros(v0.size)  # the start
+        status, finished = "not run", False
+        try:
+            sol = least_squares(lambda p: value(p)[0], phi0, jac=lambda p: value(p)[1], method="trf", x_scale=1.0,
+                                max_nfev=self._max_iter, ftol=self._tol, xtol=self._tol, gtol=min(self._tol, 1e-10))
+            v_end = v_of(sol.x)
+            if float(np.sum(value(sol.x)[0] ** 2)) > best["cost"]:
+                v_end = best["v"]
+            status = {-1: "improper_input", 0: "max_nfev", 1: "gtol", 2: "ftol", 3: "xtol", 4: "ftol_xtol"
+                      }.get(int(sol.status), str(sol.status))
+            finished = sol.status > 0
+        except _Spent:
+            v_end = best["v"]
+            timed = deadline is not None and time.perf_counter() > deadline
+            status = "time_limit" if timed else "stopped"
+        message = f"trf: {status}; {best['evals']} evaluations"
+        return self.outcome(start, v_end[:l], finished=finished, status=status, message=message,
+                            iterations=best["evals"], wall_time=time.perf_counter() - t0)
+
+    def _residual_and_jacobian(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Weighted residual r(v) and ∂r/∂v at the unknowns v = (θ, estimated initial states), in numpy."""
+        l, n = self.model.n_parameters, self.model.n_states
+        theta = v[:l]
+        mats, dmats = state_space_derivatives(self.model, theta)
+        sw = np.sqrt(self._weights)
+        rs, Js = [], []
+        if self._estimate_x0:
+            x0s = [v[l + n * e: l + n * (e + 1)] for e in range(len(self.records))]
+        else:
+            x0s = self.initial_states(theta)
+        for e, (r, x0) in enumerate(zip(self.records, x0s, strict=True)):
+            dx0 = np.zeros((n, v.size))
+            if self._estimate_x0:
+                dx0[:, l + n * e: l + n * (e + 1)] = np.eye(n)
+            elif self._x0_mode == "model" and self.model.initial_state_map is not None:
+                dx0[:, :l] = self.model.initial_state_map.Xi[:, :, 0].T
+            Y, dY = output_sensitivity(mats, dmats, r.t, r.u, x0, dx0)
+            rs.append(((r.y - Y) * sw).T.reshape(-1))
+            Js.append((-dY * sw[None, :, None]).transpose(1, 0, 2).reshape(-1, v.size))
+        return np.concatenate(rs), np.vstack(Js)
 
     def residual_channels(self) -> np.ndarray:
         """Output channel of every entry of the residual vector of :meth:`jacobian`."""
@@ -522,19 +636,4 @@ class OutputError(Estimator, FisherInformation):
         CasADi Jacobian (12 s for 2500 samples of a 5-mass chain).
         """
         theta = self.model.theta_vector(theta)
-        model = self.model
-        l, n = model.n_parameters, model.n_states
-        mats, dmats = state_space_derivatives(model, theta)
-        columns = self.n_unknowns()
-        sw = np.sqrt(self._weights)
-        rs, Js = [], []
-        for e, (r, x0) in enumerate(zip(self.records, self.initial_states(theta), strict=True)):
-            dx0 = np.zeros((n, columns))
-            if self._estimate_x0:
-                dx0[:, l + n * e: l + n * (e + 1)] = np.eye(n)
-            elif self._x0_mode == "model" and model.initial_state_map is not None:
-                dx0[:, :l] = model.initial_state_map.Xi[:, :, 0].T
-            Y, dY = output_sensitivity(mats, dmats, r.t, r.u, x0, dx0)
-            rs.append(((r.y - Y) * sw).T.reshape(-1))
-            Js.append((-dY * sw[None, :, None]).transpose(1, 0, 2).reshape(-1, columns))
-        return np.concatenate(rs), np.vstack(Js)
+        return self._residual_and_jacobian(self._unknowns(theta))

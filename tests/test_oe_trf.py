@@ -1,0 +1,97 @@
+"""Output error with ``solver="trf"``: trust-region least squares on the numpy sensitivities (symid/fit/timeseries).
+
+References: the parameters the records are simulated from (noise-free: the exact fit), and IPOPT's estimate
+(``solver="ipopt"``) on the same noisy records, the least-squares minimum both reach.
+"""
+
+import numpy as np
+import pytest
+
+import symid as si
+from symid.fit.timeseries.auto import AutoOutputError
+from symid.fit.timeseries.oe import OutputError
+
+TRUTH = np.array([2.0, 0.8, 50.0])
+START = TRUTH * np.array([1.5, 0.6, 1.3])
+DT = 0.05
+
+
+def oscillator(factors=None):
+    factors = np.ones(3) if factors is None else np.asarray(factors)
+    m, c, k = si.parameters("m c k", positive=True)
+    return si.SecondOrderModel(M=[[factors[0] * m]], V=[[factors[1] * c]], K=[[factors[2] * k]], B=[[1]], C=[[1]],
+                               parameters=[m, c, k])
+
+
+def record(noise=None, x0=None, n=300, seed=0):
+    u = np.random.default_rng(seed).standard_normal(n)
+    return si.simulate_io(oscillator(), TRUTH, u, DT, noise=noise, seed=seed + 1, x0=x0)
+
+
+def test_trf_reaches_the_truth_of_noise_free_samples():
+    out = OutputError(oscillator(), record(), solver="trf").run(START)
+    assert out.success and out.message.startswith("trf:")
+    np.testing.assert_allclose(out.theta, TRUTH, rtol=1e-8)  # the exact fit of samples of the model itself
+
+
+def test_trf_and_ipopt_reach_the_same_least_squares_estimate_on_noisy_samples():
+    io = record(noise=0.02)
+    trf = OutputError(oscillator(), io, solver="trf").run(START)
+    ipopt = OutputError(oscillator(), io, solver="ipopt").run(START)
+    assert trf.success and ipopt.success
+    assert np.max(np.abs(trf.theta / TRUTH - 1)) > 1e-4  # the noise moved the estimate: a real comparison
+    np.testing.assert_allclose(trf.theta, ipopt.theta, rtol=1e-6)
+    assert trf.cost <= ipopt.cost * (1 + 1e-9)
+
+
+def test_trf_estimates_the_initial_states_of_several_records():
+    records = [record(x0=[0.3, -1.0], seed=1), record(x0=[-0.2, 0.5], n=200, seed=2)]
+    est = OutputError(oscillator(), records, initial_state="estimate", solver="trf")
+    out = est.run(START)
+    assert out.success
+    np.testing.assert_allclose(out.theta, TRUTH, rtol=1e-8)
+    x0s = est.initial_states(out.theta)
+    np.testing.assert_allclose(x0s[0], [0.3, -1.0], rtol=1e-7)
+    np.testing.assert_allclose(x0s[1], [-0.2, 0.5], rtol=1e-7)
+
+
+def test_trf_estimate_follows_the_units():
+    """Parameters declared in units 1e-5 … 1e6 apart, time in ms, outputs × 1e5, initial state estimated: the
+    estimate is the same estimate converted (the unknowns are log-parameters relative to the start)."""
+    io = record(noise=0.01, x0=[0.3, -1.0])
+    ref = OutputError(oscillator(), io, initial_state="estimate", solver="trf").run(START)
+    f = 10.0 ** np.array([-5.0, 4.0, 6.0])
+    alpha, beta = 1e-3, 1e5  # time in units 1e3 times smaller; outputs 1e5 times larger
+    T = np.array([alpha**-2, alpha**-1, 1.0]) / beta / f  # m, c, k of the same physics in the new units
+    io_u = si.IOData(io.u, io.y * beta, DT / alpha)
+    out = OutputError(oscillator(f), io_u, initial_state="estimate", solver="trf").run(START * T)
+    assert ref.success and out.success
+    np.testing.assert_allclose(out.theta / T, ref.theta, rtol=1e-6)
+
+
+def test_trf_keeps_to_its_time_limit_and_stops_on_the_callback():
+    io = record(n=3000)
+    est = OutputError(oscillator(), io, solver="trf", time_limit=0.2, max_iter=10**6, tol=1e-15)
+    out = est.run(TRUTH * 30)
+    # the budget plus at most one evaluation (a few ms here) and the outcome's test
+    assert out.status == "time_limit" and not out.finished and out.wall_time < 3.0
+    seen = []
+    stopper = OutputError(oscillator(), record(), solver="trf", callback=lambda info: seen.append(info) or True)
+    out = stopper.run(START)
+    assert out.status == "stopped" and len(seen) == 1
+    np.testing.assert_allclose(seen[0].theta, START, rtol=1e-12)  # the first evaluation: the start itself
+
+
+def test_an_unknown_solver_and_a_hessian_trf_does_not_use_are_named():
+    with pytest.raises(si.OptionError, match="solver"):
+        OutputError(oscillator(), record(), solver="lbfgs")
+    with pytest.raises(si.OptionError, match="hessian='exact' is IPOPT's"):
+        OutputError(oscillator(), record(), solver="trf", hessian="exact")
+
+
+def test_auto_runs_its_passes_with_trf():
+    est = AutoOutputError(oscillator(), record(), solver="trf", black_box_start=False)
+    out = est.run(START)
+    assert out.success
+    assert any(f"best pass: {why}" in out.message for why in ("gtol", "ftol", "xtol", "ftol_xtol"))  # trf's own
+    np.testing.assert_allclose(out.theta, TRUTH, rtol=1e-8)
