@@ -239,7 +239,7 @@ def test_a_megabyte_of_rows_under_a_header_declaring_a_few(tmp_path):
     _refused(lambda: BlackBox.from_csv(path), r"declares 9 data rows \('# n_rows'\) but holds \d{5}")
 
 
-def test_a_megabyte_of_blank_lines(tmp_path):  # a million lines: the slowest file under tracemalloc (2.7 s)
+def test_a_megabyte_of_blank_lines(tmp_path):  # a million lines: 0.15 s under tracemalloc (7.5 s per-line loop)
     path = _megabyte_lie("FrequencyData", tmp_path, lambda L, a, e: "".join(L[:a]) + "\n" * 2**20 + L[e])
     _refused(lambda: FrequencyData.from_csv(path), r"'# n_rows: 3' is more than the file's contents can hold")
 
