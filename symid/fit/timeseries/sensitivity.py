@@ -153,19 +153,27 @@ def output_sensitivity(mats: tuple[np.ndarray, ...], dmats: tuple[np.ndarray, ..
     N = u.shape[0]
     reps, group = interval_groups(t)
     zoh = [_zoh_derivatives(A, B, dA, dB, h) for h in reps]
-    X = np.empty((N, n))
-    S = np.empty((N, n, k))
-    x = np.asarray(x0, dtype=float).reshape(n)
-    s = np.asarray(dx0, dtype=float).reshape(n, k).copy()
-    pad = np.zeros((n, k - l))
+    # the input's part of each step for every sample at once: Bd u (N−1, n) and ∂Bd/∂θ u (N−1, n·l)
+    Bu, dBu = np.zeros((N - 1, n)), np.zeros((N - 1, n * l))
+    for g, (_, Bd, _, dBd) in enumerate(zoh):
+        at = np.flatnonzero(group == g)
+        Bu[at] = u[at] @ Bd.T
+        dBu[at] = np.einsum("knm,tm->tnk", dBd, u[at]).reshape(at.size, n * l)
+    steps = [(Ad, dAd.transpose(1, 0, 2).reshape(n * l, n)) for Ad, _, dAd, _ in zoh]  # rows (state, θₖ)
+    # Z = [x | S] (n, 1 + k): one product with Ad moves the state and every sensitivity
+    Zs = np.empty((N, n, 1 + k))
+    Z = np.empty((n, 1 + k))
+    Z[:, 0], Z[:, 1:] = np.asarray(x0, dtype=float).reshape(n), np.asarray(dx0, dtype=float).reshape(n, k)
+    forcing = np.zeros((n, 1 + k))
     with np.errstate(over="ignore", invalid="ignore"):
-        for i in range(N):
-            X[i], S[i] = x, s
-            if i < N - 1:
-                Ad, Bd, dAd, dBd = zoh[group[i]]
-                forcing = dAd @ x + dBd @ u[i]  # (l, n)
-                s = Ad @ s + (np.hstack([forcing.T, pad]) if k > l else forcing.T)
-                x = Ad @ x + Bd @ u[i]
+        for i in range(N - 1):
+            Zs[i] = Z
+            Ad, dA2 = steps[group[i]]
+            forcing[:, 0] = Bu[i]
+            forcing[:, 1:1 + l] = (dA2 @ Z[:, 0] + dBu[i]).reshape(n, l)
+            Z = Ad @ Z + forcing
+        Zs[N - 1] = Z
+        X, S = Zs[:, :, 0], Zs[:, :, 1:]
         Y = X @ C.T + u @ D.T
         dY = np.einsum("pn,tnk->tpk", C, S)
         dY[:, :, :l] += np.einsum("kpn,tn->tpk", dC, X) + np.einsum("kpm,tm->tpk", dD, u)
