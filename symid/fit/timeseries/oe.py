@@ -187,9 +187,10 @@ class OutputError(Estimator, FisherInformation):
         first start builds it), checked after every iteration (status
         ``"Maximum_WallTime_Exceeded"``). Default: none.
     callback : callable, optional
-        Called after every IPOPT iteration with a
-        :class:`~symid.engine.ipopt.IpoptIteration` (iteration, relative misfit, elapsed
-        seconds, θ); a true return value stops the start (status ``"User_Requested_Stop"``).
+        Called after every IPOPT iteration (``"trf"``: every evaluation that lowers the
+        misfit) with a :class:`~symid.engine.ipopt.IpoptIteration` (iteration, relative
+        misfit, elapsed seconds, θ); a true return value stops the start (status
+        ``"User_Requested_Stop"``; ``"stopped"`` for ``"trf"``).
     verbose : bool, optional
         Print one line per iteration (iteration, misfit, elapsed). Default False.
 
@@ -554,7 +555,7 @@ class OutputError(Estimator, FisherInformation):
                 if cost < best["cost"]:
                     best["cost"], best["v"] = cost, v
                     if self._report is not None and self._report(IpoptIteration(
-                            best["evals"] + self._iterations_before, cost, time.perf_counter() - t0, v[:l].copy())):
+                            best["evals"], cost, time.perf_counter() - t0, v[:l].copy())):
                         raise _Spent
             memo.clear()
             memo[key] = (r, J)
