@@ -46,7 +46,7 @@ def oscillator():
 
 def test_output_error_gauss_newton_reaches_the_truth(oscillator):
     model, io, truth = oscillator
-    est = OutputError(model, io, hessian=GAUSS_NEWTON)
+    est = OutputError(model, io, hessian=GAUSS_NEWTON, solver="ipopt")
     out = est.run(truth * np.array([1.3, 0.7, 1.2]))
     assert out.success
     # noise-free samples of the model itself: the truth is the exact fit (simulate_io, zero-order hold as the fit)
@@ -55,7 +55,7 @@ def test_output_error_gauss_newton_reaches_the_truth(oscillator):
 
 def test_gauss_newton_hessian_is_two_jtj_of_the_residual(oscillator):
     model, io, truth = oscillator
-    est = OutputError(model, io, hessian=GAUSS_NEWTON)
+    est = OutputError(model, io, hessian=GAUSS_NEWTON, solver="ipopt")
     gaps = []
     for factor in (1.1, 1.01):
         theta = truth * factor
@@ -81,7 +81,7 @@ def test_gauss_newton_hessian_is_two_jtj_of_the_residual(oscillator):
 def test_auto_hessian_is_exact_unless_its_build_would_take_a_quarter_of_the_time_limit(oscillator):
     model, io, truth = oscillator
     start = truth * 1.2
-    probe = OutputError(model, io)
+    probe = OutputError(model, io, solver="ipopt")
     q = probe._balance(start)
     s = probe._squarings(start, q)
     v, qq, r = probe._symbolic(s)
@@ -89,9 +89,9 @@ def test_auto_hessian_is_exact_unless_its_build_would_take_a_quarter_of_the_time
     predicted = EXACT_BUILD_RATE * size
     assert probe.options["hessian"] == "auto"
     assert probe._solver(s).hessian == "exact"  # no time limit: exact
-    roomy = OutputError(model, io, time_limit=4.5 * predicted)
+    roomy = OutputError(model, io, time_limit=4.5 * predicted, solver="ipopt")
     assert roomy._solver(s).hessian == "exact"
-    tight = OutputError(model, io, time_limit=3.5 * predicted)
+    tight = OutputError(model, io, time_limit=3.5 * predicted, solver="ipopt")
     assert tight._solver(s).hessian == GAUSS_NEWTON
     out = tight.run(start)
     assert "Gauss–Newton Hessian (hessian='auto'" in out.message

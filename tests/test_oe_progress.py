@@ -1,5 +1,8 @@
 """oe talks during long runs and keeps to a time budget (issue 14 item 6): callback=, verbose=, time_limit=.
 
+These are IPOPT's (``solver="ipopt"``), whose iterations and solver build the callback and the budget see;
+tests/test_oe_trf.py has the same for ``solver="trf"``, the default.
+
 Reference: the one-mass oscillator m q̈ + c q̇ + k q = u (m = 2, c = 0.8, k = 50), 200 samples at 0.05 s of a white
 force, 1 % output noise, started 30-50 % off (IPOPT takes 10 iterations; tests/test_units_invariance.py).
 """
@@ -32,7 +35,7 @@ def io():
 
 def test_callback_sees_every_iteration_with_the_misfit_and_theta(io):
     seen = []
-    est = OutputError(oscillator(), io, callback=seen.append)
+    est = OutputError(oscillator(), io, callback=seen.append, solver="ipopt")
     out = est.run(START)
     assert [i.iteration for i in seen] == list(range(out.iterations + 1))
     np.testing.assert_allclose(seen[0].theta, START, rtol=1e-12)
@@ -43,12 +46,12 @@ def test_callback_sees_every_iteration_with_the_misfit_and_theta(io):
 
 
 def test_callback_stops_the_start(io):
-    out = OutputError(oscillator(), io, callback=lambda info: info.iteration >= 2).run(START)
+    out = OutputError(oscillator(), io, callback=lambda info: info.iteration >= 2, solver="ipopt").run(START)
     assert (out.status, out.iterations, out.success) == ("User_Requested_Stop", 2, False)
 
 
 def test_verbose_prints_one_line_per_iteration(io, capsys):
-    out = OutputError(oscillator(), io, verbose=True).run(START)
+    out = OutputError(oscillator(), io, verbose=True, solver="ipopt").run(START)
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == out.iterations + 1 and all(line.startswith("ipopt  iteration") for line in lines)
 
@@ -58,12 +61,12 @@ def test_time_limit_stops_the_start_after_the_iteration_that_exceeds_it(io):
         time.sleep(0.2)
         return False
 
-    est = OutputError(oscillator(), io, time_limit=0.5, callback=crawl)
+    est = OutputError(oscillator(), io, time_limit=0.5, callback=crawl, solver="ipopt")
     out = est.run(START)
     assert out.status == "Maximum_WallTime_Exceeded" and not out.success
     assert 1 <= out.iterations <= 3  # 0.2 s per iteration against 0.5 s: stopped after the third (iteration 2)
     assert est.run(START).status == "Maximum_WallTime_Exceeded"  # every start has its own budget
-    assert OutputError(oscillator(), io, time_limit=60.0).run(START).status == "Solve_Succeeded"
+    assert OutputError(oscillator(), io, time_limit=60.0, solver="ipopt").run(START).status == "Solve_Succeeded"
 
 
 def test_building_the_solver_counts_in_the_time_limit(io):
@@ -74,7 +77,7 @@ def test_building_the_solver_counts_in_the_time_limit(io):
         time.sleep(0.3)
         return False
 
-    est = OutputError(oscillator(), io, time_limit=1.2, callback=crawl)
+    est = OutputError(oscillator(), io, time_limit=1.2, callback=crawl, solver="ipopt")
     build = est._solver
 
     def slow_build(s_max):

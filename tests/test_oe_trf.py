@@ -82,6 +82,28 @@ def test_trf_keeps_to_its_time_limit_and_stops_on_the_callback():
     np.testing.assert_allclose(seen[0].theta, START, rtol=1e-12)  # the first evaluation: the start itself
 
 
+def test_trf_verbose_prints_a_line_per_evaluation_that_lowers_the_misfit(capsys):
+    seen = []
+    out = OutputError(oscillator(), record(noise=0.01), verbose=True, callback=seen.append).run(START)
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == len(seen) >= 3 and all(line.startswith("trf    iteration") for line in lines)
+    misfits = [i.objective for i in seen]
+    assert all(b < a for a, b in zip(misfits, misfits[1:], strict=False))  # each one lower
+    assert misfits[-1] == pytest.approx(out.cost, rel=1e-9)
+    assert seen[0].theta == pytest.approx(START, rel=1e-12)
+
+
+def test_a_start_where_the_model_cannot_be_simulated_is_said_so():
+    # an unstable start whose response overflows the record (found on a generated 3-state network, where trf
+    # reported SciPy's "gtol" at the start: a zero gradient of the refused residual)
+    a, b = si.parameters("a b")
+    model = si.StateSpaceModel(A=[[a, b], [0, -1]], B=[[0], [1]], C=[[1, 0]])
+    io = si.simulate_io(model, {"a": -1.0, "b": 1.0}, np.random.default_rng(0).standard_normal(400), dt=1.0)
+    out = OutputError(model, io).run(np.array([2000.0, 1.0]))  # e^{2000 t}: not finite after the first sample
+    assert out.status == "invalid_start" and not out.success and not out.finished
+    assert "not finite" in out.message
+
+
 def test_an_unknown_solver_and_a_hessian_trf_does_not_use_are_named():
     with pytest.raises(si.OptionError, match="solver"):
         OutputError(oscillator(), record(), solver="lbfgs")

@@ -147,9 +147,34 @@ def test_an_estimate_where_the_model_is_singular_is_a_failed_start_not_an_except
     monkeypatch.setattr(OutputError, "_squarings", singular_after_the_solve)
     monkeypatch.setattr(OutputError, "misfit",  # as where M(θ) is singular: the model cannot be evaluated
                         lambda self, theta: misfit(self, theta) if np.array_equal(theta, start) else float("inf"))
-    res = si.identify(model, io, method="oe", x0=start, identifiability_check=False)
+    res = si.identify(model, io, method="oe", x0=start, identifiability_check=False, solver="ipopt")
     assert calls["n"] >= 2 and np.all(np.isfinite(res.theta_vector))  # a result, judged like any other
     assert res.cost == float("inf") and not res.success and res.uncertainty is None
+
+
+def test_trf_steps_where_the_model_is_singular_are_refused_not_raised(monkeypatch):
+    # solver="trf" (the default): an evaluation where M(θ) is singular raises a ModelError inside the sensitivity
+    # recursion; the step is refused (a large residual) and the start ends where it could evaluate the model
+    from symid.fit.timeseries.oe import OutputError
+
+    model = _oscillator()
+    truth = np.array([2.0, 3.0, 8000.0])
+    io = si.simulate_io(model, truth, np.random.default_rng(1).standard_normal(200), 0.01)
+    start = np.array([1.5, 2.0, 6000.0])
+    original = OutputError._residual_and_jacobian
+    refused = {"n": 0}
+
+    def singular_far_from_the_start(self, v):
+        if np.max(np.abs(v / start - 1)) > 0.05:  # steps beyond 5 % of the start: as if M(θ) were singular there
+            refused["n"] += 1
+            raise si.ModelError("M(θ) is singular at θ = ...")
+        return original(self, v)
+
+    monkeypatch.setattr(OutputError, "_residual_and_jacobian", singular_far_from_the_start)
+    res = si.identify(model, io, method="oe", x0=start, identifiability_check=False)
+    assert refused["n"] >= 1 and np.all(np.isfinite(res.theta_vector))
+    assert np.max(np.abs(res.theta_vector / start - 1)) <= 0.05 + 1e-12  # never an estimate it could not evaluate
+    assert res.cost < OutputError(model, io).misfit(start)  # it still went downhill inside the region
 
 
 def test_an_infusion_without_a_start():

@@ -172,6 +172,7 @@ def test_ipopt_spectra_frequency_axis_and_data_rescaled(spectra, a):
 
 # -- output error on sampled records (oe) -----------------------------------------------------------------
 #
+# With IPOPT (solver="ipopt"), whose path is compared; trf, the default, in tests/test_oe_trf.py.
 # oe's cost is a sum over a simulated record, whose rounding is larger than a frequency response's: measured
 # 4e-15 relative at the estimate below (cost at the estimate, 20 perturbations of 1e-15). Once the cost is within
 # that of its minimum, IPOPT's last barrier steps compare costs that differ by less than their rounding, and how many
@@ -199,7 +200,7 @@ PROGRESS = 1e-11  # an iteration makes progress while its cost exceeds the final
 def oe_run(model, data, x0, **options):
     """The outcome and the iterations that make progress: (cost, θ) while the cost is above its end by PROGRESS."""
     seen = []
-    out = OutputError(model, data, callback=seen.append, **options).run(x0)
+    out = OutputError(model, data, callback=seen.append, solver="ipopt", **options).run(x0)
     assert seen[-1].objective == pytest.approx(out.cost, rel=1e-9)
     excess = np.array([i.objective / out.cost - 1 for i in seen])
     assert not np.any((excess > PROGRESS / 10) & (excess < PROGRESS * 10)), excess  # no iteration near the threshold
@@ -271,5 +272,5 @@ def test_the_unscaled_oe_set_up_was_not_invariant(records):
     another problem for IPOPT (measured: an estimate 4e6 × off, "Solve_Succeeded")."""
     io, ref = records
     f = np.array([1e6, 1.0, 1.0])
-    out = OutputError(oscillator(f), io, scale=np.ones(3)).run(OE_START / f)
+    out = OutputError(oscillator(f), io, scale=np.ones(3), solver="ipopt").run(OE_START / f)
     assert np.max(np.abs(out.theta * f / ref[0].theta - 1)) > 1.0

@@ -222,15 +222,18 @@ class IpoptIteration:
     theta: np.ndarray = field(repr=False)
 
 
-def print_iteration(info: IpoptIteration) -> None:
-    """One line per IPOPT iteration (iteration, objective, elapsed seconds): what ``verbose=True`` prints."""
-    print(f"ipopt  iteration {info.iteration:5d}  objective {info.objective:.6e}  {info.elapsed:9.2f} s", flush=True)
+def print_iteration(info: IpoptIteration, label: str = "ipopt") -> None:
+    """One line per IPOPT iteration (iteration, objective, elapsed seconds): what ``verbose=True`` prints; ``label``
+    names the solver (another that reports the same way, e.g. ``"trf"``)."""
+    print(f"{label:6s} iteration {info.iteration:5d}  objective {info.objective:.6e}  {info.elapsed:9.2f} s",
+          flush=True)
 
 
-def iteration_reporter(callback: Callable[[IpoptIteration], Any] | None, verbose: bool
+def iteration_reporter(callback: Callable[[IpoptIteration], Any] | None, verbose: bool, label: str = "ipopt"
                        ) -> Callable[[IpoptIteration], bool] | None:
     """The per-iteration callback of :class:`ScaledIpopt` from a user's ``callback`` and ``verbose``
-    (``None`` when neither is asked for: the solver then runs without one).
+    (``None`` when neither is asked for: the solver then runs without one); ``label`` as for
+    :func:`print_iteration`.
 
     Examples
     --------
@@ -246,7 +249,7 @@ def iteration_reporter(callback: Callable[[IpoptIteration], Any] | None, verbose
 
     def report(info: IpoptIteration) -> bool:
         if verbose:
-            print_iteration(info)
+            print_iteration(info, label)
         return bool(callback(info)) if callback is not None else False
 
     return report

@@ -11,7 +11,7 @@ other one within that factor of the typical values ``scale`` when they are given
 one fits, ``restarts`` passes are spent, or ``time_limit`` (the start's whole budget) is
 reached. The outcome is the best fit found; every pass's time counts in the start's.
 A restart is drawn again (up to ``DRAW_TRIES`` times) until the model's response to the
-records is finite there: IPOPT cannot start where the simulation overflows, and for a
+records is finite there: no solver can start where the simulation overflows, and for a
 first-order network with symmetric couplings (``benchmarks/timeseries_population.py``'s
 state-space class) 8 % of the draws within a factor 3 of a start whose couplings exceed
 its rates were stable, so every restart of one such start failed at once
@@ -69,10 +69,13 @@ class AutoOutputError(OutputError):
     Parameters
     ----------
     model, data, initial_state, positivity, solver, hessian, max_iter, tol, callback, verbose
-        As for :class:`~symid.fit.timeseries.oe.OutputError` (each pass is one output-error run).
+        As for :class:`~symid.fit.timeseries.oe.OutputError` (each pass is one output-error run;
+        ``solver="trf"`` by default: 30 of 32 starts of the time-series population met the
+        success rule against 28 with IPOPT's passes, in a median 2.1 s against 7.0 s).
     scale : array_like, optional
         Typical magnitude of each parameter: every other restart is drawn around it (and
-        IPOPT works on θ / scale). Default: restarts around the start only.
+        each pass scales its unknowns by it, as ``OutputError`` does). Default: restarts
+        around the start only.
     restarts : int, optional
         Passes from random restarts after the pass from the start (and the one from the
         black box, ``black_box_start``), at most (default 10).
@@ -114,7 +117,7 @@ class AutoOutputError(OutputError):
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = 120.0, callback: Any = None, verbose: bool = False,
                  restarts: int = 10, spread: float = 10.0, seed: int = 0, black_box_start: bool = True,
-                 solver: str = "ipopt"):
+                 solver: str = "trf"):
         budget = check_time_limit("time_limit", time_limit)
         super().__init__(model, data, initial_state=initial_state, scale=scale, positivity=positivity,
                          hessian=hessian, max_iter=max_iter, tol=tol, time_limit=budget, callback=callback,
@@ -140,7 +143,7 @@ class AutoOutputError(OutputError):
 
     def _finite_draw(self, rng: np.random.Generator, centre: np.ndarray) -> np.ndarray:
         """A restart drawn around ``centre`` at which the model can be simulated (finite misfit): the first of at most
-        ``DRAW_TRIES`` draws, else the last (its pass then fails at once, as IPOPT cannot start from it)."""
+        ``DRAW_TRIES`` draws, else the last (its pass then fails at once: no solver can start from it)."""
         theta = self._draw(rng, centre)
         for _ in range(self.DRAW_TRIES - 1):
             if np.isfinite(self.misfit(theta)):
