@@ -4,6 +4,8 @@ References: the parameters the records are simulated from (noise-free: the exact
 (``solver="ipopt"``) on the same noisy records, the least-squares minimum both reach.
 """
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -88,7 +90,7 @@ def test_trf_verbose_prints_a_line_per_evaluation_that_lowers_the_misfit(capsys)
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == len(seen) >= 3 and all(line.startswith("trf    iteration") for line in lines)
     misfits = [i.objective for i in seen]
-    assert all(b < a for a, b in zip(misfits, misfits[1:], strict=False))  # each one lower
+    assert all(b < a for a, b in itertools.pairwise(misfits))  # each one lower
     assert misfits[-1] == pytest.approx(out.cost, rel=1e-9)
     assert seen[0].theta == pytest.approx(START, rel=1e-12)
 

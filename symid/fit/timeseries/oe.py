@@ -30,12 +30,12 @@ in a median 2.1 s per start against 7.0 s; one output-error run from 19 against 
 problem and noise level): 6 of 8 fits against 4 of 8, each success in 3.7 to 51 s.
 
 Nothing in the set-up depends on units (issue 14): the cost is relative to each channel's
-energy; trf works on log(θ / θ₀) for every parameter kept positive; IPOPT works on θ / |θ₀| per start (and on every estimated initial state over the
-state's rms along the start's response), on the cost over its start's decade, with a barrier
-no stronger than the cost's pull at the start (:class:`symid.engine.ipopt.ScaledIpopt`); and
-the matrix exponential is balanced before its Taylor polynomial
-(:func:`symid.fit.timeseries.response.balancing`), so that a time axis or a state in other
-units does not change its rounding.
+energy; trf works on log(θ / θ₀) for every parameter kept positive; IPOPT works on θ / |θ₀|
+per start (and on every estimated initial state over the state's rms along the start's
+response), on the cost over its start's decade, with a barrier no stronger than the cost's
+pull at the start (:class:`symid.engine.ipopt.ScaledIpopt`); and the matrix exponential is
+balanced before its Taylor polynomial (:func:`symid.fit.timeseries.response.balancing`), so
+that a time axis or a state in other units does not change its rounding.
 """
 
 from __future__ import annotations
