@@ -255,7 +255,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--data", help="folder holding the two EMPS .mat files (default: $SYMID_EMPS_DATA)")
     ap.add_argument("--quick", action="store_true", help="the committed cut (what the test suite runs)")
     ap.add_argument("--make-subset", action="store_true", help="rewrite examples/data/emps_subset.npz and stop")
-    ap.add_argument("--oe", action="store_true", help="also fit oe, open and closed loop (about two minutes)")
+    ap.add_argument("--oe", action="store_true", help="also fit oe, open and closed loop (about half a minute)")
     ap.add_argument("--sweep", action="store_true", help="also svf over filter bandwidths 5-100 Hz and hold='zoh'")
     ap.add_argument("--out", help="folder for the validation figures (PNG)")
     args = ap.parse_args(argv)
