@@ -75,12 +75,13 @@ in physical units, whatever their scale (measured on the generated population of
    the whiteness test cannot tell two fits apart that are both as good as the truth's.
    The restarts go on until a second pass ends at the best misfit, or 4 passes after the
    first fit. On the population benchmark's noisy problems (1 %, 27 problems, n = 2 to 8,
-   two informed and two uninformed starts each, 45 s per start), 51 of 54 uninformed
-   starts met its rule against 49 with the first fit (a 5-compartment model and an
-   8-mass chain with gains, each at the reference's misfit instead of 1.2 % and 4.3
-   times above it), 54 of 54 informed either way; the median time per start grew from
-   0.42 to 0.54 s, the mean from 3.1 to 6.2 s (an experiment's script, not kept; the
-   benchmark's rerun is in the README).
+   two informed and two uninformed starts each, 45 s per start; ``OMP_NUM_THREADS=1
+   OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/auto_confirm.py``, confirm 0 and 4
+   side by side, ``benchmarks/results/auto_confirm.jsonl``), 51 of 54 uninformed starts
+   met its rule against 49 with the first fit (a 5-compartment model and an 8-mass chain
+   with gains, each at the reference's misfit instead of 1.2 % and 4.3 times above it),
+   54 of 54 informed either way, no start lost; the median time per start grew from 0.61
+   to 0.97 s uninformed (0.32 to 0.42 s informed), the mean from 3.5 to 6.5 s.
 
 Measured on generated 5-mass chains the population benchmark does not use (noise-free,
 uninformed starts, 45 s each; ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python
