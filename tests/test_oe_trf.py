@@ -5,6 +5,7 @@ References: the parameters the records are simulated from (noise-free: the exact
 """
 
 import itertools
+import warnings
 
 import numpy as np
 import pytest
@@ -104,6 +105,30 @@ def test_a_start_where_the_model_cannot_be_simulated_is_said_so():
     out = OutputError(model, io).run(np.array([2000.0, 1.0]))  # e^{2000 t}: not finite after the first sample
     assert out.status == "invalid_start" and not out.success and not out.finished
     assert "not finite" in out.message
+
+
+def test_a_budget_spent_before_the_first_evaluation_is_a_time_limit_not_an_invalid_start():
+    out = OutputError(oscillator(), record(), time_limit=1e-9).run(START)  # found by a new user: "invalid_start"
+    assert out.status == "time_limit" and not out.finished
+    np.testing.assert_array_equal(out.theta, START)
+
+
+def test_steps_that_all_overflow_leave_the_start_and_say_so():
+    # found by a new user: an unstable start (e^{~7.7 t} over 40 s) evaluated, every step from it overflowed, and trf
+    # returned NaN parameters under SciPy's "gtol"; now the start, with a status and message saying why
+    a, b, g = si.parameters("a b g")
+    model = si.StateSpaceModel(A=[[0, 1], [-a, -b]], B=[[0], [g]], C=[[1, 0]])
+    u = np.repeat(np.random.default_rng(3).standard_normal(100), 8)
+    io = si.simulate_io(model, {"a": 4.0, "b": 0.6, "g": 2.0}, u, dt=0.05, noise=0.01, seed=1)
+    start = np.array([-20.0, -5.0, 1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # and nothing from numpy or SciPy is printed
+        out = OutputError(model, io).run(start)
+    assert np.all(np.isfinite(out.theta)) and not out.success
+    if np.array_equal(out.theta, start):
+        assert out.status == "no_step" and "every step from the start was refused" in out.message
+    else:  # a finite step was found after all: then it is no worse than the start
+        assert out.cost <= OutputError(model, io).misfit(start)
 
 
 def test_an_unknown_solver_and_a_hessian_trf_does_not_use_are_named():

@@ -228,6 +228,9 @@ def whiteness(residuals: np.ndarray) -> float:
     if s < 3:
         return 0.0
     r = r.reshape(s, -1)
+    peak = float(np.max(np.abs(r)))
+    if peak > 0:  # the statistic does not change with the residuals' scale; residuals near overflow do not overflow
+        r = r / peak
     prod = np.conj(r[:-1]) * r[1:]
     var = float(np.sum(np.abs(prod) ** 2)) / (2.0 if is_complex else 1.0)
     if var == 0.0:

@@ -542,7 +542,8 @@ class OutputError(Estimator, FisherInformation):
         positive[:l] = np.isfinite(self._lower) & (self._lower >= 0)  # kept positive (positivity)
         centre = np.where(positive, np.where(v0 > 0, v0, unit), v0)
         big = 1e3 * math.sqrt(self.n_data())
-        best = {"cost": math.inf, "v": v0.copy(), "evals": 0}
+        best = {"cost": math.inf, "v": v0.copy(), "evals": 0, "refused": 0}
+        costs: dict[bytes, float] = {}  # every finite evaluation's misfit, by φ
 
         class _Spent(Exception):
             pass
@@ -566,11 +567,13 @@ class OutputError(Estimator, FisherInformation):
             except (ModelError, np.linalg.LinAlgError, ValueError):
                 ok = False
             if not ok:
+                best["refused"] += 1
                 r, J = np.full(self.n_data(), big), np.zeros((self.n_data(), v.size))
             else:
                 inside = np.abs(phi) < _LOG_BOX
                 J = J * np.where(positive, np.where(inside, v, 0.0), unit)[None, :]  # chain rule to φ
                 cost = float(r @ r)
+                costs[key] = cost
                 best["evals"] += 1
                 if cost < best["cost"]:
                     best["cost"], best["v"] = cost, v
@@ -584,11 +587,13 @@ class OutputError(Estimator, FisherInformation):
         phi0 = np.zeros(v0.size)  # the start
         status, finished = "not run", False
         try:
-            sol = least_squares(lambda p: value(p)[0], phi0, jac=lambda p: value(p)[1], method="trf", x_scale=1.0,
-                                max_nfev=self._max_iter, ftol=self._tol, xtol=self._tol, gtol=min(self._tol, 1e-10))
-            v_end = v_of(sol.x)
-            if float(np.sum(value(sol.x)[0] ** 2)) > best["cost"]:
-                v_end = best["v"]
+            with np.errstate(all="ignore"):  # steps into overflow are refused above, not printed by SciPy
+                sol = least_squares(lambda p: value(p)[0], phi0, jac=lambda p: value(p)[1], method="trf",
+                                    x_scale=1.0, max_nfev=self._max_iter, ftol=self._tol, xtol=self._tol,
+                                    gtol=min(self._tol, 1e-10))
+            # SciPy's last point, unless an evaluation it did not keep was better (or its own was refused)
+            end_cost = costs.get(sol.x.tobytes(), math.inf)
+            v_end = v_of(sol.x) if end_cost <= best["cost"] else best["v"]
             status = {-1: "improper_input", 0: "max_nfev", 1: "gtol", 2: "ftol", 3: "xtol", 4: "ftol_xtol"
                       }.get(int(sol.status), str(sol.status))
             finished = sol.status > 0
@@ -596,11 +601,16 @@ class OutputError(Estimator, FisherInformation):
             v_end = best["v"]
             timed = deadline is not None and time.perf_counter() > deadline
             status = "time_limit" if timed else "stopped"
-        message = f"trf: {status}; {best['evals']} evaluations"
-        if not math.isfinite(best["cost"]):  # not one finite evaluation: the start itself cannot be simulated
+        message = f"trf: {status}; {best['evals']} evaluation{'s' if best['evals'] != 1 else ''}"
+        if not math.isfinite(best["cost"]) and status not in ("time_limit", "stopped"):
+            # not one finite evaluation (the budget did not stop it first): the start itself cannot be simulated
             status, finished = "invalid_start", False
             message = ("trf: invalid_start; the model's response at the start is not finite (or the model cannot be "
                        "evaluated there), so no step could be taken")
+        elif best["refused"] and np.array_equal(v_end, v0):
+            status, finished = "no_step", False
+            message += (f"; every step from the start was refused ({best['refused']} where the model's response is "
+                        f"not finite or the model cannot be evaluated): the estimate is the start")
         return self.outcome(start, v_end[:l], finished=finished, status=status, message=message,
                             iterations=best["evals"], wall_time=time.perf_counter() - t0)
 
