@@ -27,7 +27,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.linalg import expm_frechet
+from scipy.linalg import expm, expm_frechet
 
 from symid.fit.timeseries.response import interval_groups
 
@@ -100,9 +100,7 @@ def _zoh_derivatives(A: np.ndarray, B: np.ndarray, dA: np.ndarray, dB: np.ndarra
         dF[:n, :n], dF[:n, n:] = dA[k] * h, dB[k] * h
         Phi, L = expm_frechet(F, dF, compute_expm=True, check_finite=False)
         dAd[k], dBd[k] = L[:n, :n], L[:n, n:]
-    if Phi is None:
-        from scipy.linalg import expm
-
+    if Phi is None:  # no parameter in A or B: the exponential alone
         Phi = expm(F)
     return Phi[:n, :n], Phi[:n, n:], dAd, dBd
 
