@@ -81,13 +81,13 @@ def test_auto_runs_the_black_box_start_first_unless_the_start_fits(monkeypatch, 
     x0 = TRUTH if start_fits else TRUTH * 3.0
     calls = []
 
-    def stub(model_, data, start, *, scale, time_limit, response=None):
+    def stub(model_, data, start, *, scale, time_limit, passes=8, response=None):
         calls.append(time_limit)
         return BlackBoxStart(TRUTH.copy(), "the stub's fit", 0.0)
 
     monkeypatch.setattr(auto_module, "black_box_start", stub)
     res = si.identify(model, io, x0=x0, restarts=0, time_limit=40.0, identifiability_check=False)
-    assert calls == [pytest.approx(10.0)]  # a quarter of the budget (BLACK_BOX_LIMIT = 15 s caps longer ones)
+    assert calls == [pytest.approx(20.0)]  # half the budget, a safety (BLACK_BOX_SHARE): its passes are counted
     assert res.success
     np.testing.assert_allclose(res.theta_vector, TRUTH, rtol=1e-8)
     # a pass that fits to rounding ends the start: the other special pass is not run
@@ -143,3 +143,21 @@ def test_the_black_box_is_estimated_once_for_every_start(monkeypatch):
     for factor in (2.0, 3.0):  # two starts of one estimator (as identify runs them)
         assert est.run(TRUTH * factor).success
     assert len(responses) == 1
+
+
+def test_on_noisy_records_the_response_fit_is_counted_in_passes_not_seconds():
+    # the black box of noisy records is no model's response, so no pass fits it exactly; the fit stops when three
+    # passes end at the same best misfit (measured here: 3 passes, about 1 s), not when a time runs out, and the same
+    # start gives the same start for output error under any budget that is not spent
+    model = _chain()
+    io = _records(model, noise=0.01)
+    x0 = TRUTH * np.array([3.0, 0.5, 2.0, 0.5, 0.5, 2.0])
+    found = black_box_start(model, io, x0, scale=None, time_limit=60.0)
+    again = black_box_start(model, io, x0, scale=None, time_limit=600.0)
+    assert found.theta is not None and found.misfit > 1e-10, found.note  # the noisy black box is fitted, not exactly
+    assert found.note.endswith(" s, 3 pass(es))"), found.note
+    np.testing.assert_array_equal(found.theta, again.theta)
+    # the start is near the truth: 1 % output noise moves the black box's modes by far less than a factor 2
+    np.testing.assert_allclose(found.theta, TRUTH, rtol=0.5)
+    capped = black_box_start(model, io, x0, scale=None, time_limit=60.0, passes=1)
+    assert capped.note.endswith(" s, 1 pass(es))"), capped.note

@@ -57,7 +57,7 @@ import numpy as np
 from symid.fit.options import check_bool, check_float, check_int, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.success import EXACT_FIT
-from symid.fit.timeseries.bbstart import black_box_response, black_box_start
+from symid.fit.timeseries.bbstart import PASSES, black_box_response, black_box_start
 from symid.fit.timeseries.oe import OutputError
 
 __all__ = ["AutoOutputError"]
@@ -89,10 +89,10 @@ class AutoOutputError(OutputError):
         Wall-time budget of the whole start in seconds, every pass included (default 120).
     black_box_start : bool, optional
         On one uniformly sampled record, one more pass starts from the model fitted to
-        an N4SID black box's response (:mod:`symid.fit.timeseries.bbstart`), within
-        a quarter of the budget (at most ``BLACK_BOX_LIMIT`` s): the first pass, unless
-        the start already fits exactly and no worse; the start gets the second unless the
-        first fits to rounding (default True).
+        an N4SID black box's response (:mod:`symid.fit.timeseries.bbstart`; at most
+        ``bbstart.PASSES`` passes of that fit, with half the budget as a safety): the first
+        pass, unless the start already fits exactly and no worse; the start gets the second
+        unless the first fits to rounding (default True).
 
     Examples
     --------
@@ -110,8 +110,9 @@ class AutoOutputError(OutputError):
     method: ClassVar[str] = "auto"
     DRAW_TRIES: ClassVar[int] = 100
     """Draws tried for a restart at which the model's response is finite (module notes)."""
-    BLACK_BOX_LIMIT: ClassVar[float] = 15.0
-    """Seconds at most for the black-box start's response fit (and a quarter of the start's budget)."""
+    BLACK_BOX_SHARE: ClassVar[float] = 0.5
+    """The share of the start's budget after which the black-box start's response fit stops (a safety: its passes
+    are counted, ``bbstart.PASSES``, so that the start does not depend on the machine's load)."""
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
@@ -157,9 +158,9 @@ class AutoOutputError(OutputError):
         (None: no such pass), and what the black-box step found."""
         if not self._black_box_start:
             return [start], None, ""
-        limit = self.BLACK_BOX_LIMIT if self._budget is None else min(self.BLACK_BOX_LIMIT, 0.25 * self._budget)
+        limit = None if self._budget is None else self.BLACK_BOX_SHARE * self._budget
         if self._verbose_passes:
-            print(f"auto: fitting the model to an N4SID black box's response (at most {limit:g} s)", flush=True)
+            print(f"auto: fitting the model to an N4SID black box's response (at most {PASSES} passes)", flush=True)
         if self._bb_response is None:  # the black box's response is the records', the same for every start
             self._bb_response = black_box_response(self.model, self.data)
         found = black_box_start(self.model, self.data, start, scale=self.scale, time_limit=limit,
