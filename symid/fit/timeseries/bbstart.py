@@ -22,20 +22,19 @@ method through a black box:
 3. **Structured fit.** The model is fitted to that response on 100 log-spaced lines from
    0.3 times the slowest to 3 times the fastest black-box mode by the frequency-response
    ``auto`` from the start (with the typical values ``scale``), in at most ``PASSES``
-   passes; its estimate is the start of an output-error pass. The passes stop once three
-   of them end at the same best misfit, whether or not it is an exact fit: the response
-   is a black box's, exact only to N4SID's rounding on noise-free records (a relative
-   error of about 1e-8 on 5-mass chains) and no model's at all on noisy ones, so
-   ``auto``'s rule for data (restart while a black box fits them better than the model)
-   would always restart. The count, not a time, ends the fit, so the start does not depend
-   on how busy the machine is; a time limit (a share of the start's budget) is only a
-   safety. Measured on the time-series population's records (n = 2, 3, 5, one informed
-   and one uninformed start per problem and noise level, every pass logged, 45 s each):
-   noise-free, the best misfit came at pass 0 in 26 of 30 runs and by pass 4 in all; at
-   1 %, by pass 0 in 21 of 30 (at n = 2 and 3 every later pass ended at a minimum already
-   found, 30 of 31 passes spent for nothing), and by pass 9 and 16 on the two 5-mass
-   records whose black box is poorest (the chain and the chain with gains, where the fit
-   ends at misfit 1e-3 to 4e-3 after any of passes 3 to 16).
+   passes; its estimate is the start of an output-error pass. The count of passes, not a
+   time, ends the fit, so the start does not depend on how busy the machine is (a time
+   limit, a share of the start's budget, is only a safety). Measured on the time-series
+   population's records (n = 2, 3, 5, one informed and one uninformed start per problem
+   and noise level, every pass logged, 45 s each): noise-free, the best misfit came at
+   pass 0 in 26 of 30 runs and by pass 4 in all; at 1 %, at pass 0 in 21 of 30, and by
+   pass 9 and 16 on the two 5-mass records whose black box is poorest (the chain and the
+   chain with gains, where the fit ends at misfit 1e-3 to 4e-3 after any of passes 3 to
+   16). A noisy black box is no model's response, so the passes go on to the count there
+   (``auto``'s rule for data: restart while a black box fits them better than the
+   model); stopping once three passes ended at the same misfit instead lost a 3-mass
+   chain on noise-free records, whose near-fit at 2e-8 came three times before the
+   fourth pass reached the truth.
 
 On noise-free records the response is the model's own, and the fit recovers θ; on noisy
 ones N4SID can misplace a weakly observable mode, and the fit is only a start like any
@@ -56,7 +55,6 @@ import numpy as np
 from symid.data import FrequencyData, IOData
 from symid.errors import SymidError
 from symid.fit.frf.lm import AutoFRF
-from symid.fit.result import StartOutcome
 
 __all__ = ["BlackBoxStart", "black_box_response", "black_box_start", "modal_response"]
 
@@ -151,7 +149,7 @@ def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray 
                     response: tuple[FrequencyData | None, str] | None = None) -> BlackBoxStart:
     """The frequency-response ``auto`` fit of the model to the N4SID black box's response (module notes).
 
-    At most ``passes`` passes (fewer once three end at the same best misfit); ``time_limit``
+    At most ``passes`` passes (fewer once one fits the response exactly); ``time_limit``
     is a safety. Never raises for records or models the route cannot take: the start is
     then None and ``note`` says why. ``response`` is :func:`black_box_response`'s answer
     when the caller has it already (it does not depend on the start; computed here otherwise).
@@ -161,7 +159,7 @@ def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray 
         return BlackBoxStart(None, why)
     x0 = np.asarray(x0, dtype=float).reshape(-1)
     try:
-        fit = _ResponseFit(model, frf, scale=scale, time_limit=time_limit, restarts=passes - 1)
+        fit = AutoFRF(model, frf, scale=scale, time_limit=time_limit, restarts=passes - 1)
         fit.check_start(x0)
         out = fit.run(x0)
     except SymidError as exc:
@@ -174,9 +172,3 @@ def black_box_start(model: Any, data: Any, x0: np.ndarray, *, scale: np.ndarray 
     return BlackBoxStart(out.theta, f"the N4SID black box's response fitted to misfit {out.cost:.2e} "
                                     f"({out.wall_time:.1f} s, {1 + len(out.passes)} pass(es))", float(out.cost))
 
-
-class _ResponseFit(AutoFRF):
-    """``auto`` on a black box's response: a minimum found three times ends the fit (module notes, step 3)."""
-
-    def _cleaner_than(self, best: StartOutcome) -> bool:
-        return False
