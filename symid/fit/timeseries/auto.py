@@ -57,7 +57,7 @@ import numpy as np
 from symid.fit.options import check_bool, check_float, check_int, check_seed, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.success import EXACT_FIT
-from symid.fit.timeseries.bbstart import PASSES, black_box_response, black_box_start
+from symid.fit.timeseries.bbstart import BlackBoxResponse, black_box_response, black_box_start
 from symid.fit.timeseries.oe import OutputError
 
 __all__ = ["AutoOutputError"]
@@ -89,10 +89,10 @@ class AutoOutputError(OutputError):
         Wall-time budget of the whole start in seconds, every pass included (default 120).
     black_box_start : bool, optional
         On one uniformly sampled record, one more pass starts from the model fitted to
-        an N4SID black box's response (:mod:`symid.fit.timeseries.bbstart`; at most
-        ``bbstart.PASSES`` passes of that fit, with half the budget as a safety): the first
-        pass, unless the start already fits exactly and no worse; the start gets the second
-        unless the first fits to rounding (default True).
+        an N4SID black box's response (:mod:`symid.fit.timeseries.bbstart`; that fit is
+        counted in passes, with half the budget as a safety): the first pass, unless the
+        start already fits exactly and no worse; the start gets the second unless the first
+        fits to rounding (default True).
 
     Examples
     --------
@@ -112,7 +112,7 @@ class AutoOutputError(OutputError):
     """Draws tried for a restart at which the model's response is finite (module notes)."""
     BLACK_BOX_SHARE: ClassVar[float] = 0.5
     """The share of the start's budget after which the black-box start's response fit stops (a safety: its passes
-    are counted, ``bbstart.PASSES``, so that the start does not depend on the machine's load)."""
+    are counted, so that the start does not depend on the machine's load)."""
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
@@ -129,7 +129,7 @@ class AutoOutputError(OutputError):
         self._seed = check_seed("seed", seed)
         self._verbose_passes = bool(verbose)
         self._black_box_start = check_bool("black_box_start", black_box_start)
-        self._bb_response: tuple[Any, str] | None = None  # black_box_response's answer, computed once
+        self._bb_response: BlackBoxResponse | None = None  # black_box_response's answer, computed once
         self._positive = np.asarray(model.positive, dtype=bool) & self._positivity
         self.options = {**self.options, "time_limit": budget, "restarts": self._restarts, "spread": self._spread,
                         "seed": self._seed, "black_box_start": self._black_box_start}
@@ -160,7 +160,7 @@ class AutoOutputError(OutputError):
             return [start], None, ""
         limit = None if self._budget is None else self.BLACK_BOX_SHARE * self._budget
         if self._verbose_passes:
-            print(f"auto: fitting the model to an N4SID black box's response (at most {PASSES} passes)", flush=True)
+            print("auto: fitting the model to an N4SID black box's response", flush=True)
         if self._bb_response is None:  # the black box's response is the records', the same for every start
             self._bb_response = black_box_response(self.model, self.data)
         found = black_box_start(self.model, self.data, start, scale=self.scale, time_limit=limit,
