@@ -12,7 +12,7 @@ each, ``si.identify(model, record, seed=s)`` with the default method (``auto``) 
 
 Success as in ``population.py`` (noise-free: largest relative parameter error ≤ 1e-3, or
 for a problem not proven globally identifiable an exact fit with positive parameters;
-1 %: error at most twice that of output error started at the truth, or not proven
+1 %: error at most twice that of IPOPT's output error started at the truth, or not proven
 global, a misfit at most 1.001 times its misfit). 60 s per start (``--time-limit``).
 
 Run::
@@ -39,7 +39,7 @@ import numpy as np
 from _study import RESULTS, git_commit  # benchmarks/ (the script's folder) is on the path
 from population import parameter_error as error
 from population import start_success
-from timeseries_population import CLASSES, NOISES, fit, problem_list
+from timeseries_population import CLASSES, NOISES, REFERENCE, fit, problem_list
 
 from symid.runlog import write_json_atomic
 
@@ -74,7 +74,8 @@ def main(argv: list[str] | None = None) -> int:
             for noise in NOISES:
                 if noise:
                     jobs[(p.name, noise, "reference", 0)] = pool.submit(
-                        fit, p.cls, p.n_size, p.info["draw"], noise, "oe", p.truth.tolist(), time_limit=args.time_limit)
+                        fit, p.cls, p.n_size, p.info["draw"], noise, REFERENCE, p.truth.tolist(),
+                        time_limit=args.time_limit)
                 for d in run_draws:
                     for s in seeds:
                         jobs[(p.name, noise, d, s)] = pool.submit(
