@@ -17,8 +17,10 @@ estimate fits, :mod:`symid.fit.timeseries.auto`); ``--methods`` may add ``oe-trf
 sensitivities instead of IPOPT on CasADi's graph). Success as in ``population.py``:
 noise-free, the largest relative parameter error ≤ 1e-3 (or, not proven globally
 identifiable, an exact fit with positive parameters); at 1 % noise, an error at most
-twice that of ``oe`` with IPOPT started at the truth (or, not proven global, a misfit at most 1.001
-times its misfit). A method that refuses the problem (an error naming why) fails it.
+twice that of the least-squares estimate from the truth (output error started there by
+IPOPT and by trf, the lower misfit: ``REFERENCES``; or, not proven global, a misfit at
+most 1.001 times its misfit). A method that refuses the problem (an error naming why)
+fails it.
 
 Run (about 25 minutes on 2 cores)::
 
@@ -52,11 +54,20 @@ METHODS = ("scr", "oe", "auto")
 VARIANTS = {"oe-trf": ("oe", {"solver": "trf"}), "auto-trf": ("auto", {"solver": "trf"}),
             "oe-ipopt": ("oe", {"solver": "ipopt"}), "auto-ipopt": ("auto", {"solver": "ipopt"})}
 """Method labels beyond symid's own: (method, options)."""
-REFERENCE = "oe-ipopt"
-"""The 1 % reference: IPOPT's output error started at the truth (issue 14's definition), whatever the default solver.
-Since ``solver="trf"`` became the default, plain ``oe`` from the truth can stop at its evaluation limit near the truth
-in a sloppy direction (a 3-mass chain: misfit 1.01745e-4 at 54 % error, where IPOPT goes on to 1.01729e-4 at 7e5 %),
-which made the same estimate a miss in one run and a success in the other."""
+REFERENCES = ("oe-ipopt", "oe-trf")
+"""The 1 % reference is the lower misfit of output error started at the truth by IPOPT (issue 14's definition) and by
+trf: the least-squares estimate nearest the truth. Either alone can fall short of it: trf can stop at its evaluation
+limit near the truth in a sloppy direction (a 3-mass chain: misfit 1.01745e-4 at 54 % error, where IPOPT goes on to
+1.01729e-4 at 7e5 %), and IPOPT can spend the whole 60 s building its graph without a step (the 5-mass chain's 2491
+samples: the truth itself, error 0, as reference)."""
+
+
+def reference(results: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The better of the reference runs (:data:`REFERENCES`), by misfit."""
+    runs = [results[m] for m in REFERENCES if results[m]["cost"] is not None and math.isfinite(results[m]["cost"])]
+    return min(runs, key=lambda r: r["cost"]) if runs else results[REFERENCES[0]]
+
+
 NOISES = (0.0, 0.01)
 KINDS = ("informed", "uninformed")
 TIME_LIMIT = 60.0
@@ -126,8 +137,9 @@ def main(argv: list[str] | None = None) -> int:
         for p in problems:
             for noise in NOISES:
                 if noise:
-                    jobs[(p.name, noise, "reference", 0, "oe")] = pool.submit(
-                        fit, p.cls, p.n_size, p.info["draw"], noise, REFERENCE, p.truth.tolist())
+                    for ref_method in REFERENCES:
+                        jobs[(p.name, noise, "reference", 0, ref_method)] = pool.submit(
+                            fit, p.cls, p.n_size, p.info["draw"], noise, ref_method, p.truth.tolist())
                 for kind in KINDS:
                     for i, x0 in enumerate(p.starts(kind, args.starts, seed=0)):
                         for m in methods:
@@ -141,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
         if kind == "reference":
             continue
         p = by[name]
-        ref = results[(name, noise, "reference", 0, "oe")] if noise else None
+        ref = reference({r: results[(name, noise, "reference", 0, r)] for r in REFERENCES}) if noise else None
         ok = start_success(rec["theta"], rec["cost"], p.truth, np.ones(p.truth.size, bool), bool(p.info.get("global")),
                            ref)
         rows.append({"problem": name, "noise": noise, "kind": kind, "start": i, "method": m, "success": ok,
@@ -176,12 +188,12 @@ def main(argv: list[str] | None = None) -> int:
                             "methods": methods, "time_limit": TIME_LIMIT, "table": table, "rows": rows,
                             "problems": {p.name: {"identifiability": p.info["identifiability"],
                                                   "global": bool(p.info.get("global"))} for p in problems},
-                            # the 1 % references (REFERENCE from the truth): a noisy start is judged against them
-                            "references": {f"{name}/noise{noise:g}": {"cost": rec["cost"],
-                                                                      "error": None if rec["theta"] is None else
-                                                                      error(rec["theta"], by[name].truth),
-                                                                      "status": rec["status"]}
-                                           for (name, noise, kind, _, _), rec in results.items()
+                            # the 1 % references (REFERENCES from the truth): a noisy start is judged against the better
+                            "references": {f"{name}/noise{noise:g}/{m}": {"cost": rec["cost"],
+                                                                         "error": None if rec["theta"] is None else
+                                                                         error(rec["theta"], by[name].truth),
+                                                                         "status": rec["status"]}
+                                           for (name, noise, kind, _, m), rec in results.items()
                                            if kind == "reference"},
                             "wall_time": time.perf_counter() - t_all,
                             "machine": {"platform": platform.platform(), "python": platform.python_version()}})
