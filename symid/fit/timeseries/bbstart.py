@@ -37,11 +37,11 @@ method through a black box:
    from a start a decade off came to near-fits at 2e-8 in ten passes before the eleventh
    reached the truth). Measured on the time-series population's records (n = 2, 3, 5, one
    informed and one uninformed start per problem and noise level, every pass logged, 45 s
-   each, the floor not yet used): noise-free, the best misfit came at pass 0 in 26 of 30
-   runs and by pass 4 in all; at 1 %, at pass 0 in 21 of 30, later passes ending at
-   minima found before, and by pass 9 and 16 on the two 5-mass records whose black box is
-   poorest. Before, a 15 s cap ended the fit, so a noisy record's start depended on the
-   machine's load, and spent the whole 15 s there.
+   each, the floor not yet used): noise-free, the best misfit came at pass 0 in 25 of 30
+   runs and by pass 4 in all; at 1 %, at pass 0 in 23 of 30 and by pass 3 in all but the
+   four runs of the 5-mass chain and chain with gains, whose black boxes are poorest
+   (passes 6 to 16). Before, a 15 s cap ended the fit, so a noisy record's start depended
+   on the machine's load, and spent the whole 15 s there.
 
 On noise-free records the response is the model's own, and the fit recovers θ; on noisy
 ones N4SID can misplace a weakly observable mode, and the fit is only a start like any
