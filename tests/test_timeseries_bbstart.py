@@ -87,7 +87,7 @@ def test_auto_runs_the_black_box_start_first_unless_the_start_fits(monkeypatch, 
 
     monkeypatch.setattr(auto_module, "black_box_start", stub)
     res = si.identify(model, io, x0=x0, restarts=0, time_limit=40.0, identifiability_check=False)
-    assert calls == [pytest.approx(20.0, rel=1e-12)]  # half the budget, a safety (BLACK_BOX_SHARE): its passes are counted
+    assert calls == [pytest.approx(20.0, rel=1e-12)]  # half the budget, a safety (BLACK_BOX_SHARE): passes are counted
     assert res.success
     np.testing.assert_allclose(res.theta_vector, TRUTH, rtol=1e-8)
     # a pass that fits to rounding ends the start: the other special pass is not run
