@@ -26,10 +26,15 @@ succeeds when
 
 - noise-free: maxₖ |θ̂ₖ − θ*ₖ|/|θ*ₖ| ≤ 1e-3, or, for a problem not proven globally
   identifiable, θ̂ fits the data exactly (relative misfit ≤ 1e-10) with every parameter
-  declared positive positive: another admissible solution;
-- 1 % noise: maxₖ |θ̂ₖ − θ*ₖ|/|θ*ₖ| ≤ 2 × that of IPOPT started at the truth (the
-  reference estimate), or, for a problem not proven globally identifiable, θ̂ fits at
-  least as well as the reference (misfit ≤ 1.001 × its misfit) with positive parameters.
+  declared positive: another admissible solution;
+- 1 % noise: maxₖ |θ̂ₖ − θ*ₖ|/|θ*ₖ| ≤ 2 × that of the reference estimate (IPOPT and
+  ``lm`` started at the truth, whichever ends at the lower misfit: ``REFERENCES``), or θ̂
+  fits at least as well as the reference with positive parameters (misfit ≤ its misfit;
+  ≤ 1.001 × it for a problem not proven globally identifiable). The reference is taken
+  for the least-squares estimate; a fit below its misfit is a better one, even where the
+  landscape is so flat that it lies more than twice the reference's error away (measured:
+  a 3-mass chain with gains at misfit 1.6079e-5 and error 10.1 against the reference's
+  1.6080e-5 and 1.0).
 
 The error is the largest relative error of any parameter, not ‖θ̂ − θ*‖/‖θ*‖: in SI units
 the springs (1e3–1e5 N/m) would dominate that norm and a mass 100 % off would pass.
@@ -116,14 +121,32 @@ def _problem(log: RunLog, cls: str, n: int, index: int, timeout: float) -> Probl
     return p
 
 
+REFERENCES = ("ipopt", "lm")
+"""The 1 % reference is the lower misfit of IPOPT (the issue's definition) and ``lm`` started at the truth: the
+least-squares estimate nearest the truth. IPOPT alone can stop short of it (``benchmarks/noisy_reference.py``: on 6
+of 27 problems ``lm`` from the truth ended lower, the reference up to 2.14 times higher, e.g. an 8-mass chain at
+6.08e-5 and error 14.6 where ``lm`` reaches 5.96e-5 at error 2.2); the time-series benchmark takes the same rule."""
+
+
+def _reference_run(p: Problem, data: Any, method: str) -> dict[str, Any]:
+    """One reference run: ``method`` started at the truth, with the typical values as ``scale=``."""
+    t0 = time.perf_counter()
+    res = si.identify(p.model, data, method=method, x0=p.truth, identifiability_check=False, scale=p.typical)
+    return {"theta": res.theta_vector, "cost": res.cost, "error": parameter_error(res.theta_vector, p.truth),
+            "status": res.status, "seconds": time.perf_counter() - t0}
+
+
 def _reference(log: RunLog, p: Problem, noise: float, data: Any) -> dict[str, Any]:
-    """IPOPT started at the truth: the estimate a method is measured against on noisy data."""
+    """The estimate a method is measured against on noisy data: the lower misfit of :data:`REFERENCES` started at
+    the truth (every run is logged under ``runs``)."""
     key = f"{p.name}/noise{noise:g}/reference"
     rec = log.get(key)
     if rec is None:
-        res = si.identify(p.model, data, method="ipopt", x0=p.truth, identifiability_check=False, scale=p.typical)
-        log.append(key, {"theta": res.theta_vector, "cost": res.cost,
-                         "error": parameter_error(res.theta_vector, p.truth), "status": res.status})
+        runs = {m: _reference_run(p, data, m) for m in REFERENCES}
+        finite = [m for m in REFERENCES if runs[m]["cost"] is not None and np.isfinite(runs[m]["cost"])]
+        best = min(finite, key=lambda m: runs[m]["cost"]) if finite else REFERENCES[0]
+        log.append(key, {**{k: runs[best][k] for k in ("theta", "cost", "error", "status")}, "method": best,
+                         "runs": runs})
         rec = log.get(key)
     return rec
 
@@ -147,7 +170,9 @@ def start_success(theta: Any, cost: Any, truth: np.ndarray, positive: np.ndarray
     if reference is None:  # noise-free
         return err <= 1e-3 or (not globally and admissible and float(cost) <= EXACT_FIT)
     ref_err, ref_cost = parameter_error(reference["theta"], truth), float(reference["cost"])
-    return err <= 2 * ref_err or (not globally and admissible and float(cost) <= 1.001 * ref_cost)
+    # a fit at least as good as the least-squares estimate found from the truth is one too, wherever it lies: in a
+    # sloppy landscape two fits of nearly equal misfit can differ by a factor 10 in some parameter
+    return err <= 2 * ref_err or (admissible and float(cost) <= (1.0 if globally else 1.001) * ref_cost)
 
 
 def run_problem(log: RunLog, p: Problem, args: argparse.Namespace, executor: Executor | None) -> None:
@@ -280,7 +305,8 @@ def redo_references(log: RunLog, timeout: float) -> None:
         new = _reference(log, p, noise, p.data(noise=noise, seed=0))
         before = parameter_error(old["theta"], p.truth)  # recomputed: old records may hold another definition
         print(f"[{i + 1}/{len(keys)}] {key}: error {before:.3g} -> {new['error']:.3g}, misfit "
-              f"{old['cost']:.4g} -> {new['cost']:.4g} ({new['status']}, {time.perf_counter() - t0:.1f} s)",
+              f"{old['cost']:.4g} -> {new['cost']:.4g} ({new['method']}: {new['status']}, "
+              f"{time.perf_counter() - t0:.1f} s)",
               flush=True)
 
 
@@ -325,8 +351,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--fresh", action="store_true", help="start over: discard the log")
     ap.add_argument("--summary-only", action="store_true", help="rebuild the summary from the log; run nothing")
     ap.add_argument("--redo-references", action="store_true",
-                    help="compute every logged noisy reference (IPOPT started at the truth) again with this code, "
-                         "then rebuild the summary: the noisy successes are judged against the new references")
+                    help="compute every logged noisy reference (IPOPT and lm started at the truth, the lower "
+                         "misfit) again with this code, then rebuild the summary: the noisy successes are "
+                         "judged against the new references")
     ap.add_argument("--recheck", action="store_true",
                     help="check every logged problem's identifiability again with this code (budget --check-timeout), "
                          "then rebuild the summary: a problem now proven globally identifiable is judged by its "
@@ -355,8 +382,9 @@ def main(argv: list[str] | None = None) -> int:
                           "an exact fit (misfit <= 1e-10) with positive parameters",
             "problems": f"structurally locally identifiable, and a 1e-3 error of any parameter changes the misfit by "
                         f"more than {RESOLUTION_FLOOR:g} (to first order); the others are listed in 'unresolved'",
-            "noisy": "largest relative error of any parameter <= 2 x that of IPOPT started at the truth, or (not "
-                     "proven globally identifiable) misfit <= 1.001 x the reference's with positive parameters"}}
+            "noisy": "largest relative error of any parameter <= 2 x that of the reference (the lower misfit of "
+                     "IPOPT and lm started at the truth), or misfit <= the reference's (<= 1.001 x it where not proven "
+                     "globally identifiable) with positive parameters"}}
         write_json_atomic(args.out, summary)
         return summary
 
