@@ -183,7 +183,9 @@ def test_n4sid_route_is_judged_on_the_measured_samples():
     unc = res.uncertainty
     assert unc.shift > 0.5 and np.all(np.isnan(unc.intervals)) and "fits the N4SID black box" in unc.note
     pol = res.polished
-    assert pol.cost < res.cost and pol.uncertainty.shift is None
+    # the polished estimate minimises the misfit: one Gauss-Newton step from it moves by a negligible part of a
+    # standard error (measured 1.9e-7)
+    assert pol.cost < res.cost and pol.uncertainty.shift < 1e-3
     lo, hi = pol.uncertainty.intervals.T
     truth = np.array([TRUTH[k] for k in model.parameter_names])
     assert np.all((lo <= truth) & (truth <= hi))  # seed 1: the truth lies in every interval

@@ -290,3 +290,25 @@ def test_a_failed_fit_shows_no_intervals():
     assert "uncertainty: not shown, the estimate does not fit the data" in text
     assert "std. error" not in text
     assert res.uncertainty is not None
+
+
+def test_intervals_are_withheld_wherever_the_estimate_is_not_the_least_squares_one():
+    """For every method, not only those that do not minimise the misfit: one Gauss-Newton step says how far the
+    least-squares estimate lies, in standard errors (SHIFT_LIMIT = 0.5)."""
+    from symid.fit.registry import prepare
+
+    model = one_dof()
+    frf = si.simulate_frf(model, T1, W20, noise=0.01, seed=3)
+    res = si.identify(model, frf, method="ipopt", identifiability_check=False)
+    at_minimum = res.uncertainty
+    assert at_minimum.shift < 1e-3 and np.all(np.isfinite(at_minimum.intervals)) and at_minimum.note == ""
+    est = prepare(model, frf, "ipopt", {})
+    theta = np.array([res.theta[k] for k in model.parameter_names])
+    off = theta + 3 * at_minimum.standard_errors * np.array([1.0, 0.0, 0.0])  # the mass 3 standard errors off
+    unc = est.uncertainty(off, model.parameter_names)
+    # to first order the step lands back on the estimate, δ = 3 σ_m e_m, whose length in the covariance's metric is
+    # 3 σ_m √((cov⁻¹)_mm) (≥ 3: the other parameters correlate with m); within 20 %, the covariance at the shifted
+    # point differing from that at the minimum
+    C = at_minimum.covariance
+    assert unc.shift == pytest.approx(3 * np.sqrt(C[0, 0] * np.linalg.inv(C)[0, 0]), rel=0.2)
+    assert np.all(np.isnan(unc.intervals)) and "standard errors from the least-squares estimate" in unc.note

@@ -62,7 +62,8 @@ class TimeSeries(DataContainer):
     Parameters
     ----------
     t : array_like, shape (N,)
-        Sample times in seconds, finite and strictly increasing.
+        Sample times in the unit ``time_unit`` (seconds by default), finite and strictly
+        increasing.
     u : array_like, shape (N, m) or (N,)
         Input samples; ``u[k]`` acts on [t_k, t_{k+1}).
     y : array_like, shape (N, p) or (N,)
@@ -79,8 +80,9 @@ class TimeSeries(DataContainer):
 
     Notes
     -----
-    NPZ files only (``to_npz`` / ``from_npz``); :meth:`from_iodata` converts a uniform
-    record.
+    Written and read as NPZ files (``to_npz`` / ``from_npz``); a table (CSV, DataFrame,
+    ``.mat``, dict of arrays) comes in through :meth:`from_table`; :meth:`from_iodata`
+    converts a uniform record.
 
     Examples
     --------

@@ -34,17 +34,25 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     data : FrequencyData, SpectralData, BlackBox or IOData
         The measurements. The data kind picks the formulation (:mod:`symid.fit.registry`):
         a frequency response goes to :mod:`symid.fit.frf` (thesis ch. 3, 4), spectra to
-        :mod:`symid.fit.spectra` (ch. 5), a black box or input/output records (then
-        N4SID and an exact zero-order-hold ``d2c`` first) to
-        :mod:`symid.fit.similarity` (ch. 6, 7).
+        :mod:`symid.fit.spectra` (ch. 5), input/output records (``IOData``, ``TimeSeries``)
+        to :mod:`symid.fit.timeseries` (output error on the samples; its ``"scr"``,
+        ``"als"`` and ``"gb"`` run N4SID and an exact zero-order-hold ``d2c`` first and
+        then the similarity formulations) and a black box to :mod:`symid.fit.similarity`
+        (ch. 6, 7).
     method : str, optional
         Default: the data kind's default (:attr:`symid.fit.registry.DataKind.default_method`):
         ``"auto"`` for a frequency response (:mod:`symid.fit.frf.lm`: least squares on
         log-parameters, restarted around the start until the estimate fits; the most
-        reliable method on the generated population of ``benchmarks/population.py``),
-        ``"scr"`` otherwise. ``"scr"`` (sequential convex relaxation), ``"ipopt"`` (nonlinear least squares
-        with CasADi/IPOPT), ``"ls"`` (a linear special case, where it applies), and for
-        black-box data ``"als"``, ``"gb"``. ``"scr"`` on a second-order model whose C or
+        reliable method on the generated population of ``benchmarks/population.py``) and
+        for input/output records (:mod:`symid.fit.timeseries.auto`: output error on the
+        samples, restarted, with a start from an N4SID black box; measured on
+        ``benchmarks/timeseries_population.py``), ``"scr"`` for spectra and black boxes.
+        Others: ``"scr"`` (sequential convex relaxation), ``"ipopt"`` (nonlinear least
+        squares with CasADi/IPOPT), ``"ls"`` (a linear special case, where it applies),
+        ``"lm"`` (one least-squares run, frequency response), for black-box data and
+        records ``"als"``, ``"gb"``, and for records ``"oe"`` (output error from the
+        start), ``"srivc"`` and ``"svf"`` (each data kind's ``methods``:
+        :func:`symid.fit.registry.data_kinds`). ``"scr"`` on a second-order model whose C or
         B is known, square and invertible runs the exact linear least squares instead
         (reported as method ``"ls"``; ``force_scr=True`` runs SCR anyway). ``"<method>+polish"``
         (as :func:`symid.compare` names it) is ``method`` with ``polish=True``.

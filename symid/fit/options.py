@@ -167,7 +167,7 @@ def scale_by_name(options: Mapping[str, Any], parameter_names: Sequence[str]) ->
     >>> scale_by_name({"scale": {"m": 2.0}}, ["m", "k"])
     Traceback (most recent call last):
     ...
-    symid.errors.OptionError: scale by name needs every parameter; missing: k
+    symid.errors.OptionError: scale by name needs every parameter; missing: k (parameters whose values are known ...)
     """
     value = options.get("scale")
     if not isinstance(value, Mapping):
@@ -182,7 +182,8 @@ def scale_by_name(options: Mapping[str, Any], parameter_names: Sequence[str]) ->
         raise OptionError(f"scale names {', '.join(parts)}, not a parameter of the model ({', '.join(names)})")
     missing = [n for n in names if n not in value]
     if missing:
-        raise OptionError(f"scale by name needs every parameter; missing: {', '.join(missing)}")
+        raise OptionError(f"scale by name needs every parameter; missing: {', '.join(missing)} (parameters whose "
+                          f"values are known leave the model first: a model file's through ModelFile.free_model())")
     out = [value[n] for n in names]
     try:
         out = [float(v) for v in out]

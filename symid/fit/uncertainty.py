@@ -33,7 +33,13 @@ the covariance is reported. The covariance is that of the least-squares estimate
 method's misfit, evaluated at θ̂: exact to first order for the methods that minimise that
 misfit (``ipopt``, ``oe``); for the others (``scr``, ``ls``, ``als``, ``gb``, an
 equation-error objective) it holds as far as their estimate agrees with that minimiser,
-and ``note`` says so (``polish=True`` reaches it).
+and ``note`` says so (``polish=True`` reaches it). For every method, one Gauss–Newton
+step from θ̂ measures how far the least-squares estimate lies (``shift``, in standard
+errors): beyond ``SHIFT_LIMIT`` the intervals centred on θ̂ are withheld (NaN) with the
+reason. A method that minimises the misfit can stop short of the minimum too: the
+frequency-response ``auto`` accepts a fit within the noise, and a DC motor's fit (a
+new user's model) ended with its friction at 5e-7 of its typical value, 3.4 standard
+errors from the least-squares estimate IPOPT reached from the same start.
 
 A Fisher information that is near-singular means the data hardly determine some
 combination of the parameters — practically non-identifiable even when structurally
@@ -106,11 +112,15 @@ class Uncertainty:
     residual_ratio : float or None
         With given noise: rms of the residual in units of the given noise (≈ 1 when it is right).
     note : str
-        What the covariance describes when the method does not minimise this misfit.
+        What the covariance describes when the method does not minimise this misfit, and
+        why the intervals are withheld when they are.
     shift : float or None
-        For such a method: the distance from θ̂ to the least-squares estimate of the misfit
-        (one Gauss–Newton step), in standard errors, √(δᵀ cov⁻¹ δ). Above ``SHIFT_LIMIT``
-        the intervals (centred on θ̂) would not hold and are NaN.
+        The distance from θ̂ to the least-squares estimate of the misfit (one Gauss–Newton
+        step), in standard errors, √(δᵀ cov⁻¹ δ): for every method, since one that
+        minimises the misfit can stop short of its minimum too (a fit accepted within the
+        noise, a parameter held at its bound). Above ``SHIFT_LIMIT`` the intervals
+        (centred on θ̂) would not hold and are NaN, and ``note`` says why. ``None`` for a
+        method whose sensitivity to the noise is known (``estimate_sensitivity``).
     """
 
     parameter_names: tuple[str, ...]
@@ -223,7 +233,7 @@ class FisherInformation(abc.ABC):
             std, given = self.given_noise(noise_std)
             unc = fisher_uncertainty(theta, parameter_names, r, J, channels, given_std=std, given_values=given,
                                      sensitivity=G, note=note)
-        if not note or G is not None:
+        if G is not None:
             return unc
         return _with_shift(unc, r, J)
 
@@ -244,8 +254,9 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray) -> Uncertainty:
         return unc
     if shift <= SHIFT_LIMIT:
         return dataclasses.replace(unc, shift=shift)
-    note = (f"{unc.note}. θ̂ lies {shift:.3g} standard errors from the least-squares estimate of these data "
-            f"(more than {SHIFT_LIMIT}): intervals around θ̂ would not hold, so none are given (NaN)")
+    note = (f"{unc.note + '. ' if unc.note else ''}θ̂ lies {shift:.3g} standard errors from the least-squares "
+            f"estimate of these data (more than {SHIFT_LIMIT}): intervals around θ̂ would not hold, so none are given "
+            f"(NaN)")
     return dataclasses.replace(unc, shift=shift, note=note, intervals=np.full((l, 2), np.nan))
 
 

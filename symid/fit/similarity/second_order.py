@@ -60,7 +60,8 @@ def check_second_order(model: Any) -> None:
     if model.output not in ("position", "velocity"):
         raise ModelError("the similarity formulations of thesis ch. 7 take position or velocity outputs (7-2), "
                          f"(7-24); this model has {model.output} output (thesis §7-7-3: future work). "
-                         "Use method='ipopt'")
+                         "Use method='ipopt' on a black box; on input/output records the default method "
+                         "('auto') or 'oe' (output error on the samples)")
 
 
 def _full_rank(X: np.ndarray, rank: int) -> bool:
@@ -359,7 +360,8 @@ class ScrSimilarity2nd(ScrEstimator, SimilarityEstimator):
         self._progress_options(callback, verbose)
         if not model.maps["B"].is_constant:
             raise ModelError("the second-order similarity formulation (7-10) needs the input matrix B known (thesis "
-                             "§7-2: F known); B holds parameters. Use method='ipopt'")
+                             "§7-2: F known); B holds parameters. Use method='ipopt' on a black box; on input/output "
+                             "records the default method ('auto') or 'oe' (output error on the samples)")
         self.model, self.data, self.frf = model, data, data.frf
         self.options = {"weights": weights, "aux_init": aux_init, "seed": seed, "lmis": lmis, "implied": implied,
                         "backend": backend, "max_iter": max_iter, "tol": tol, "time_limit": solve_opts["time_limit"],
