@@ -16,9 +16,9 @@ method through a black box:
    on the time-series population's 12 records (n = 2, 3, 5 of every class) its black
    boxes predicted the noisy samples with relative misfits up to 2.6e-3 (3-mass chain with
    gains), 2.9e-3 (5-mass with gains) and 0.42 (5-mass chain), against the 1e-4 the noise
-   explains; over the horizons 20 to 120 the best of each was within 3e-4 of the
-   samples, 1e-4 on all but the 5-mass chain (2.9e-4 at 60, 1.1e-4 at 80, 1.0e-4 at 120),
-   and no worse on noise-free records. A horizon is not tried where its Hankel
+   explains; the best of the default and ``HORIZONS`` predicts every one of the 12 noisy
+   records to 8.7e-5 … 1.01e-4 (the 5-mass chain's at horizon 120), and the noise-free
+   ones to 2e-19 or better. A horizon is not tried where its Hankel
    matrices' LQ factor would cost more than ``HANKEL_WORK`` (records of many samples or
    channels), or where the record is too short for it.
 2. **Its continuous-time response, mode by mode.** With Ad = V Λ V⁻¹ (simple
@@ -37,10 +37,10 @@ method through a black box:
    of an output-error pass. The response is a black box's, so it is judged like noisy
    data whose noise floor is the black box's own relative misfit on the samples (from its
    initial state): a fit within that floor is a fit. On noise-free records the floor is
-   N4SID's rounding (5e-31 to 3e-9 on the time-series population's 12 records), so only
-   the model's own response fits; at 1 % noise it is about 1e-4 (9e-5 to 1.5e-4 on 8 of
-   the 12), more where N4SID misplaces a weakly observable mode (6e-4 to 3e-3 for the
-   3-mass chain and the chains with gains, 0.42 for the 5-mass chain). A vector fit of the
+   N4SID's rounding (2e-19 or better on the time-series population's 12 records), so only
+   the model's own response fits; at 1 % noise it is about 1e-4 (step 1; with the default
+   horizon alone it was up to 3e-3 for the chains with gains and 0.42 for the 5-mass
+   chain, where N4SID misplaced weakly observable modes). A vector fit of the
    response is no yardstick here: it fits any black box's response exactly.
    Passes are counted, not timed, so the start does not depend on how busy the machine
    is (a share of the start's budget is only a safety): at most ``PASSES`` on noisy
@@ -51,8 +51,8 @@ method through a black box:
    informed and one uninformed start per problem and noise level, every pass logged, 45 s
    each, the floor not yet used): noise-free, the best misfit came at pass 0 in 25 of 30
    runs and by pass 4 in all; at 1 %, at pass 0 in 23 of 30 and by pass 3 in all but the
-   four runs of the 5-mass chain and chain with gains, whose black boxes are poorest
-   (passes 6 to 16). Before, a 15 s cap ended the fit, so a noisy record's start depended
+   four runs of the 5-mass chain and chain with gains, whose black boxes were poorest
+   with the default horizon (passes 6 to 16). Before, a 15 s cap ended the fit, so a noisy record's start depended
    on the machine's load, and spent the whole 15 s there.
 
 On noise-free records the response is the model's own, and the fit recovers θ; on noisy
