@@ -33,6 +33,16 @@ the level of |H| and the modes left the band (the F-16 modal model of
 ``examples/f16_gvt.py``, M = I: every k = 1.3e6, modes at 185 Hz for a band of 2–15 Hz;
 now k = 1.2e3, 5.5 Hz).
 
+A second-order model with known entries in M, V or K and no gains can have no level
+that fits: a DC motor written as L q̈ + R q̇ + K ω = u, J ω̇ + b ω − K q̇ = 0 with L and R
+known (K, J, b in the damping and mass matrices) has, at the ratios ζ₀ sets, a response
+whose misfit falls as the level goes to 0 and then stays flat, and the search ended on
+that plateau, at e^−77.5, with J = 2e-38 (a new user's model, the fit staying there:
+every parameter 1e-35 of the truth, reported as a fit). Where the misfit is as low at the
+search's edge as at its minimum, the level is instead the one the known entries imply (a
+known mass m: m ω₀²; a damper c: c ω₀/(2ζ₀); a spring: itself; their geometric mean):
+J = 0.03, K = b = 0.32 for that motor (truth 1e-4, 0.05, 1e-5).
+
 These typical values are where :func:`symid.fit.frf.modal.black_box_start` starts, and
 what :func:`symid.fit.starts.draw_starts` draws around (log-uniformly within a factor 3)
 when there is no black-box start: a start of the right order of magnitude, not an
@@ -145,14 +155,29 @@ def typical_scale(model: Any, data: Any) -> np.ndarray:
             out = theta(level)
             out[[r in ("B", "C", "D") for r in roles]] = np.exp(log_gain)
             return np.abs(out)
+    if second and _pinned(model) and min(misfit(-_EDGE), misfit(_EDGE)) <= misfit(level) * (1 + 1e-6):
+        level = math.log(_known_level(model, w0))  # the data do not fix the level: the misfit is as low at the edge
     return np.abs(theta(level))
+
+
+_EDGE = 80.0
+"""The search's outermost log-level (module notes: e^±80 covers any unit system)."""
+
+
+def _known_level(model: Any, w0: float) -> float:
+    """The level the known nonzero entries of M, V and K imply (a mass m: m ω₀², a damper c: c ω₀ / (2ζ₀), a spring:
+    itself), their geometric mean: for a model whose response no common level fits (module notes)."""
+    per = {"M": w0**2, "V": w0 / (2 * ZETA0), "K": 1.0}
+    logs = [math.log(abs(float(x)) * f) for name, f in per.items()
+            for x in np.asarray(model.maps[name].X0, dtype=float).ravel() if x != 0]
+    return math.exp(sum(logs) / len(logs))
 
 
 def _search(misfit: Any) -> float | None:
     """The minimiser of a function of one log-level: a coarse grid, then a bounded search in its bracket."""
     # the level enters H as 1/L (second order) or L (state space, through the gains): a 1-D search over
     # 2 × 80 natural-log units covers any unit system; the grid picks the bracket, the bounded search refines
-    grid = np.linspace(-80.0, 80.0, 81)
+    grid = np.linspace(-_EDGE, _EDGE, 81)
     values = np.array([misfit(g) for g in grid])
     if not np.any(np.isfinite(values)):
         return None
