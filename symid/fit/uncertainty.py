@@ -256,7 +256,7 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray) -> Uncertainty:
         return dataclasses.replace(unc, shift=shift)
     note = (f"{unc.note + '. ' if unc.note else ''}θ̂ lies {shift:.3g} standard errors from the least-squares "
             f"estimate of these data (more than {SHIFT_LIMIT}): intervals around θ̂ would not hold, so none are given "
-            f"(NaN)")
+            f"(NaN); polish=True refines θ̂ to that estimate where the method has a polisher")
     return dataclasses.replace(unc, shift=shift, note=note, intervals=np.full((l, 2), np.nan))
 
 
