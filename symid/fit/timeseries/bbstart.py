@@ -10,15 +10,15 @@ method through a black box:
 1. **Black box.** N4SID of the model's order (:func:`symid.n4sid`; feedthrough only when
    the model has one at the start) on the one uniformly sampled record, with its default
    horizon and with the longer ones of ``HORIZONS``; the black box whose simulation from
-   its own initial state predicts the samples best is kept. The default horizon (10 block
-   rows here) sees a fraction of the slowest mode's period on records sampled ten times
-   per period of the fastest, and at 1 % noise leaves weakly observable modes misplaced:
-   on the time-series population's 12 records (n = 2, 3, 5 of every class) its black
-   boxes predicted the noisy samples with relative misfits up to 2.6e-3 (3-mass chain with
-   gains), 2.9e-3 (5-mass with gains) and 0.42 (5-mass chain), against the 1e-4 the noise
-   explains; the best of the default and ``HORIZONS`` predicts every one of the 12 noisy
-   records to 8.7e-5 … 1.01e-4 (the 5-mass chain's at horizon 120), and the noise-free
-   ones to 2e-19 or better. A horizon is not tried where its Hankel
+   its own initial state predicts the samples best is kept. The default horizon (10 to
+   20 block rows on these records) sees a fraction of the slowest mode's period on records
+   sampled ten times per period of the fastest, and at 1 % noise leaves weakly observable
+   modes misplaced: on the time-series population's 12 records (n = 2, 3, 5 of every
+   class) its black boxes predicted the noisy samples with relative misfits up to 2.6e-3
+   (3-mass chain with gains), 2.9e-3 (5-mass with gains) and 0.42 (5-mass chain), against
+   the 1e-4 the noise explains; the best of the default and ``HORIZONS`` predicts every
+   one of the 12 noisy records to 8.7e-5 … 1.01e-4 (the 5-mass chain's at horizon 120),
+   and the noise-free ones to 2e-19 or better. A horizon is not tried where its Hankel
    matrices' LQ factor would cost more than ``HANKEL_WORK`` (records of many samples or
    channels), or where the record is too short for it.
 2. **Its continuous-time response, mode by mode.** With Ad = V Λ V⁻¹ (simple
@@ -52,8 +52,8 @@ method through a black box:
    each, the floor not yet used): noise-free, the best misfit came at pass 0 in 25 of 30
    runs and by pass 4 in all; at 1 %, at pass 0 in 23 of 30 and by pass 3 in all but the
    four runs of the 5-mass chain and chain with gains, whose black boxes were poorest
-   with the default horizon (passes 6 to 16). Before, a 15 s cap ended the fit, so a noisy record's start depended
-   on the machine's load, and spent the whole 15 s there.
+   with the default horizon (passes 6 to 16). Before, a 15 s cap ended the fit, so a
+   noisy record's start depended on the machine's load, and spent the whole 15 s there.
 
 On noise-free records the response is the model's own, and the fit recovers θ; on noisy
 ones N4SID can misplace a weakly observable mode, and the fit is only a start like any
