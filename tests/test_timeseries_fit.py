@@ -275,3 +275,15 @@ def test_the_output_error_of_a_diverged_estimate_is_inf_without_a_numpy_warning(
         warnings.simplefilter("error", RuntimeWarning)
         assert est.misfit(np.array([46.0])) == float("inf")
         assert np.isfinite(est.misfit(np.array([-1.0])))
+
+
+def test_the_identifiability_check_says_it_ignores_a_dose_given_as_the_initial_state():
+    """With B = 0 the input-output map from a zero initial state is zero, so the local check finds nothing
+    identifiable; the bolus x0 fixes every parameter (module docstring). The warning and the report say that the
+    check ignores x0 (a new user read "infinitely many values fit the data equally well" as the truth)."""
+    model = pk_model()
+    with pytest.warns(si.IdentifiabilityWarning, match="nonzero initial state x0 may determine them") as caught:
+        si.identify(model, pk_record(model), method="oe", x0=START)
+    assert not any("infinitely many" in str(w.message) for w in caught)
+    rep = si.identifiability(model, timeout=10)
+    assert any("nonzero initial state" in note for note in rep.notes), rep.notes

@@ -252,6 +252,8 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     pos = _positive_flags(model, args.positive, known_exact)
     necessary = _necessary(model, len(free), known_exact)
     notes: list[str] = []
+    if getattr(model, "initial_state_kind", "zero") in ("known", "affine"):
+        notes.append(_X0_IGNORED)
 
     def left() -> float | None:
         return None if timeout is None else max(timeout - (time.perf_counter() - t0), 0.0)
@@ -585,6 +587,11 @@ def check_local(model, known: Mapping[str, float] | None = None, *, seed: int = 
     return tuple(q.name for q, ok in zip(local.parameters, local.identifiable, strict=True) if not ok)
 
 
+_X0_IGNORED = ("this analysis is of the input-output map from a zero initial state: the model's nonzero initial state "
+               "x0 is not used, and records of its free response (a dose given as x0) can determine parameters "
+               "that this report calls not identifiable")
+
+
 def warn_if_not_identifiable(model, known: Mapping[str, float] | None = None, *, stacklevel: int = 2
                              ) -> tuple[str, ...]:
     """Emit an :class:`~symid.IdentifiabilityWarning` naming the parameters that are not locally identifiable.
@@ -609,7 +616,14 @@ def warn_if_not_identifiable(model, known: Mapping[str, float] | None = None, *,
         bad = check_local(model, known)
     except ModelError:
         return ()
-    if bad:
+    if bad and getattr(model, "initial_state_kind", "zero") in ("known", "affine"):
+        warnings.warn(
+            f"parameter(s) {', '.join(bad)} are not locally identifiable from the input-output map from a zero "
+            "initial state, the only map this check analyses; this model's nonzero initial state x0 may determine "
+            "them from its free response (a dose given as x0), so check the estimate's standard errors "
+            "(identifiability_check=False skips this check).",
+            IdentifiabilityWarning, stacklevel=stacklevel + 1)
+    elif bad:
         warnings.warn(
             f"parameter(s) {', '.join(bad)} are not locally identifiable from the input-output map: infinitely "
             "many values fit the data equally well. Fix some of them (known values) or reparameterise; "
