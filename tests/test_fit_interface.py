@@ -375,3 +375,7 @@ def test_the_summary_reports_the_identifiability_check_beside_the_starts_time():
     assert "s for the identifiability check before" in res.summary()
     quiet = si.identify(model, frf, x0=[2.0, 0.8, 8.0], identifiability_check=False)
     assert "identifiability_check_s" not in quiet.options
+    # a second new-user trial: "total time 0.3 s" for a call measured at 1.0 to 1.6 s around it (the setup, the
+    # typical values and the uncertainty left out); the whole call is now said beside the starts' time
+    assert res.options["identify_s"] >= res.wall_time + res.options["identifiability_check_s"]
+    assert "the whole call" in res.summary()

@@ -139,6 +139,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     >>> [round(v, 6) for v in res.theta.values()], res.success
     ([2.0, 0.5, 3.0], True)
     """
+    t_call = time.perf_counter()
     if method is None:
         from symid.fit.registry import data_kind
 
@@ -210,6 +211,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             polished = dataclasses.replace(polished, uncertainty=polisher.uncertainty(
                 polished.theta_vector, model.parameter_names, noise_std=noise_std))
         result = dataclasses.replace(result, polished=polished)
+    # the whole call (setup, typical values, the check, the starts, uncertainty and polish), beside the starts' time
+    result = dataclasses.replace(result, options={**result.options, "identify_s": time.perf_counter() - t_call})
     ambiguity = result.ambiguity()
     if ambiguity is not None:
         warnings.warn(ambiguity, IdentifiabilityWarning, stacklevel=2)

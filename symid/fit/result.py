@@ -366,7 +366,9 @@ class IdentificationResult:
                  f"  solver: {self.status}, {self.iterations} iterations; {self.message}",
                  f"total time {self.wall_time:.3f} s" + (
                      f" (and {self.options['identifiability_check_s']:.2f} s for the identifiability check before)"
-                     if self.options.get("identifiability_check_s") is not None else "")]
+                     if self.options.get("identifiability_check_s") is not None else "") + (
+                     f"; the whole call {self.options['identify_s']:.3f} s (setup, typical values, check, starts, "
+                     f"uncertainty, polish)" if self.options.get("identify_s") is not None else "")]
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
         if not self.success:
