@@ -120,6 +120,16 @@ def test_non_affine_hint(entry, hint):
     assert f"Hint: {hint}" in str(info.value), str(info.value)
 
 
+def test_a_ratio_in_a_first_order_a_points_to_the_second_order_form_that_keeps_the_physical_parameters():
+    # a new user's thermal network: -G12/C1 in A; M = diag(C1, C2), V = -F, K = 0, velocity output is the same model
+    C1, G12 = si.parameters("C1 G12", positive=True)
+    with pytest.raises(si.NonAffineError, match=r"SecondOrderModel\(M=E, V=-F, K=0, B=G, C=C, output='velocity'\)"):
+        si.StateSpaceModel(A=[[-G12 / C1]], B=[[1]], C=[[1]])
+    with pytest.raises(si.NonAffineError) as info:  # not for a second-order model's entries
+        si.SecondOrderModel(M=[[1]], V=[["c/m"]], K=[[1]], B=[[1]], C=[[1]])
+    assert "SecondOrderModel(M=E" not in str(info.value)
+
+
 @pytest.mark.parametrize("where", ["M", "V", "K", "B", "C"])
 def test_non_affine_entry_named_in_every_second_order_matrix(where):
     k, c = si.parameters("k c", positive=True)

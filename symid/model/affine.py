@@ -102,6 +102,18 @@ def _hint(expr: sp.Expr, involved: Sequence[sp.Symbol]) -> str:
             f"(for example `{''.join(names)} = {'*'.join(names)}` when the entry holds a product)")
 
 
+def _descriptor_hint(name: str, expr: sp.Expr, involved: Sequence[sp.Symbol]) -> str:
+    """For a ratio in a first-order model's A (a conductance over a capacity, a friction over an inertia): the
+    second-order form that keeps the physical parameters (E x' = F x + G u as M q'' + V q' = B u with x = q')."""
+    if name != "A":
+        return ""
+    _, den = sp.fraction(sp.together(expr))
+    if not den.free_symbols & set(involved):
+        return ""
+    return (" Or keep the physical parameters: a model E x' = F x + G u whose E holds them (capacities, "
+            "inertias) is SecondOrderModel(M=E, V=-F, K=0, B=G, C=C, output='velocity'), its velocity being x.")
+
+
 def order_parameters(matrices: Sequence[tuple[str, sp.Matrix]]) -> tuple[sp.Symbol, ...]:
     """Parameters in order of first appearance, row by row, through the given matrices.
 
@@ -173,7 +185,7 @@ def affine_map(matrix: sp.Matrix, parameters: Sequence[sp.Symbol], name: str) ->
                 raise NonAffineError(
                     f"matrix {name}, entry ({i}, {j}) = {expr} is not affine in the parameters: it is nonlinear "
                     f"in {names}. symid needs every entry to be affine, X(θ) = X0 + Σ θi Xi. "
-                    f"Hint: {_hint(expr, involved)}.",
+                    f"Hint: {_hint(expr, involved)}.{_descriptor_hint(name, expr, involved)}",
                     matrix=name, entry=(i, j), expression=str(expr),
                     parameters=tuple(str(p) for p in involved))
             c0 = expr.xreplace({p: 0 for p in present}) if present else expr
