@@ -91,7 +91,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     identifiability_check : bool
         Before estimating, run the cheap local identifiability test and emit an
         :class:`~symid.IdentifiabilityWarning` naming the parameters that no data of
-        this kind can determine (default True).
+        this kind can determine (default True); after an estimate that fits, the global
+        test within about a second (:func:`symid.structural.analyse.several_solutions`,
+        cached per model structure): where other parameter values give the same response
+        (a flip-flop of two rate constants), a warning says so, and ``summary()`` too.
     noise_floor : float, optional
         The relative misfit noise alone leaves at the true parameters (ε² for relative
         noise of level ε); used to judge ``success`` (:mod:`symid.fit.success`). Default:
@@ -165,12 +168,12 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"), black_box=not linear)
     if x0 is not None:
         estimator.check_start(x0s[0])  # the user's own start: refused with a reason (e.g. outside the bounds)
-    check_s = None
+    check_s, not_local = None, ()
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
 
         t_check = time.perf_counter()
-        warn_if_not_identifiable(model, stacklevel=2)
+        not_local = warn_if_not_identifiable(model, stacklevel=2)
         check_s = time.perf_counter() - t_check
     if linear:  # one start says it all
         x0s = x0s[:1]
@@ -211,6 +214,16 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             polished = dataclasses.replace(polished, uncertainty=polisher.uncertainty(
                 polished.theta_vector, model.parameter_names, noise_std=noise_std))
         result = dataclasses.replace(result, polished=polished)
+    if identifiability_check and not not_local and result.success:
+        from symid.structural.analyse import several_solutions
+
+        t_check = time.perf_counter()
+        several = several_solutions(model)
+        extra = {"identifiability_check_s": (check_s or 0.0) + time.perf_counter() - t_check}
+        if several is not None:
+            extra["several_solutions"] = several
+            warnings.warn(several, IdentifiabilityWarning, stacklevel=2)
+        result = dataclasses.replace(result, options={**result.options, **extra})
     # the whole call (setup, typical values, the check, the starts, uncertainty and polish), beside the starts' time
     result = dataclasses.replace(result, options={**result.options, "identify_s": time.perf_counter() - t_call})
     ambiguity = result.ambiguity()

@@ -365,7 +365,7 @@ class IdentificationResult:
                  f"  fit: {self.fit}",
                  f"  solver: {self.status}, {self.iterations} iterations; {self.message}",
                  f"total time {self.wall_time:.3f} s" + (
-                     f" (and {self.options['identifiability_check_s']:.2f} s for the identifiability check before)"
+                     f" (and {self.options['identifiability_check_s']:.2f} s for the identifiability checks)"
                      if self.options.get("identifiability_check_s") is not None else "") + (
                      f"; the whole call {self.options['identify_s']:.3f} s (setup, typical values, check, starts, "
                      f"uncertainty, polish)" if self.options.get("identify_s") is not None else "")]
@@ -380,6 +380,8 @@ class IdentificationResult:
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")
+        if self.options.get("several_solutions"):
+            lines.append(f"NOT UNIQUE (structure): {self.options['several_solutions']}")
         unc = self.uncertainty
         if unc is not None and not self.success:
             # intervals describe an estimate that fits the data; around one that does not they mean nothing

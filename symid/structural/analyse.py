@@ -10,7 +10,7 @@ from fractions import Fraction
 import sympy as sp
 from sympy import QQ
 
-from symid.errors import IdentifiabilityWarning, ModelError
+from symid.errors import IdentifiabilityWarning, ModelError, SymidError
 from symid.structural.arguments import checked_arguments, checked_known, checked_seed
 from symid.structural.combinations import (
     _rank,
@@ -590,6 +590,69 @@ def check_local(model, known: Mapping[str, float] | None = None, *, seed: int = 
 _X0_IGNORED = ("this analysis is of the input-output map from a zero initial state: the model's nonzero initial state "
                "x0 is not used, and records of its free response (a dose given as x0) can determine parameters "
                "that this report calls not identifiable")
+
+
+GLOBAL_CHECK_BUDGET = 1.0
+"""Seconds :func:`several_solutions` gives :func:`identifiability` (the small models where a flip-flop hides, such
+as first-order absorption and elimination, take 0.1 to 0.5 s; larger ones end undetermined, and say nothing)."""
+
+
+def several_solutions(model) -> str | None:
+    """One sentence when :func:`identifiability` proves, within ``GLOBAL_CHECK_BUDGET``, that other admissible
+    parameter values give the model's response (locally, not globally identifiable), else ``None``.
+
+    :func:`symid.identify` calls it after a fit: the estimate is then one of several that the data
+    cannot tell apart, and which one depends on the start (a new user's oral-dose model, ka and
+    ke interchangeable, came back with them swapped from 19 of 20 records, a success every time
+    and nothing said). Cached per model structure within the process.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.analyse import several_solutions
+    >>> ka, ke, q = si.parameters("ka ke q", positive=True)
+    >>> oral = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])
+    >>> print(several_solutions(oral))  # doctest: +ELLIPSIS
+    the model is locally but not globally identifiable: at a random parameter point, 2 admissible ...
+    """
+    try:
+        key = (type(model).__name__, getattr(model, "output", None), tuple(model.parameter_names),
+               tuple(model.positive), getattr(model, "initial_state_kind", "zero"),
+               tuple((k, sp.srepr(v)) for k, v in sorted(model.symbolic.items())))
+    except (AttributeError, TypeError):
+        return None
+    if key not in _SEVERAL:
+        if len(_SEVERAL) >= 64:  # the oldest goes
+            _SEVERAL.pop(next(iter(_SEVERAL)))
+        _SEVERAL[key] = _several_solutions(model)
+    return _SEVERAL[key]
+
+
+_SEVERAL: dict[tuple, str | None] = {}
+""":func:`several_solutions`'s answers by model structure (a cache: the answer depends on the structure only)."""
+
+
+def _several_solutions(model) -> str | None:
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            rep = identifiability(model, timeout=GLOBAL_CHECK_BUDGET)
+    except SymidError:
+        return None
+    count, bound = rep.n_solutions, rep.n_solutions_at_least
+    if rep.verdict != "local" or not ((count or 0) >= 2 or (bound or 0) >= 2):
+        return None
+    star = {n: float(Fraction(str(v))) for n, v in rep.theta_star.items()}
+    sols = [*rep.solutions] if rep.solutions else [star, *rep.witnesses]
+    differ = [n for n in rep.parameters
+              if len({float(f"{float(sol[n]):.6g}") for sol in sols if n in sol}) > 1]
+    how = f"{count}" if count is not None else f"at least {bound}"
+    return (f"the model is locally but not globally identifiable: at a random parameter point, {how} admissible "
+            f"parameter values give the same response" + (f" ({', '.join(differ)} differ between them)" if differ
+                                                         else "")
+            + "; the estimate is one of them, which one depends on the start, and no data of this kind tell them "
+            "apart (si.identifiability(model).solutions lists them): fix what is known, or compare starts "
+            "(starts=, .alternatives())")
 
 
 def warn_if_not_identifiable(model, known: Mapping[str, float] | None = None, *, stacklevel: int = 2
