@@ -331,3 +331,18 @@ def test_a_text_theta_is_named_as_text(siso):
         si.simulate_frf(model, "truth", W)
     with pytest.raises(si.OptionError, match="x0: theta is the text 'truth'"):
         si.identify(model, si.simulate_frf(model, th, W), x0="truth", identifiability_check=False)
+
+
+def test_absolute_noise_has_the_given_standard_deviation_per_output():
+    # a new user added 0.05 K of thermometer noise by hand: simulate_io had only relative noise
+    a, b = si.parameters("a b", positive=True)
+    model = si.StateSpaceModel(A=[[-a, 0], [0, -b]], B=[[1], [1]], C=[[1, 0], [0, 1]])
+    u = np.zeros(40000)
+    exact = si.simulate_io(model, {"a": 1.0, "b": 2.0}, u, 0.1)
+    noisy = si.simulate_io(model, {"a": 1.0, "b": 2.0}, u, 0.1, noise_std=[0.05, 2.0], seed=3)
+    # zero input: the output is pure noise; 40 000 samples give the standard deviation to about 0.35 % (1/√(2N)),
+    # 2 % allows six of those
+    np.testing.assert_allclose(np.std(noisy.y - exact.y, axis=0), [0.05, 2.0], rtol=0.02)
+    for bad, match in ((-1.0, ">= 0"), ([0.1, 0.2, 0.3], "one per output"), (np.nan, "finite")):
+        with pytest.raises(DataError, match=match):
+            si.simulate_io(model, {"a": 1.0, "b": 2.0}, u[:5], 0.1, noise_std=bad)

@@ -310,7 +310,7 @@ def _model_initial_state(model: Any, theta: Any, n: int) -> np.ndarray:
 
 
 def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any = None,
-                noise: float | None = None, seed: Seed = None) -> IOData:
+                noise: float | None = None, noise_std: Any = None, seed: Seed = None) -> IOData:
     """Sampled response of a model to a zero-order-hold input (exact discretisation).
 
     The first-order form ``x' = A x + B u, y = C x + D u`` (``model.state_space(θ)``)
@@ -340,6 +340,10 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
         Relative noise level ε ≥ 0 on the output: channel j gets white Gaussian noise of
         standard deviation ε·std(y_j) (the standard deviation over time of the exact
         output). The input stays exact. ``None`` or 0 gives exact data.
+    noise_std : float or array_like of shape (p,), optional
+        Absolute noise instead (or as well): white Gaussian noise of this standard deviation
+        on every output, in the output's units (one value, or one per output; ≥ 0), as a
+        sensor of known resolution adds (0.05 K on a thermometer).
     seed : int or numpy.random.Generator, optional
         Seed of :func:`numpy.random.default_rng`.
 
@@ -394,4 +398,13 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
                         f"is the system unstable? (max Re λ(A) = {np.linalg.eigvals(A).real.max():.3g})")
     if level > 0:
         y = y + level * np.std(y, axis=0) * rng.standard_normal(y.shape)
+    if noise_std is not None:
+        std = checks.as_array(noise_std, "noise_std", complex_ok=False)
+        if std.shape not in ((), (1,), (y.shape[1],)):
+            raise DataError(f"noise_std must be one number or one per output ({y.shape[1]}); got shape "
+                            f"{checks.shape_text(std.shape)}")
+        checks.check_finite(std, "noise_std")
+        if np.any(std < 0):
+            raise DataError(f"noise_std must be >= 0 (a standard deviation in the output's units); got {std.tolist()}")
+        y = y + std.reshape(-1)[None, :] * rng.standard_normal(y.shape)
     return IOData(u_, y, dt_)
