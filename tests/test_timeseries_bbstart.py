@@ -205,3 +205,24 @@ def test_the_n4sid_horizon_is_the_one_whose_black_box_predicts_the_samples_best(
     assert _record_misfit(default, noisy) > 1e-2
     assert found.horizon > default.horizon
     assert 0.5e-4 < found.record_misfit < 3e-4
+
+
+@pytest.mark.parametrize("jordan", [False, True])
+def test_the_black_box_is_simulated_mode_by_mode_as_sample_by_sample(jordan):
+    # reference: the state recursion itself, sample by sample; a Jordan block (no eigenvector basis) takes that path
+    from symid.fit.timeseries.bbstart import _black_box_output
+
+    rng = np.random.default_rng(0)
+    A = rng.standard_normal((6, 6))
+    A = 0.95 * A / np.max(np.abs(np.linalg.eigvals(A)))
+    if jordan:
+        A = np.array([[0.9, 1.0], [0.0, 0.9]])
+    n = A.shape[0]
+    B, C, D = rng.standard_normal((n, 2)), rng.standard_normal((3, n)), rng.standard_normal((3, 2))
+    u, x0 = rng.standard_normal((3000, 2)), rng.standard_normal(n)
+    x, ref = x0.copy(), np.empty((3000, 3))
+    for k in range(3000):
+        ref[k] = C @ x + D @ u[k]
+        x = A @ x + B @ u[k]
+    # the modal path loses digits to the eigenvector basis's condition (measured 5e-15 relative here)
+    np.testing.assert_allclose(_black_box_output(A, B, C, D, u, x0), ref, rtol=0, atol=1e-10 * np.abs(ref).max())
