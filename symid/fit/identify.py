@@ -214,18 +214,19 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             polished = dataclasses.replace(polished, uncertainty=polisher.uncertainty(
                 polished.theta_vector, model.parameter_names, noise_std=noise_std))
         result = dataclasses.replace(result, polished=polished)
+    extra: dict[str, Any] = {}
     if identifiability_check and not not_local and result.success:
         from symid.structural.analyse import several_solutions
 
         t_check = time.perf_counter()
         several = several_solutions(model)
-        extra = {"identifiability_check_s": (check_s or 0.0) + time.perf_counter() - t_check}
+        extra["identifiability_check_s"] = (check_s or 0.0) + time.perf_counter() - t_check
         if several is not None:
             extra["several_solutions"] = several
             warnings.warn(several, IdentifiabilityWarning, stacklevel=2)
-        result = dataclasses.replace(result, options={**result.options, **extra})
-    # the whole call (setup, typical values, the check, the starts, uncertainty and polish), beside the starts' time
-    result = dataclasses.replace(result, options={**result.options, "identify_s": time.perf_counter() - t_call})
+    # the whole call (setup, typical values, the checks, the starts, uncertainty and polish), beside the starts' time
+    extra["identify_s"] = time.perf_counter() - t_call
+    result = dataclasses.replace(result, options={**result.options, **extra})
     ambiguity = result.ambiguity()
     if ambiguity is not None:
         warnings.warn(ambiguity, IdentifiabilityWarning, stacklevel=2)
