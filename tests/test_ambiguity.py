@@ -8,6 +8,7 @@ whose transfer function a21 / ((s + a2 + a21)(s + a1)) is unchanged when the pol
 
 from __future__ import annotations
 
+import functools
 import re
 import warnings
 
@@ -15,6 +16,7 @@ import numpy as np
 import pytest
 
 import symid as si
+from symid.structural import analyse
 
 
 def two_compartments():
@@ -22,7 +24,9 @@ def two_compartments():
     return si.StateSpaceModel(A=[[-(a2 + a21), 0], [a21, -a1]], B=[[1], [0]], C=[[0, 1]])
 
 
-def test_two_exact_solutions_reached_by_different_starts_are_reported():
+def test_two_exact_solutions_reached_by_different_starts_are_reported(monkeypatch):
+    # the global check after the fit runs to the end here (its one-second budget does not hold under any load)
+    monkeypatch.setattr(analyse, "several_solutions", functools.partial(analyse.several_solutions, timeout=None))
     model = two_compartments()
     truth = {"a1": 3.0, "a2": 0.5, "a21": 1.0}
     frf = si.simulate_frf(model, truth, np.logspace(-1, 1, 40))

@@ -8,6 +8,7 @@ fixes k10, k12, k21 and 1/V; Godfrey, *Compartmental Models and Their Applicatio
 
 from __future__ import annotations
 
+import functools
 import warnings
 
 import numpy as np
@@ -18,6 +19,7 @@ import symid as si
 from symid.data.timeseries import TimeSeries
 from symid.fit.registry import prepare
 from symid.fit.timeseries.response import simulate_output
+from symid.structural import analyse
 
 TRUTH = {"k10": 0.2, "k12": 0.5, "k21": 0.15, "q": 0.05}
 T_PK = np.array([0, 0.25, 0.5, 1, 1.5, 2, 3, 4, 6, 8, 10, 12, 16, 20, 24, 30, 36, 48.0])  # hours
@@ -289,7 +291,7 @@ def test_the_identifiability_check_says_it_ignores_a_dose_given_as_the_initial_s
     assert any("nonzero initial state" in note for note in rep.notes), rep.notes
 
 
-def test_a_fit_of_a_model_with_two_solutions_says_so():
+def test_a_fit_of_a_model_with_two_solutions_says_so(monkeypatch):
     """A new user's oral dose (first-order absorption ka, elimination ke, q = 1/V): ka and ke are interchangeable
     (the flip-flop; Godfrey 1983, ch. 6), so two parameter values give every concentration curve. The default fit
     returned the swapped one from 19 of 20 records, a success, with nothing said; the global check after the fit
@@ -300,6 +302,9 @@ def test_a_fit_of_a_model_with_two_solutions_says_so():
     u = np.zeros(49)
     u[0] = 1000.0  # 500 mg over the first half hour
     io = si.simulate_io(oral, truth, u, 0.5, noise=0.05, seed=1)
+    # the check's one-second budget holds here unloaded (0.15-0.4 s), but not under any load: this test is of what
+    # identify does with the verdict, so the check runs to the end
+    monkeypatch.setattr(analyse, "several_solutions", functools.partial(analyse.several_solutions, timeout=None))
     with pytest.warns(si.IdentifiabilityWarning, match="locally but not globally identifiable") as caught:
         res = si.identify(oral, io, x0={"ka": 0.3, "ke": 0.05, "q": 0.01})
     assert res.success

@@ -597,14 +597,16 @@ GLOBAL_CHECK_BUDGET = 1.0
 as first-order absorption and elimination, take 0.1 to 0.5 s; larger ones end undetermined, and say nothing)."""
 
 
-def several_solutions(model) -> str | None:
-    """One sentence when :func:`identifiability` proves, within ``GLOBAL_CHECK_BUDGET``, that other admissible
-    parameter values give the model's response (locally, not globally identifiable), else ``None``.
+def several_solutions(model, *, timeout: float | None = GLOBAL_CHECK_BUDGET) -> str | None:
+    """One sentence when :func:`identifiability` proves, within ``timeout`` seconds (``None``: no limit), that other
+    admissible parameter values give the model's response (locally, not globally identifiable), else ``None``.
 
     :func:`symid.identify` calls it after a fit: the estimate is then one of several that the data
     cannot tell apart, and which one depends on the start (a new user's oral-dose model, ka and
     ke interchangeable, came back with them swapped from 19 of 20 records, a success every time
-    and nothing said). Cached per model structure within the process. ``None`` for a model with a
+    and nothing said). Cached per model structure and ``timeout`` within the process: on a busy
+    machine a check that runs out of time says nothing, and stays silent for that structure.
+    ``None`` for a model with a
     nonzero initial state: the analysis is of the input-output map from rest, and a free
     response can tell apart solutions that map cannot.
 
@@ -614,13 +616,13 @@ def several_solutions(model) -> str | None:
     >>> from symid.structural.analyse import several_solutions
     >>> ka, ke, q = si.parameters("ka ke q", positive=True)
     >>> oral = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])
-    >>> print(several_solutions(oral))  # doctest: +ELLIPSIS
+    >>> print(several_solutions(oral, timeout=None))  # doctest: +ELLIPSIS
     the model is locally but not globally identifiable: at a random parameter point, 2 admissible ...
     """
     if getattr(model, "initial_state_kind", "zero") in ("known", "affine"):
         return None
     try:
-        key = (type(model).__name__, getattr(model, "output", None), tuple(model.parameter_names),
+        key = (timeout, type(model).__name__, getattr(model, "output", None), tuple(model.parameter_names),
                tuple(model.positive), getattr(model, "initial_state_kind", "zero"),
                tuple((k, sp.srepr(v)) for k, v in sorted(model.symbolic.items())))
     except (AttributeError, TypeError):
@@ -628,7 +630,7 @@ def several_solutions(model) -> str | None:
     if key not in _SEVERAL:
         if len(_SEVERAL) >= 64:  # the oldest goes
             _SEVERAL.pop(next(iter(_SEVERAL)))
-        _SEVERAL[key] = _several_solutions(model)
+        _SEVERAL[key] = _several_solutions(model, timeout)
     return _SEVERAL[key]
 
 
@@ -636,11 +638,11 @@ _SEVERAL: dict[tuple, str | None] = {}
 """:func:`several_solutions`'s answers by model structure (a cache: the answer depends on the structure only)."""
 
 
-def _several_solutions(model) -> str | None:
+def _several_solutions(model, timeout: float | None) -> str | None:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            rep = identifiability(model, timeout=GLOBAL_CHECK_BUDGET)
+            rep = identifiability(model, timeout=timeout)
     except Exception:  # a check after the fit never costs the user the fit: it says nothing instead
         return None
     count, bound = rep.n_solutions, rep.n_solutions_at_least
