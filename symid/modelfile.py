@@ -92,9 +92,11 @@ class ModelFile:
         ``scale=`` (the unknowns become θ / scale).
     bounds : dict of str to (float, float)
         Plausible range (low, high) of some free parameters; ``±inf`` leaves a side open.
-        ``start`` must lie inside them; ``symid identify`` reports an estimate outside them
-        and, when every free parameter has finite bounds and no start is given, starts at
-        their centre (geometric for positive ranges).
+        ``start`` must lie inside them; ``symid identify`` passes them to the methods that
+        take ``bounds=`` (the default ``auto``, ``lm``, ``oe``, ``ipopt``: the estimate stays
+        inside), reports an estimate of the other methods outside them and, when every free
+        parameter has finite bounds and no start is given, starts at their centre
+        (geometric for positive ranges).
     input_units, output_units : tuple of str
         Physical unit of each input and output (labels only: the Bode plot's |H| is in
         output unit per input unit). Empty when not given.

@@ -115,7 +115,7 @@ def make_starts(model: Any, starts: int, seed: int | None, x0: Any = None, *, ze
 
 
 def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = None, *, draws: str | None = None,
-                scale: Any = None, black_box: bool = True) -> list[np.ndarray]:
+                scale: Any = None, black_box: bool = True, bounds: Any = None) -> list[np.ndarray]:
     """The starts of :func:`symid.identify` and :func:`symid.compare`: ``x0`` first, then random draws.
 
     Parameters
@@ -139,6 +139,12 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
     black_box : bool, optional
         Build the black-box start (default ``True``); ``False`` for a method that does not
         use its start (the linear least squares), where it would only cost time.
+    bounds : dict or array_like, optional
+        The user's bounds (the methods' ``bounds=`` option): a positive parameter with
+        two positive finite bounds is drawn around their geometric mean unless ``scale``
+        gives its typical value, and every start but the user's ``x0`` is moved into the
+        bounds (:mod:`symid.fit.bounded`; a user's start outside them is the method's
+        to refuse).
 
     Examples
     --------
@@ -168,8 +174,15 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         else:
             draws = "normal"  # the user's start alone
     draws = check_choice("draws", draws, DRAWS)
+    lower = upper = None
+    if bounds is not None:
+        from symid.fit.options import check_bounds
+
+        lower, upper = check_bounds("bounds", bounds, model.parameter_names)
+    user_x0 = x0
     if draws == "normal":
-        return make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+        out = make_starts(model, starts, seed, x0, zero_first=type(model).__name__ == "StateSpaceModel")
+        return out if lower is None else _into_bounds(out, lower, upper, user_x0 is not None)
     if scale is not None:
         typical = np.abs(check_scale("scale", scale, model.n_parameters))
     elif typical is None:
@@ -177,6 +190,11 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         if typical is None:
             raise OptionError(f"draws='scale' needs typical values: give scale= (one value or one per parameter); "
                               f"{kind.name} data give none of their own")
+    positive = np.asarray(model.positive, dtype=bool)
+    if lower is not None:
+        from symid.fit.bounded import typical_within
+
+        typical = typical_within(typical, lower, upper, positive, scale is not None)
     if black_box and x0 is None and kind.name == "frequency response":
         from symid.fit.frf.modal import black_box_start
 
@@ -184,5 +202,13 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         if found is not None:
             x0 = found.theta
             if scale is None:
-                typical = found.typical
-    return make_starts(model, starts, seed, x0, typical=typical)
+                typical = found.typical if lower is None else typical_within(found.typical, lower, upper, positive,
+                                                                             False)
+    out = make_starts(model, starts, seed, x0, typical=typical)
+    return out if lower is None else _into_bounds(out, lower, upper, user_x0 is not None)
+
+
+def _into_bounds(starts: list[np.ndarray], lower: np.ndarray, upper: np.ndarray, keep_first: bool
+                 ) -> list[np.ndarray]:
+    """The starts moved into [lower, upper], but for the user's own start (``keep_first``)."""
+    return [x if (i == 0 and keep_first) else np.clip(x, lower, upper) for i, x in enumerate(starts)]

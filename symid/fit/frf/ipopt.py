@@ -8,6 +8,7 @@ import casadi as ca
 import numpy as np
 
 from symid.engine.ipopt import HESSIANS, ScaledIpopt, casadi_frf, iteration_reporter
+from symid.fit.bounded import on_bounds
 from symid.fit.frf.misfit import FrfEstimator, NoiseWeighted
 from symid.fit.options import (
     check_bool,
@@ -168,7 +169,9 @@ class IpoptFRF(NoiseWeighted, FrfEstimator):
             max_iter = check_int("max_iter", max_iter, low=1, high=10**7)
         time_limit = check_time_limit("time_limit", time_limit)
         run = self._solver.solve(x0, max_iter=max_iter, time_limit=time_limit)
-        message = run.status + run.note + moved_onto_bounds(x0, self.lower, self.upper, self.model.parameter_names)
+        names = self.model.parameter_names
+        message = (run.status + run.note + moved_onto_bounds(x0, self.lower, self.upper, names)
+                   + on_bounds(run.z, self.lower, self.upper, names, np.asarray(self.model.positive, dtype=bool)))
         return self.outcome(x0, run.z, finished=run.finished, status=run.status, message=message,
                             iterations=run.iterations, wall_time=run.seconds)
 

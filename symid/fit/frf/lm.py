@@ -126,8 +126,18 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from symid.errors import ModelError, OptionError
+from symid.fit.bounded import bounds_option, clip_into, log_box, named_bounds, on_bounds
 from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted
-from symid.fit.options import check_bool, check_float, check_int, check_scale, check_seed, check_time_limit
+from symid.fit.options import (
+    check_bool,
+    check_float,
+    check_int,
+    check_scale,
+    check_seed,
+    check_start_bounds,
+    check_time_limit,
+    moved_onto_bounds,
+)
 from symid.fit.result import StartOutcome
 from symid.fit.sensitivity import frf_sensitivity
 from symid.fit.success import EXACT_FIT, black_box_ratio
@@ -191,6 +201,12 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         1e-10): restarts go on until a second pass ends at the best misfit (a confirmed
         minimum) or ``confirm`` passes have been spent since the first fit; the outcome is
         the best (default 0 for ``"lm"``, 4 for ``"auto"``).
+    bounds : dict or array_like, optional
+        Lower and upper bounds per parameter: a dict by name of (low, high) pairs (None or
+        ±inf for an open side), or an (l, 2) array. The passes stay within them (bounds on
+        the log-parameters, :mod:`symid.fit.bounded`), restarts and the chain's values are
+        moved into them, and a start outside them is refused. Parameters declared
+        positive stay positive without a bound. Default: none.
     chain_start : bool, optional
         For a chain of masses driven and measured at one mass, one pass starts from the
         chain's values read off the response by continued fractions
@@ -224,7 +240,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                  time_limit: float | None = None, bands: int | None = None, seed: int = 0,
                  variance: Any = "data", verbose: bool = False,
                  callback: Callable[[int, dict[str, Any]], Any] | None = None, chain_start: bool | None = None,
-                 confirm: int | None = None):
+                 confirm: int | None = None, bounds: Any = None):
         self.model, self.data = model, data
         l = model.n_parameters
         self.scale = None if scale is None else check_scale("scale", scale, l)
@@ -244,10 +260,13 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         confirm = self.default_confirm if confirm is None else check_int("confirm", confirm, low=0, high=10**6)
         if callback is not None and not callable(callback):
             raise OptionError(f"callback must be callable (pass_index, info) -> bool; got {type(callback).__name__}")
+        self.lower, self.upper, self._bounded = bounds_option(model, bounds, positivity)
         label = self.set_variance(variance)  # weights, the given noise and the noise floor it declares
         self._variance = variance
         self.callback = callback
-        self.options = {"scale": None if self.scale is None else self.scale.tolist(), "restarts": restarts,
+        self.options = {"scale": None if self.scale is None else self.scale.tolist(),
+                        "bounds": named_bounds(model.parameter_names, self.lower, self.upper)
+                        if self._bounded else None, "restarts": restarts,
                         "bands": bands,
                         "spread": spread, "max_iter": max_iter,
                         "positivity": positivity, "tol": tol, "time_limit": time_limit, "seed": seed,
@@ -263,6 +282,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         self._w = np.asarray(data.w, dtype=float)
         self._chain: Any = None  # the chain's values (chain_start), read once per estimator
         self._chain_read = False
+        self._box: tuple[np.ndarray, np.ndarray] | None = None  # bounds on φ of the start under way (bounds)
 
     # -- parametrisation ------------------------------------------------------------------------
     def _units(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -357,12 +377,14 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         # the judged criterion gets ten times the evaluations: on noisy data of a sloppy model its minimum
         # lies at the end of a long valley (measured: 250-850 evaluations on a 2-mass chain at 1 % noise)
         nfev = self.options["max_iter"] * (10 if kind == "abs" else 1)
-        sol = least_squares(lambda p: value(p)[0], phi, jac=lambda p: value(p)[1], method="trf", x_scale=1.0,
-                            max_nfev=nfev, ftol=tol, xtol=tol, gtol=min(tol, 1e-10))
+        box = (-np.inf, np.inf) if self._box is None else self._box
+        sol = least_squares(lambda p: value(p)[0], self._clip(phi), jac=lambda p: value(p)[1], method="trf",
+                            x_scale=1.0, max_nfev=nfev, ftol=tol, xtol=tol, gtol=min(tol, 1e-10), bounds=box)
         return self._clip(sol.x), int(sol.nfev)
 
     def _clip(self, phi: np.ndarray) -> np.ndarray:
-        return np.where(self._positive, np.clip(phi, -_LOG_BOX, _LOG_BOX), phi)
+        phi = np.where(self._positive, np.clip(phi, -_LOG_BOX, _LOG_BOX), phi)
+        return phi if self._box is None else np.clip(phi, *self._box)
 
     def _pass(self, phi: np.ndarray, centre: np.ndarray, unit: np.ndarray, deadline: float | None
               ) -> tuple[np.ndarray, int, bool]:
@@ -398,6 +420,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             raise OptionError(f"the start {names[k]} = {x[k]:g} is negative, but {names[k]} is declared positive and "
                               f"{self.method!r} keeps it so; give a positive start (0 takes its scale), or "
                               f"positivity=False")
+        check_start_bounds(x, self.lower, self.upper, names)
 
     def _chain_theta(self, x0: np.ndarray) -> np.ndarray | None:
         """x0 with the chain's values read off the response (chain_start), or None where there are none."""
@@ -423,7 +446,14 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         opts = self.options
         limit = opts["time_limit"]
         deadline = None if limit is None else t0 + limit
+        moved, start = "", x0
+        if self._bounded:  # a drawn start outside the bounds begins on them (a user's own was refused)
+            moved = moved_onto_bounds(x0, self.lower, self.upper, self.model.parameter_names)
+            x0 = clip_into(x0, self.lower, self.upper)
         centre, unit = self._units(x0)
+        self._box = None
+        if self._bounded:
+            self._box = log_box(self.lower, self.upper, centre, unit, self._positive, _LOG_BOX)
         rng = np.random.default_rng([opts["seed"], *np.frombuffer(x0.tobytes(), dtype=np.uint32)])
         best: StartOutcome | None = None
         total_nfev = 0
@@ -473,7 +503,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             theta, nfev, spent = self._pass(phi, centre, unit, deadline)
             total_nfev += nfev
             passes += 1
-            cand = self.outcome(x0, theta, finished=not spent, status="time_limit" if spent else "converged",
+            cand = self.outcome(start, theta, finished=not spent, status="time_limit" if spent else "converged",
                                 message="", iterations=total_nfev, wall_time=time.perf_counter() - t0)
             visited.append(cand)
             if best is None or cand.cost < best.cost * (1 - 1e-6):
@@ -497,7 +527,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 theta, nfev, spent = self._pass(self._phi(best.theta, centre, unit), centre, unit, deadline)
                 total_nfev += nfev
                 passes += 1
-                cand = self.outcome(x0, theta, finished=not spent, status="time_limit" if spent else "converged",
+                cand = self.outcome(start, theta, finished=not spent, status="time_limit" if spent else "converged",
                                     message="", iterations=total_nfev, wall_time=time.perf_counter() - t0)
                 visited.append(cand)
                 if cand.cost < best.cost:
@@ -533,11 +563,18 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 "time_limit": f"time limit of {limit:g} s reached after {passes} pass(es)" if limit else "",
                 "stopped": f"stopped by the callback after {passes} pass(es)",
                 "repeated": f"{_REPEATS} of {passes} passes ended at the same best misfit"}[status]
-        out = self.outcome(x0, best.theta, finished=status not in ("time_limit", "stopped"), status=status,
-                           message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}{chain_note}",
+        out = self.outcome(start, best.theta, finished=status not in ("time_limit", "stopped"), status=status,
+                           message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}{chain_note}"
+                                   f"{moved}{self._on_bounds(best.theta)}",
                            iterations=total_nfev, wall_time=wall)
         others = tuple(c for c in visited if c is not best)
         return dataclasses.replace(out, passes=others) if others else out
+
+    def _on_bounds(self, theta: np.ndarray) -> str:
+        """Which entries of the estimate sit on the user's bounds ('' without bounds)."""
+        if not self._bounded:
+            return ""
+        return on_bounds(theta, self.lower, self.upper, self.model.parameter_names, self._positive)
 
     def _cleaner_than(self, best: StartOutcome) -> bool:
         """Whether the data are cleaner than ``best``, a fit the success rule refuses: a black box of the model's

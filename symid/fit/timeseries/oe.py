@@ -40,6 +40,7 @@ that a time axis or a state in other units does not change its rounding.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any, ClassVar
@@ -59,6 +60,7 @@ from symid.engine.ipopt import (
 )
 from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
+from symid.fit.bounded import bounds_option, clip_into, log_box, named_bounds, on_bounds
 from symid.fit.options import (
     check_bool,
     check_callback,
@@ -66,7 +68,9 @@ from symid.fit.options import (
     check_float,
     check_int,
     check_scale,
+    check_start_bounds,
     check_time_limit,
+    moved_onto_bounds,
 )
 from symid.fit.result import StartOutcome
 from symid.fit.timeseries.records import as_records
@@ -172,6 +176,11 @@ class OutputError(Estimator, FisherInformation):
         depend on the units of θ.
     positivity : bool, optional
         Bound parameters declared ``positive=True`` below by 0. Default True.
+    bounds : dict or array_like, optional
+        Lower and upper bounds per parameter: a dict by name of (low, high) pairs (None or
+        ±inf for an open side), or an (l, 2) array. Both solvers stay within them (trf on
+        the log-parameters, :mod:`symid.fit.bounded`); a start outside them is refused,
+        a drawn one moved onto them (the message says so). Default: none.
     hessian : {"auto", "exact", "gauss-newton", "limited-memory"}, optional
         For ``solver="ipopt"``, IPOPT's Hessian: CasADi's exact one, Gauss–Newton 2 JᵀJ from the residual's
         Jacobian J (first derivatives only), or L-BFGS. ``"auto"`` (default): exact,
@@ -235,7 +244,7 @@ class OutputError(Estimator, FisherInformation):
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = None, callback: Any = None, verbose: bool = False,
-                 solver: str = "trf"):
+                 solver: str = "trf", bounds: Any = None):
         self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
         self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
         if self._x0_mode == "known":
@@ -244,6 +253,7 @@ class OutputError(Estimator, FisherInformation):
         l = model.n_parameters
         self.scale = None if scale is None else check_scale("scale", scale, l)
         self._positivity = check_bool("positivity", positivity)
+        self.lower, self.upper, self._bounded = bounds_option(model, bounds, self._positivity)
         self._hessian = check_choice("hessian", hessian, ("auto", *HESSIANS, GAUSS_NEWTON))
         self._solver_kind = check_choice("solver", solver, SOLVERS)
         if self._solver_kind == "trf" and self._hessian != "auto":
@@ -261,6 +271,8 @@ class OutputError(Estimator, FisherInformation):
         self._deadline: float | None = None  # of the start under way (time_limit), checked every iteration
         self._timed_out = False
         self.options = {"scale": "start" if self.scale is None else self.scale.tolist(),
+                        "bounds": named_bounds(model.parameter_names, self.lower, self.upper)
+                        if self._bounded else None,
                         "positivity": self._positivity, "solver": self._solver_kind, "hessian": self._hessian,
                         "max_iter": self._max_iter, "tol": self._tol, "time_limit": self._time_limit,
                         "callback": None if callback is None else "given", "verbose": verbose,
@@ -408,11 +420,12 @@ class OutputError(Estimator, FisherInformation):
         """IPOPT on ‖r‖² for ``s_max`` squarings, scaled per start (built once)."""
         if s_max not in self._solvers:
             v, q, r = self._symbolic(s_max)
-            extra = v.numel() - self._lower.size
-            lower = np.concatenate([self._lower, np.full(extra, -np.inf)])
+            extra = v.numel() - self.lower.size
+            lower = np.concatenate([self.lower, np.full(extra, -np.inf)])
+            upper = np.concatenate([self.upper, np.full(extra, np.inf)])
             hessian = self._hessian_for(v, q, r, s_max)
             self._solvers[s_max] = ScaledIpopt(f"symid_oe_{s_max}", v, ca.sumsqr(r), lower=lower,
-                                               upper=np.full(v.numel(), np.inf), max_iter=self._max_iter,
+                                               upper=upper, max_iter=self._max_iter,
                                                tol=self._tol, hessian=hessian, parameters=q,
                                                residual_jacobian=self._jacobian_function(s_max)
                                                if hessian == GAUSS_NEWTON else None,
@@ -495,9 +508,26 @@ class OutputError(Estimator, FisherInformation):
         needs more squarings, IPOPT runs again from it with the larger number (at most
         three rounds), with the start's scaling.
         """
+        given = np.asarray(x0, dtype=float)
+        moved = ""
+        if self._bounded:  # a drawn start outside the bounds begins on them (a user's own was refused)
+            moved = moved_onto_bounds(given, self.lower, self.upper, self.model.parameter_names)
+            x0 = clip_into(given, self.lower, self.upper)
         if self._solver_kind == "trf":
-            return self._run_trf(np.asarray(x0, dtype=float))
-        start = np.asarray(x0, dtype=float)
+            out = self._run_trf(np.asarray(x0, dtype=float))
+        else:
+            out = self._run_ipopt(np.asarray(x0, dtype=float))
+        if self._bounded:
+            moved += on_bounds(out.theta, self.lower, self.upper, self.model.parameter_names,
+                               np.asarray(self.model.positive, dtype=bool) & self._positivity)
+        return dataclasses.replace(out, start=given, message=out.message + moved) if moved else out
+
+    def check_start(self, x0: np.ndarray) -> None:
+        """Refuse a start of the wrong length or outside the bounds (an :class:`OptionError` naming it)."""
+        check_start_bounds(x0, self.lower, self.upper, self.model.parameter_names)
+
+    def _run_ipopt(self, start: np.ndarray) -> StartOutcome:
+        """``solver="ipopt"``: IPOPT on CasADi's graph (see :meth:`run`)."""
         t0 = time.perf_counter()
         l = self.model.n_parameters
         q = self._balance(start) if np.all(np.isfinite(start)) else np.ones(self.model.n_states
@@ -585,12 +615,17 @@ class OutputError(Estimator, FisherInformation):
             return r, J
 
         phi0 = np.zeros(v0.size)  # the start
+        box: Any = (-np.inf, np.inf)
+        if self._bounded:  # θ's bounds on its φ; the initial states unbounded
+            lo, hi = log_box(self.lower, self.upper, centre[:l], unit[:l], positive[:l], _LOG_BOX)
+            free = np.full(v0.size - l, np.inf)
+            box = (np.concatenate([lo, -free]), np.concatenate([hi, free]))
         status, finished = "not run", False
         try:
             with np.errstate(all="ignore"):  # steps into overflow are refused above, not printed by SciPy
                 sol = least_squares(lambda p: value(p)[0], phi0, jac=lambda p: value(p)[1], method="trf",
                                     x_scale=1.0, max_nfev=self._max_iter, ftol=self._tol, xtol=self._tol,
-                                    gtol=min(self._tol, 1e-10))
+                                    gtol=min(self._tol, 1e-10), bounds=box)
             # SciPy's last point, unless an evaluation it did not keep was better (or its own was refused)
             end_cost = costs.get(sol.x.tobytes(), math.inf)
             v_end = v_of(sol.x) if end_cost <= best["cost"] else best["v"]

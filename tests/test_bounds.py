@@ -1,0 +1,123 @@
+"""bounds= for the trust-region methods on log-parameters (lm, auto; oe and auto on time series) and the starts.
+
+Reference values: the models' truths, which the data are simulated from (noise-free), and
+the bounds the tests give. An estimate held on a bound is compared with the bound itself.
+"""
+
+import numpy as np
+import pytest
+
+import symid as si
+from symid.errors import OptionError
+from symid.fit.bounded import log_box, on_bounds
+from symid.fit.starts import draw_starts
+
+M, C, K = si.parameters("m c k", positive=True)
+MODEL = si.SecondOrderModel(M=[[M]], V=[[C]], K=[[K]], B=[[1]], C=[[1]])
+TRUTH = {"m": 2.0, "c": 0.5, "k": 3e4}  # a 1-DOF oscillator at 19.4 rad/s
+W = np.logspace(1, 3, 40)
+
+
+@pytest.fixture(scope="module")
+def frf():
+    return si.simulate_frf(MODEL, TRUTH, W)
+
+
+@pytest.fixture(scope="module")
+def io():
+    u = np.random.default_rng(0).standard_normal(600)
+    return si.simulate_io(MODEL, {"m": 2.0, "c": 0.8, "k": 50.0}, u, dt=0.05)
+
+
+@pytest.mark.parametrize("method", ["auto", "lm"])
+def test_bounds_that_hold_the_truth_leave_the_frf_estimate_the_truth(frf, method):
+    res = si.identify(MODEL, frf, method=method, bounds={"k": (1e4, 1e5)}, starts=2, seed=0,
+                      identifiability_check=False)
+    assert res.success
+    np.testing.assert_allclose(res.theta_vector, [2.0, 0.5, 3e4], rtol=1e-8)
+    assert res.options["bounds"] == {"m": [0.0, np.inf], "c": [0.0, np.inf], "k": [1e4, 1e5]}
+
+
+@pytest.mark.parametrize("method", ["auto", "lm", "ipopt"])
+def test_an_frf_estimate_stays_within_bounds_that_exclude_the_truth_and_says_it_sits_on_one(frf, method):
+    few = {"restarts": 3} if method == "auto" else {}  # no value fits: auto would spend its 30 restarts
+    res = si.identify(MODEL, frf, method=method, bounds={"k": (1e3, 2e4)}, starts=2, seed=0,
+                      identifiability_check=False, **few)
+    k = res.theta["k"]
+    assert k <= 2e4 * (1 + 1e-12)
+    np.testing.assert_allclose(k, 2e4, rtol=1e-9)  # held at the upper bound the truth 3e4 lies above
+    assert not res.success  # no value within the bounds fits these exact data
+    assert "on its bounds: k = 20000 (upper)" in res.best_start.message
+
+
+def test_the_estimate_in_other_units_is_the_same_estimate_converted_with_bounds(frf):
+    """k in kN/m: the data unchanged, the model's k and its bounds 1e-3 times; the estimate on the bound too."""
+    model = si.SecondOrderModel(M=[[M]], V=[[C]], K=[[1e3 * K]], B=[[1]], C=[[1]])
+    a = si.identify(MODEL, frf, method="auto", bounds={"k": (1e3, 2e4)}, x0=[1.0, 1.0, 1e4], seed=0,
+                    identifiability_check=False, restarts=3)
+    b = si.identify(model, frf, method="auto", bounds={"k": (1.0, 20.0)}, x0=[1.0, 1.0, 10.0], seed=0,
+                    identifiability_check=False, restarts=3)
+    np.testing.assert_allclose(b.theta_vector * [1, 1, 1e3], a.theta_vector, rtol=1e-6)
+
+
+@pytest.mark.parametrize("method", ["auto", "oe"])
+def test_time_series_estimates_honour_bounds(io, method):
+    inside = si.identify(MODEL, io, method=method, bounds={"k": (10, 100)}, starts=1, seed=0,
+                         identifiability_check=False)
+    assert inside.success
+    np.testing.assert_allclose(inside.theta_vector, [2.0, 0.8, 50.0], rtol=1e-6)
+    held = si.identify(MODEL, io, method=method, bounds={"k": (60, 100)}, x0=[1.0, 1.0, 70.0], seed=0,
+                       identifiability_check=False, restarts=2) if method == "auto" else \
+        si.identify(MODEL, io, method=method, bounds={"k": (60, 100)}, x0=[1.0, 1.0, 70.0],
+                    identifiability_check=False)
+    np.testing.assert_allclose(held.theta["k"], 60.0, rtol=1e-9)  # the truth 50 lies below the bound
+    assert not held.success and "on its bounds: k = 60 (lower)" in held.best_start.message
+
+
+def test_oe_with_ipopt_honours_bounds(io):
+    res = si.identify(MODEL, io, method="oe", solver="ipopt", bounds={"k": (60, 100)}, x0=[1.0, 1.0, 70.0],
+                      identifiability_check=False)
+    assert res.theta["k"] >= 60.0 * (1 - 1e-9)
+    np.testing.assert_allclose(res.theta["k"], 60.0, rtol=1e-6)  # IPOPT's interior point: within its tolerance
+
+
+@pytest.mark.parametrize("method", ["auto", "lm"])
+def test_a_users_start_outside_the_bounds_is_refused(frf, io, method):
+    with pytest.raises(OptionError, match="the start k = 10 lies outside its bounds"):
+        si.identify(MODEL, frf, method=method, bounds={"k": (1e4, 1e5)}, x0=[1.0, 1.0, 10.0])
+    ts = "auto" if method == "auto" else "oe"
+    with pytest.raises(OptionError, match="the start k = 10 lies outside its bounds"):
+        si.identify(MODEL, io, method=ts, bounds={"k": (60, 100)}, x0=[1.0, 1.0, 10.0])
+
+
+def test_equal_bounds_are_refused_with_the_known_value_to_give_instead(frf):
+    with pytest.raises(OptionError, match=r"k has equal bounds \[10, 10\].*known=\{'k': 10\}"):
+        si.identify(MODEL, frf, method="auto", bounds={"k": (10, 10)})
+
+
+def test_a_drawn_start_outside_the_bounds_begins_on_them_and_says_so(frf):
+    from symid.fit.frf.lm import LmFRF
+
+    out = LmFRF(MODEL, frf, bounds={"k": (1e4, 1e5)}).run(np.array([2.0, 0.5, 1e3]))
+    assert "start moved onto the bounds: k 1000 → 1e+04" in out.message
+    np.testing.assert_allclose(out.start, [2.0, 0.5, 1e3], rtol=0)  # the start as given is kept in the outcome
+    np.testing.assert_allclose(out.theta, [2.0, 0.5, 3e4], rtol=1e-8)
+
+
+def test_drawn_starts_lie_within_the_bounds_around_their_geometric_mean(frf):
+    x = np.array(draw_starts(MODEL, frf, 30, seed=0, bounds={"m": (0.5, 8.0), "k": (1e3, 1e5)}))
+    assert np.all((x[:, 0] >= 0.5) & (x[:, 0] <= 8.0) & (x[:, 2] >= 1e3) & (x[:, 2] <= 1e5))
+    # drawn log-uniformly within a factor 3 of sqrt(0.5 * 8) = 2 (the first start is the black box's, moved in)
+    assert np.all((x[1:, 0] >= 2 / 3 * (1 - 1e-12)) & (x[1:, 0] <= 6 * (1 + 1e-12)))
+    mine = draw_starts(MODEL, frf, 3, seed=0, x0=[1.0, 1.0, 10.0], bounds={"k": (1e3, 1e5)})
+    np.testing.assert_allclose(mine[0], [1.0, 1.0, 10.0], rtol=0)  # the user's own start: the method refuses it
+
+
+def test_the_log_box_and_the_note_on_bounds():
+    lo, hi = log_box(np.array([1.0, -np.inf, 0.0]), np.array([100.0, 4.0, np.inf]), np.array([10.0, 2.0, 5.0]),
+                     np.array([1.0, 0.5, 1.0]), np.array([True, False, True]), 20.0)
+    np.testing.assert_allclose(lo, [np.log(0.1), -np.inf, -20.0], rtol=1e-15)
+    np.testing.assert_allclose(hi, [np.log(10.0), 4.0, 20.0], rtol=1e-15)
+    # the 0 that keeps a positive parameter positive is not the user's bound
+    assert on_bounds(np.array([0.0, 4.0]), np.array([0.0, 1.0]), np.array([np.inf, 4.0]), ["m", "k"],
+                     np.array([True, True])) == "; on its bounds: k = 4 (upper)"
