@@ -121,3 +121,11 @@ def test_the_log_box_and_the_note_on_bounds():
     # the 0 that keeps a positive parameter positive is not the user's bound
     assert on_bounds(np.array([0.0, 4.0]), np.array([0.0, 1.0]), np.array([np.inf, 4.0]), ["m", "k"],
                      np.array([True, True])) == "; on its bounds: k = 4 (upper)"
+
+
+def test_the_polish_of_a_bounded_fit_keeps_the_bounds(frf):
+    res = si.identify(MODEL, frf, method="lm", bounds={"k": (1e3, 2e4)}, x0=[1.0, 1.0, 1e4], polish=True,
+                      identifiability_check=False)
+    assert res.polished is not None
+    assert res.polished.theta["k"] <= 2e4 * (1 + 1e-9)  # IPOPT's polish got the same bounds
+    np.testing.assert_allclose(res.polished.theta["k"], 2e4, rtol=1e-6)

@@ -588,10 +588,12 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         return ratio is not None and best.cost > ratio * bb[0]
 
     def polisher(self) -> Any:
-        """IPOPT on the same frequency response and noise weighting (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
+        """IPOPT on the same frequency response, noise weighting and bounds (:class:`~symid.fit.frf.ipopt.IpoptFRF`)."""
         from symid.fit.frf.ipopt import IpoptFRF
 
-        return IpoptFRF(self.model, self.data, variance=self._variance)
+        bounds = np.column_stack([self.lower, self.upper]) if self._bounded else None
+        return IpoptFRF(self.model, self.data, variance=self._variance, bounds=bounds,
+                        positivity=self.options["positivity"])
 
 
 class AutoFRF(LmFRF):
