@@ -140,6 +140,28 @@ def test_a_units_comment_that_contradicts_is_an_error(tmp_path, polar_csv):
         FrequencyData.from_table(path, columns=POLAR, units={**POLAR_UNITS, "frequency": "rad/s"})
 
 
+@pytest.mark.parametrize("comment", ["# units: s", "# units: time=s", "# units: t [s], u [N m], y [rad/s]",
+                                     "# units: seconds", "# units: t_ms=s", "# units: time in seconds"])
+def test_a_time_unit_in_a_units_comment_is_checked(tmp_path, comment):
+    """A file that says its times are in seconds, read as milliseconds: a 1000-fold error otherwise silent."""
+    path = write_csv(tmp_path / "series.csv", [comment, "t,u,y", "0.000,1,0", "0.001,0,1", "0.002,1,1"])
+    with pytest.raises(si.DataError, match=r"line 1: the file states s\b.*the time unit declared is ms"):
+        IOData.from_table(path, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "ms"})
+
+
+def test_a_unit_inside_another_columns_unit_is_not_read_as_its_own(tmp_path):
+    """rad/s in the unit of the response is not a statement about the frequency column (a user's file)."""
+    path = write_csv(tmp_path / "frf.csv", ["# units: f [Hz], mag [dB re 1 (rad/s)/(N m)], ph [deg]", "f,mag,ph",
+                                            "1.0,-20,-90", "2.0,-26,-95"])
+    frf = FrequencyData.from_table(path, columns={"frequency": "f", "magnitude": "mag", "phase": "ph"},
+                                   units={"frequency": "Hz", "magnitude": "dB", "phase": "deg"})
+    np.testing.assert_allclose(frf.w, [2 * np.pi, 4 * np.pi], rtol=1e-15)
+    # the same file read with the frequency in rad/s contradicts its own f [Hz]
+    with pytest.raises(si.DataError, match=r"states Hz for 'f'.*frequency unit declared is rad/s"):
+        FrequencyData.from_table(path, columns={"frequency": "f", "magnitude": "mag", "phase": "ph"},
+                                 units={"frequency": "rad/s", "magnitude": "dB", "phase": "deg"})
+
+
 def test_a_units_comment_without_declared_units_is_an_error(tmp_path):
     path = write_csv(tmp_path / "plain.csv", ["# units: Hz", "f,re,im", "1.0,0.5,-0.5", "2.0,0.2,-0.4"])
     with pytest.raises(si.DataError) as info:

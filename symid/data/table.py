@@ -17,9 +17,11 @@ A table is one of
 * the path of a plain CSV file: one header line of column names (``"quoted"`` names
   are unquoted), then one row of numbers per sample; ``delimiter=`` sets the separator
   (``","`` by default, ``";"`` and tab work too). Lines starting with ``#`` are comments.
-  A comment that states units (``# units: Hz, dB``) is checked against the declared
-  units, never ignored: a unit it names that contradicts the declaration, or any unit
-  stated while ``units`` is not given, is an error. Only the declared columns are
+  A comment that states units (``# units: Hz, dB``, or per column ``# units: t [s]``,
+  ``time=s``) is checked against the declared units, never ignored: a unit it names that
+  contradicts the declaration, or any unit stated while ``units`` is not given, is an
+  error; a unit inside another column's unit (``mag [dB re 1 (rad/s)/N]``) is that
+  column's, not a statement about the frequency. Only the declared columns are
   parsed, so other columns may hold anything (dates, text). At most
   :data:`MAX_TABLE_BYTES`;
 * the path of a MATLAB ``.mat`` file (level 5, what ``save`` writes): columns are
@@ -167,20 +169,93 @@ class _Csv:
                                 "drop or fill that row")
         return out
 
-    def check_unit_comments(self, declared: Mapping[str, str], example: str) -> None:
-        """A comment that states units must agree with the declared ones (and units must be declared)."""
+    def check_unit_comments(self, declared: Mapping[str, str], example: str,
+                            columns: Mapping[str, str] | None = None) -> None:
+        """A comment that states units must agree with the declared ones (and units must be declared).
+
+        ``columns``: the name of the column of each role that has a unit (``{"t": "time"}``),
+        so that ``t [s]`` or ``t=s`` is read as the unit of that column (:func:`_stated_units`).
+        """
         for line, comment in self.comments:
             if not re.search(r"\bunits?\b", comment, flags=re.IGNORECASE):
                 continue
             if not declared:
                 raise _fail(f"{self.where}, line {line}", f"the file states units ({_files._show(comment, 60)}) but "
                             "none were declared; symid never guesses units from a comment: declare them", example)
-            for dimension, unit in unit_tokens(comment):
+            for name, dimension, unit in _stated_units(comment, {**dict.fromkeys(_UNIT_DIMENSION), **(columns or {})}):
                 mine = {u for role, u in declared.items() if _UNIT_DIMENSION.get(role) == dimension}
                 if mine and unit not in mine:
-                    raise DataError(f"{self.where}, line {line}: the file states {unit} ({_files._show(comment, 60)}) "
+                    what = f"{unit} for {name!r}" if name else unit
+                    raise DataError(f"{self.where}, line {line}: the file states {what} ({_files._show(comment, 60)}) "
                                     f"but the {dimension} unit declared is {', '.join(sorted(mine))}; check which "
                                     "is right")
+
+
+_PAIR = re.compile(r"^([^\s\[\]=:()]+)\s*(?:\[(.*)\]|\((.*)\)|[=:]\s*(.+))$")
+"""``name [unit]``, ``name (unit)``, ``name = unit`` or ``name: unit`` in a units comment."""
+
+
+def _split_items(text: str) -> list[str]:
+    """``text`` split at the commas and semicolons outside brackets and parentheses."""
+    items, depth, cur = [], 0, []
+    for ch in text:
+        depth += ch in "[("
+        depth -= ch in "])"
+        if ch in ",;" and depth <= 0:
+            items.append("".join(cur).strip())
+            cur = []
+        else:
+            cur.append(ch)
+    items.append("".join(cur).strip())
+    return [i for i in items if i]
+
+
+def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[str | None, str, str]]:
+    """The units a comment states, as (column or role name or None, dimension, unit) triples.
+
+    The text after ``units:`` is split into items at commas and semicolons. An item
+    ``name [unit]`` (or ``name = unit``, ``name: unit``, ``name (unit)``) states the unit
+    of that column: where ``name`` is a column read in a role with a unit (``roles``: name
+    → role; the role names themselves, e.g. ``time=s``, count too), every unit of the
+    role's dimension in the bracket is stated for it, and the others are ignored (``mag
+    [dB re 1 (rad/s)/N]`` states dB, not rad/s, for the magnitude); for another name, the
+    bracket's first unit is stated (a unit of a column not read can still contradict the
+    declaration: ``t_ms=s`` beside a time column). An item that is a unit alone (``s``,
+    ``Hz``) states it; any other item is free text, where unit words that are also common
+    words ("s", "min", "rad") are not read as units.
+
+    Examples
+    --------
+    >>> from symid.data.table import _stated_units
+    >>> _stated_units("# units: f [Hz], mag [dB re 1 (rad/s)/N], ph [deg]", {"f": "frequency",
+    ...               "mag": "magnitude", "ph": "phase"})
+    [('f', 'frequency', 'Hz'), ('mag', 'magnitude', 'dB'), ('ph', 'phase', 'deg')]
+    >>> _stated_units("# units: s", {}), _stated_units("# units: t_ms=s", {"t": "time"})
+    ([(None, 'time', 's')], [('t_ms', 'time', 's')])
+    """
+    text = comment.lstrip("#").strip()
+    head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE)
+    body = text[head.end():] if head else text
+    out: list[tuple[str | None, str, str]] = []
+    for item in _split_items(body):
+        pair = _PAIR.match(item)
+        if pair:
+            name = pair.group(1)
+            unit_text = next(g for g in pair.groups()[1:] if g is not None)
+            found = unit_tokens(unit_text, strict=True)
+            role = roles.get(name) if name in roles else None
+            role = role or (name if name in _UNIT_DIMENSION else None)
+            if role is not None:
+                out.extend((name, d, u) for d, u in found if d == _UNIT_DIMENSION[role])
+            elif found:
+                out.append((name, *found[0]))
+            continue
+        alone = unit_tokens(item, strict=True)
+        if len(alone) == 1 and re.fullmatch(r"[A-Za-zµμ°]+|rad\s*/\s*s(?:ec)?", item):
+            out.append((None, *alone[0]))
+        else:
+            out.extend((None, d, u) for d, u in unit_tokens(item))
+    return out
 
 
 class _Arrays:
@@ -404,7 +479,7 @@ def frequency_data_from_table(table: Any, *, columns: Mapping[str, Any], units: 
         src.check_unit_comments({}, FRF_EXAMPLE)  # a file that states units, read without any declared
     declared = _units(units, needed, where, FRF_EXAMPLE)
     if isinstance(src, _Csv):
-        src.check_unit_comments(declared, FRF_EXAMPLE)
+        src.check_unit_comments(declared, FRF_EXAMPLE, _unit_columns(roles, parts))
     cols = _Columns(src, FRF_EXAMPLE)
     w = cols.vector(roles["frequency"]) * DIMENSIONS["frequency"][declared["frequency"]]
     H = np.empty((w.size, p, m), dtype=np.complex128)
@@ -421,6 +496,14 @@ def frequency_data_from_table(table: Any, *, columns: Mapping[str, Any], units: 
         H[:, i, j] = mag * np.exp(1j * y * DIMENSIONS["phase"][declared["phase"]])
     with _naming(src.where):
         return FrequencyData(w, H)
+
+
+def _unit_columns(roles: Mapping[str, Any], parts: Mapping[str, Mapping[Any, Any]]) -> dict[str, str]:
+    """Column name → role for the columns of a frequency table whose role has a unit."""
+    out = {roles["frequency"]: "frequency"} if isinstance(roles["frequency"], str) else {}
+    for role in ("magnitude", "phase"):
+        out.update({n: role for n in parts[role].values() if isinstance(n, str)})
+    return out
 
 
 # -- time series --------------------------------------------------------------------------------------
@@ -459,7 +542,7 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
         src.check_unit_comments({}, SERIES_EXAMPLE)
     declared = _units(units, ["time"], where, SERIES_EXAMPLE)
     if isinstance(src, _Csv):
-        src.check_unit_comments(declared, SERIES_EXAMPLE)
+        src.check_unit_comments(declared, SERIES_EXAMPLE, {roles["time"]: "time"} if has_time else None)
     cols = _Columns(src, SERIES_EXAMPLE)
     factor = time_factor(declared["time"], target)
     t = cols.vector(roles["time"]) * factor if has_time else None

@@ -82,15 +82,35 @@ def time_factor(unit: str, target: str) -> float:
     return TIME_UNITS[unit] / TIME_UNITS[target]
 
 
-def unit_tokens(text: str) -> list[tuple[str, str]]:
-    """The units recognisable in free text (a comment line), as (dimension, canonical name) pairs."""
+_AMBIGUOUS = frozenset({"s", "h", "d", "min", "rad", "linear", "lin", "abs"})
+"""Words that name a unit but are too common in free text to be read as one there (in a unit's own
+place, e.g. ``t [s]``, they are units)."""
+
+
+def unit_tokens(text: str, *, strict: bool = False) -> list[tuple[str, str]]:
+    """The units recognisable in a text, as (dimension, canonical name) pairs.
+
+    ``strict=False`` (free text, a comment line): the words of :data:`_AMBIGUOUS` ("s",
+    "h", "min", "rad", ...) are skipped — in prose they are rarely units — but their long
+    forms ("seconds", "hours", "radians") count. ``strict=True`` (text known to be a unit,
+    e.g. the bracket of ``t [s]``): every unit name counts.
+
+    Examples
+    --------
+    >>> from symid.data.units import unit_tokens
+    >>> unit_tokens("time in seconds, f in Hz")
+    [('time', 's'), ('frequency', 'Hz')]
+    >>> unit_tokens("s"), unit_tokens("s", strict=True)
+    ([], [('time', 's')])
+    """
     import re
 
     out = []
     for token in re.findall(r"rad\s*/\s*s(?:ec)?\b|[A-Za-zµμ°]+", text):
-        name = _ALIASES.get(re.sub(r"\s+", "", token).lower())
-        if name is None or name in ("s", "h", "d", "min", "rad", "linear", "abs"):
-            continue  # one-letter and common words are too ambiguous in free text
+        raw = re.sub(r"\s+", "", token).lower()
+        name = _ALIASES.get(raw)
+        if name is None or (not strict and raw in _AMBIGUOUS):
+            continue
         dimension = next(d for d, units in DIMENSIONS.items() if name in units)
         out.append((dimension, name))
     return out
