@@ -572,8 +572,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="typical magnitude of every free parameter (or one number for all), for the methods "
                         "that take scale= (the unknowns become θ / scale)")
     g.add_argument("--bounds", nargs="+", metavar="NAME=LOW:HIGH",
-                   help="plausible ranges (either end may be empty): the start must lie inside; an estimate "
-                        "outside is reported; symid's estimators do not constrain θ to them")
+                   help="plausible ranges (either end may be empty): the start must lie inside; the methods "
+                        "that take bounds= (auto, lm, oe, ipopt) keep the estimate inside and say which parameters "
+                        "sit on a bound; for the others an estimate outside is reported")
     g = p.add_argument_group("method options (an option the method does not take is an error naming the flag)")
     g.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
     g.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
@@ -586,8 +587,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "substitution=both; VALUE is a number, true/false/none, JSON, or text")
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
     p.add_argument("--out", metavar="DIR",
-                   help="write result.json, summary.txt, bode.png and (SCR) convergence.png here; for time series "
-                        "also validation.json, validation.txt, validation_output.png and validation_residual.png")
+                   help="write result.json and summary.txt here, with bode.png (frequency response) or "
+                        "validation.json, validation.txt, validation_output.png and validation_residual.png (time "
+                        "series), and (SCR) convergence.png")
     p.add_argument("--json", action="store_true",
                    help="print the result as JSON on standard output (the human report goes to standard error)")
     p.set_defaults(func=_cmd_identify)

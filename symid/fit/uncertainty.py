@@ -236,13 +236,26 @@ class FisherInformation(abc.ABC):
                                      sensitivity=G, note=note)
         if G is not None:
             return unc
-        return _with_shift(unc, r, J)
+        return _with_shift(unc, r, J, self._bound_sides(theta))
+
+    def _bound_sides(self, theta: np.ndarray) -> np.ndarray | None:
+        """Per parameter: −1 on its lower bound, +1 on its upper, 0 inside (None for a method without bounds).
+        The 0 that keeps a parameter declared positive positive does not count."""
+        lower, upper = getattr(self, "lower", None), getattr(self, "upper", None)
+        if lower is None or upper is None or np.shape(lower) != theta.shape:
+            return None
+        tol = 1e-9 * np.fmax(1.0, np.abs(theta))
+        positive = np.asarray(getattr(getattr(self, "model", None), "positive", np.zeros(theta.size, bool)), bool)
+        low = np.isfinite(lower) & (np.abs(theta - lower) <= tol) & ~(positive & (lower == 0))
+        high = np.isfinite(upper) & (np.abs(theta - upper) <= tol)
+        return np.where(low, -1, np.where(high, 1, 0))
 
 
 
-def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray) -> Uncertainty:
+def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarray | None = None) -> Uncertainty:
     """Add the distance from θ̂ to the least-squares estimate (one Gauss–Newton step on ‖r + J δ‖²); beyond
-    ``SHIFT_LIMIT`` standard errors the intervals become NaN and the note says why."""
+    ``SHIFT_LIMIT`` standard errors the intervals become NaN and the note says why (that the step leaves the
+    bounds where θ̂ sits on one, ``sides``: −1 on a lower bound, +1 on an upper, 0 inside)."""
     import dataclasses
 
     l = unc.covariance.shape[0]
@@ -255,9 +268,17 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray) -> Uncertainty:
         return unc
     if shift <= SHIFT_LIMIT:
         return dataclasses.replace(unc, shift=shift)
-    note = (f"{unc.note + '. ' if unc.note else ''}θ̂ lies {shift:.3g} standard errors from the least-squares "
-            f"estimate of these data (more than {SHIFT_LIMIT}): intervals around θ̂ would not hold, so none are given "
-            f"(NaN); polish=True refines θ̂ to that estimate where the method has a polisher")
+    pushed = [] if sides is None else [k for k in range(l) if sides[k] and sides[k] * delta[k] > 0]
+    if pushed:
+        names = ", ".join(f"{unc.parameter_names[k]} ({'lower' if sides[k] < 0 else 'upper'})" for k in pushed)
+        note = (f"{unc.note + '. ' if unc.note else ''}θ̂ sits on its bounds where the data pull it beyond them: "
+                f"{names}; the least-squares estimate of these data lies {shift:.3g} standard errors away, outside "
+                f"the bounds, so intervals around θ̂ would not hold and none are given (NaN); widen the bounds if "
+                f"the physics allows, or check the model and the units")
+    else:
+        note = (f"{unc.note + '. ' if unc.note else ''}θ̂ lies {shift:.3g} standard errors from the least-squares "
+                f"estimate of these data (more than {SHIFT_LIMIT}): intervals around θ̂ would not hold, so none are "
+                f"given (NaN); polish=True refines θ̂ to that estimate where the method has a polisher")
     return dataclasses.replace(unc, shift=shift, note=note, intervals=np.full((l, 2), np.nan))
 
 

@@ -300,7 +300,9 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         return self._clip(np.where(self._positive, logs, (theta - centre) / unit))
 
     def _theta(self, phi: np.ndarray, centre: np.ndarray, unit: np.ndarray) -> np.ndarray:
-        return np.where(self._positive, centre * np.exp(np.clip(phi, -_LOG_BOX, _LOG_BOX)), centre + unit * phi)
+        theta = np.where(self._positive, centre * np.exp(np.clip(phi, -_LOG_BOX, _LOG_BOX)), centre + unit * phi)
+        # on a bound exactly, not a rounding error of exp(log(bound / centre)) beyond it
+        return np.clip(theta, self.lower, self.upper) if self._bounded else theta
 
     def _dtheta(self, phi: np.ndarray, centre: np.ndarray, unit: np.ndarray) -> np.ndarray:
         inside = np.abs(phi) < _LOG_BOX

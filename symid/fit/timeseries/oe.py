@@ -578,8 +578,13 @@ class OutputError(Estimator, FisherInformation):
         class _Spent(Exception):
             pass
 
+        lower = np.concatenate([self.lower, np.full(v0.size - l, -np.inf)])
+        upper = np.concatenate([self.upper, np.full(v0.size - l, np.inf)])
+
         def v_of(phi: np.ndarray) -> np.ndarray:
-            return np.where(positive, centre * np.exp(np.clip(phi, -_LOG_BOX, _LOG_BOX)), centre + unit * phi)
+            v = np.where(positive, centre * np.exp(np.clip(phi, -_LOG_BOX, _LOG_BOX)), centre + unit * phi)
+            # on a bound exactly, not a rounding error of exp(log(bound / centre)) beyond it
+            return np.clip(v, lower, upper) if self._bounded else v
 
         memo: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
