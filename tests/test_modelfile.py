@@ -184,3 +184,14 @@ def test_cli_bad_model_file_is_status_2(tmp_path, capsys):
     assert main(["show", str(path)]) == 2
     err = capsys.readouterr().err
     assert "defines no model" in err and "Traceback" not in err
+
+
+def test_a_model_file_passed_where_a_model_goes_names_the_step_to_take(tmp_path):
+    """A new user's si.identify(si.load_model(path), data) ended in AttributeError ('parameter_names')."""
+    spec = si.load_model(write(tmp_path, CHAIN + 'known = {"m1": 1.0}\n'))
+    frf = si.simulate_frf(spec.free_model(), [1.0, 0.1, 0.2, 2.0, 1.0], np.logspace(-1, 1, 30))
+    for call in (lambda: si.identify(spec, frf), lambda: si.compare(spec, frf, methods=["lm"], starts=1)):
+        with pytest.raises(si.ModelError, match=r"model is a ModelFile .* pass spec.free_model\(\)"):
+            call()
+    with pytest.raises(si.ModelError, match=r"pass its .free_model\(\)"):
+        si.identifiability(spec)

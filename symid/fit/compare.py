@@ -13,7 +13,7 @@ import numpy as np
 
 from symid.errors import DataError, ModelError, OptionError
 from symid.fit.options import check_choice, check_float, scale_by_name
-from symid.fit.registry import data_kind, prepare
+from symid.fit.registry import check_model, data_kind, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
 from symid.interrupt import Interrupted
@@ -279,6 +279,7 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     >>> cmp["ls"].n_success, cmp["ls"].n_starts
     (3, 3)
     """
+    check_model(model)
     if isinstance(methods, str) or not methods:
         raise ModelError("compare() needs a sequence of at least one method name")
     methods = tuple(methods)

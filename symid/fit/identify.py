@@ -11,7 +11,7 @@ import numpy as np
 
 from symid.errors import IdentifiabilityWarning, OptionError
 from symid.fit.options import check_bool, scale_by_name
-from symid.fit.registry import prepare
+from symid.fit.registry import check_model, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
 from symid.fit.uncertainty import FisherInformation
@@ -153,6 +153,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     identifiability_check = check_bool("identifiability_check", identifiability_check)
     if progress is not None:
         progress = check_bool("progress", progress)
+    check_model(model)
     options = scale_by_name(options, model.parameter_names)  # a dict by name, as x0 may be
     estimator = prepare(model, data, method, options, noise_floor=noise_floor)
     if noise_std is not None and not isinstance(estimator, FisherInformation):

@@ -14,7 +14,7 @@ from typing import Any
 from symid.errors import DataError, ModelError
 from symid.fit.base import Estimator
 
-__all__ = ["DataKind", "all_methods", "data_kind", "data_kinds", "prepare"]
+__all__ = ["DataKind", "all_methods", "check_model", "data_kind", "data_kinds", "prepare"]
 
 
 @dataclass(frozen=True)
@@ -102,14 +102,35 @@ def all_methods() -> tuple[str, ...]:
     return tuple(out)
 
 
-def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
-            noise_floor: float | None = None) -> Estimator:
-    """The estimator of ``method`` for this model and data, its options validated."""
+def check_model(model: Any) -> None:
+    """Refuse anything but a StateSpaceModel or SecondOrderModel, with the step to take for a model file or a zoo
+    entry (a :class:`~symid.errors.ModelError`).
+
+    Examples
+    --------
+    >>> from symid.fit.registry import check_model
+    >>> check_model("m s^2 + k")
+    Traceback (most recent call last):
+    ...
+    symid.errors.ModelError: model must be a StateSpaceModel or SecondOrderModel; got str
+    """
     from symid.model.secondorder import SecondOrderModel
     from symid.model.statespace import StateSpaceModel
 
-    if not isinstance(model, (StateSpaceModel, SecondOrderModel)):
-        raise ModelError(f"model must be a StateSpaceModel or SecondOrderModel; got {type(model).__name__}")
+    if isinstance(model, (StateSpaceModel, SecondOrderModel)):
+        return
+    kind = type(model).__name__
+    if any(c.__name__ == "ModelFile" for c in type(model).__mro__):
+        raise ModelError(f"model is a {kind} (what si.load_model returns), not a model: pass spec.free_model() "
+                         "(the model with the file's known values substituted), and the file's start, scale and "
+                         "bounds as x0=spec.start, scale=spec.scale, bounds=spec.bounds where you want them")
+    raise ModelError(f"model must be a StateSpaceModel or SecondOrderModel; got {kind}")
+
+
+def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
+            noise_floor: float | None = None) -> Estimator:
+    """The estimator of ``method`` for this model and data, its options validated."""
+    check_model(model)
     if model.n_parameters == 0:
         raise ModelError("the model has no free parameter: there is nothing to estimate")
     if not isinstance(method, str):

@@ -125,7 +125,8 @@ def model_kind(model) -> str:
         return "second-order"
     if hasattr(model, "symbolic_state_space") and "A" in model.symbolic:
         return "state-space"
-    hint = " (a zoo entry? pass its .model)" if hasattr(model, "model") else ""
+    hint = (" (what si.load_model returns? pass its .free_model(), the model with its known values substituted)"
+            if hasattr(model, "free_model") else "")
     raise ModelError(f"identifiability needs a StateSpaceModel or SecondOrderModel; got {type(model).__name__}{hint}")
 
 
