@@ -822,3 +822,16 @@ def test_cli_exact_count_gives_the_groebner_step_the_budget(capsys):
     out = capsys.readouterr().out
     assert "1.5 s" in out and "LOCALLY" in out
     assert "Gröbner basis stopped after" not in out  # the early stop of the default path
+
+
+def test_parameters_the_response_never_sees_are_named():
+    """A new user's effect-compartment PK model: the effect site's rates k1e, ke0 never reach the plasma output."""
+    k10, k12, k21, k1e, ke0, q = si.parameters("k10 k12 k21 k1e ke0 q", positive=True)
+    model = si.StateSpaceModel(A=[[-k10 - k12, k21, 0], [k12, -k21, 0], [k1e, 0, -ke0]], B=[[1], [0], [0]],
+                               C=[[q, 0, 0]])
+    rep = si.identifiability(model)
+    assert rep.verdicts == {"k10": "global", "k12": "global", "k21": "global", "k1e": "none", "ke0": "none",
+                            "q": "global"}
+    assert any(n.startswith("the response does not depend on k1e, ke0 at all") for n in rep.notes)
+    text = rep.summary()
+    assert "  fix k1e, ke0 (known=" in text and "or fix" not in text  # no "or" without a reparameterisation before it

@@ -88,7 +88,7 @@ def test_bad_arguments_are_named_errors(kwargs, error, match):
 def test_something_that_is_not_a_model_is_a_model_error(model):
     if model == "entry":
         model = si.load_model("belt_drive")
-        match = r"got ZooEntry \(a zoo entry\? pass its .model\)"
+        match = r"got ZooEntry \(what si.load_model returns\? pass its .free_model\(\)"
     else:
         match = f"needs a StateSpaceModel or SecondOrderModel; got {type(model).__name__}"
     with pytest.raises(si.ModelError, match=match):

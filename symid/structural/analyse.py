@@ -432,6 +432,12 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
                          f"({sum(local.identifiable) + len(combos)} of {local.rank}); the list is incomplete")
         if fix:
             notes.append(_check_fix(model, known_exact, fix, seed, left()))
+    silent = [nm for nm, q in zip(names, local.silent, strict=True) if q]
+    if silent:
+        notes.append(f"the response does not depend on {', '.join(silent)} at all (their column of the Jacobian is "
+                     f"zero at every test point): no data of this kind tell anything about "
+                     f"{'it' if len(silent) == 1 else 'them'}; drop {'it' if len(silent) == 1 else 'them'} from the "
+                     "model or give a known value")
     if not necessary.satisfied:
         notes.append("the counting condition fails: the parameters cannot all be identifiable")
     total = time.perf_counter() - t0

@@ -289,6 +289,10 @@ class LocalResult:
         A rational basis of the Jacobian's null space at each point (vectors over θ).
     identifiable : tuple of bool
         Per free parameter, locally identifiable.
+    silent : tuple of bool
+        Per free parameter, its column of the Jacobian is zero at every test point: the
+        response does not depend on it at all (e.g. a rate out of a compartment the output
+        never sees).
     """
 
     parameters: tuple[sp.Symbol, ...]
@@ -297,6 +301,7 @@ class LocalResult:
     rank: int
     nullspaces: tuple[list, ...]
     identifiable: tuple[bool, ...]
+    silent: tuple[bool, ...] = ()
 
     @property
     def best(self) -> int:
@@ -333,6 +338,7 @@ def local_analysis(model, known: Mapping[str, object] | None = None, *, seed: in
     shift = _SHIFT.get(parts.output, 0)
     rng = random.Random(seed)
     points, ranks, nulls = [], [], []
+    silent = [bool(free)] * len(free)
     for _ in range(n_points):
         for _attempt in range(20):
             pt = random_point(rng, len(free))
@@ -349,13 +355,15 @@ def local_analysis(model, known: Mapping[str, object] | None = None, *, seed: in
             raise ModelError("the transfer function has a pole at every random test frequency; "
                              "is M(θ) singular for every θ?")
         points.append(tuple(pt))
+        rows = J.to_list() if free and J is not None else None
+        silent = [q and rows is not None and all(r[k] == 0 for r in rows) for k, q in enumerate(silent)]
         ns = [list(v) for v in J.nullspace().to_list()] if free and J is not None else []
         ranks.append(len(free) - len(ns))
         nulls.append(ns)
     rank = max(ranks)
     best = ranks.index(rank)
     ident = tuple(all(vec[k] == 0 for vec in nulls[best]) for k in range(len(free)))
-    return LocalResult(tuple(free), tuple(points), tuple(ranks), rank, tuple(nulls), ident)
+    return LocalResult(tuple(free), tuple(points), tuple(ranks), rank, tuple(nulls), ident, tuple(silent))
 
 
 def rank_at(model, point: Sequence, known: Mapping[str, object] | None = None, *, rng: random.Random | None = None

@@ -274,7 +274,8 @@ class IdentifiabilityReport:
                 L.append(f"  {k} = {v}")
             if self.fix:
                 fixes = ", ".join(f"'{p}': ..." for p in self.fix)
-                L.append(f"  or fix {', '.join(self.fix)} (known={{{fixes}}}): the rest become locally identifiable")
+                lead = "or fix" if self.reparameterisation else "fix"
+                L.append(f"  {lead} {', '.join(self.fix)} (known={{{fixes}}}): the rest become locally identifiable")
         if self.notes:
             L.append("")
             L.append("notes:")
