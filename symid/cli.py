@@ -7,6 +7,7 @@ import math
 import os
 import sys
 import traceback
+import warnings
 from collections.abc import Sequence
 
 from symid.errors import SymidError
@@ -658,6 +659,12 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: object = None,
+                  line: str | None = None) -> None:
+    """``symid: warning (IdentifiabilityWarning): …`` on standard error, without the source line of the call."""
+    print(f"symid: warning ({category.__name__}): {message}", file=sys.stderr if file is None else file)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``symid`` console script.
 
@@ -671,7 +678,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        code = int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            # a warning reads as the command's own words, not as a line of symid's source
+            warnings.showwarning = _show_warning
+            code = int(args.func(args) or 0)
         sys.stdout.flush()  # inside the try: a closed pipe surfaces here, not at interpreter exit
         return code
     except BrokenPipeError:

@@ -357,3 +357,11 @@ def test_other_commands_speak_json(capsys):
                  ["compare", "belt_drive", "--methods", "scr", "--starts", "2", "--json"]):
         assert main(argv) == 0
         json.loads(capsys.readouterr().out)  # a valid document, nothing else on standard output
+
+
+def test_warnings_read_as_the_commands_words(capsys):
+    """Not `/…/symid/cli.py:304: IdentifiabilityWarning: … return identify(…)` (a new user's report)."""
+    main(["identify", "compartment_catenary", "--method", "lm"])
+    err = capsys.readouterr().err
+    assert "symid: warning (IdentifiabilityWarning): parameter(s) theta1, theta2, theta3, theta4 are not" in err
+    assert "cli.py" not in err and "return identify(" not in err

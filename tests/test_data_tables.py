@@ -399,3 +399,10 @@ def test_cli_table_flags_need_columns(tmp_path, capsys):
     assert "--units describe a table: give --columns too" in capsys.readouterr().err
     assert main(["identify", "belt_drive", "--columns", "frequency=f"]) == 2
     assert "describe the table given with --data" in capsys.readouterr().err
+
+
+def test_a_header_split_by_another_separator_says_which(tmp_path):
+    path = write_csv(tmp_path / "semi.csv", ["f_Hz;mag_dB;phase_deg", "1;-20;-90", "2;-26;-95"])
+    with pytest.raises(si.DataError, match=r"the header looks ';'-separated, not ',': read it with delimiter=';'"):
+        FrequencyData.from_table(path, columns={"frequency": "f_Hz", "magnitude": "mag_dB", "phase": "phase_deg"},
+                                 units={"frequency": "Hz", "magnitude": "dB", "phase": "deg"})

@@ -101,6 +101,7 @@ class _Csv:
     def __init__(self, path: _files.PathLike, delimiter: str):
         if delimiter not in (",", ";", "\t", "|", " "):
             raise DataError(f"delimiter must be one of ',', ';', tab, '|' or ' '; got {delimiter!r}")
+        self.delimiter = delimiter
         self.where = repr(os.fspath(path))
         with _files._open_regular(path) as fh:
             size = os.fstat(fh.fileno()).st_size
@@ -331,8 +332,17 @@ class _Columns:
 
     def _missing(self, name: str) -> DataError:
         shown = ", ".join(self.src.names[:30]) + (" ..." if len(self.src.names) > 30 else "")
-        return _fail(self.src.where, f"no column named {name!r} (it has: {shown or 'none'}); declare the columns "
-                     "the table holds", self.example)
+        hint = ""
+        used = getattr(self.src, "delimiter", None)
+        if used is not None:
+            other = next((sep for sep in (";", "\t", ",", "|") if sep != used
+                          and any(sep in n for n in self.src.names)), None)
+            if other is not None:
+                shown_sep = "tab" if other == "\t" else other
+                hint = (f"; the header looks {shown_sep!r}-separated, not {used!r}: read it with "
+                        f"delimiter={other!r} (--delimiter {shown_sep!r} on the command line)")
+        return _fail(self.src.where, f"no column named {name!r} (it has: {shown or 'none'}){hint}; declare the "
+                     "columns the table holds", self.example)
 
     def _length(self, name: str, n: int) -> None:
         if self.n is None:
