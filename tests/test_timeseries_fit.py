@@ -310,6 +310,7 @@ def test_a_fit_of_a_model_with_two_solutions_says_so(monkeypatch):
     assert res.success
     assert "ka, ke, q differ between them" in str(caught[0].message)
     assert "NOT UNIQUE (structure)" in res.summary()
+    assert "these intervals describe this solution's neighbourhood only" in res.uncertainty.note
     # a globally identifiable model (mass, damper, spring): the same checks, and no warning
     m, c, k = si.parameters("m c k", positive=True)
     mck = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
