@@ -305,12 +305,20 @@ def test_a_fit_of_a_model_with_two_solutions_says_so(monkeypatch):
     # the check's one-second budget holds here unloaded (0.15-0.4 s), but not under any load: this test is of what
     # identify does with the verdict, so the check runs to the end
     monkeypatch.setattr(analyse, "several_solutions", functools.partial(analyse.several_solutions, timeout=None))
+    monkeypatch.setattr(analyse, "solutions_at", functools.partial(analyse.solutions_at, timeout=None))
     with pytest.warns(si.IdentifiabilityWarning, match="locally but not globally identifiable") as caught:
         res = si.identify(oral, io, x0={"ka": 0.3, "ke": 0.05, "q": 0.01})
     assert res.success
     assert "ka, ke, q differ between them" in str(caught[0].message)
     assert "NOT UNIQUE (structure)" in res.summary()
     assert "these intervals describe this solution's neighbourhood only" in res.uncertainty.note
+    # the other solution at the estimate itself: ka and ke swapped, q' = q·ka/ke (the same response exactly)
+    [other] = res.options["solutions_at_estimate"]
+    th = res.theta
+    swapped = [th["ke"], th["ka"], th["q"] * th["ka"] / th["ke"]]
+    # the global step runs at θ̂ rounded to 12 digits: its solution is the swap to ~1e-12
+    np.testing.assert_allclose([other["ka"], other["ke"], other["q"]], swapped, rtol=1e-9)
+    assert f"at this estimate the other solution is ka = {other['ka']:.6g}" in res.uncertainty.note
     # a globally identifiable model (mass, damper, spring): the same checks, and no warning
     m, c, k = si.parameters("m c k", positive=True)
     mck = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])

@@ -160,7 +160,7 @@ class Uncertainty:
         if self.note:
             text += f"\n  note: {self.note}"
             if self.shift is not None and self.shift <= SHIFT_LIMIT:
-                text += f" (θ̂ lies {self.shift:.2g} standard errors from it)"
+                text += f" (θ̂ lies {self.shift:.2g} standard errors from the least-squares estimate)"
         if self.near_singular:
             top = sorted(self.weakest.items(), key=lambda kv: -abs(kv[1]))[:3]
             text += ("\n  NEAR-SINGULAR Fisher information: the data hardly determine the direction "
