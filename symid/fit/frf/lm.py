@@ -234,6 +234,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     default_time_limit: ClassVar[float | None] = None
     default_chain_start: ClassVar[bool] = False
     default_confirm: ClassVar[int] = 0
+    _loose_fits_matter: bool = True  # a fit exact only at the 1e-10 level gets more passes (choice 4)
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, restarts: int | None = None,
                  spread: float = 10.0, max_iter: int = 300, positivity: bool = True, tol: float = 1e-12,
@@ -522,7 +523,8 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             if self.callback is not None and self.callback(k, info):
                 status = "stopped"
                 break
-            if best.success and _EXACT_STOP < best.cost <= EXACT_FIT and best.cost != polished and not spent:
+            loose_fit = self._loose_fits_matter and _EXACT_STOP < best.cost <= EXACT_FIT
+            if best.success and loose_fit and best.cost != polished and not spent:
                 # a fit exact only at the 1e-10 level is often a point the pass stopped at, short of a fit to
                 # rounding along a sloppy direction: one more pass from the estimate itself goes on from there
                 polished = best.cost
@@ -542,7 +544,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 # in a sloppy direction (measured: chains of 5 masses, misfit 4e-15 at 47 % parameter error):
                 # a few more passes look for a fit to rounding before settling for it
                 first_fit = min(first_fit, k)
-                loose = _EXACT_STOP < best.cost <= EXACT_FIT
+                loose = self._loose_fits_matter and _EXACT_STOP < best.cost <= EXACT_FIT
                 settled = not loose or k >= first_fit + _EXTRA_PASSES
                 if best.cost > EXACT_FIT:  # accepted by the noise rule: confirmed, or `confirm` passes spent
                     settled = repeats >= 2 or k >= first_fit + opts["confirm"]
