@@ -365,3 +365,18 @@ def test_warnings_read_as_the_commands_words(capsys):
     err = capsys.readouterr().err
     assert "symid: warning (IdentifiabilityWarning): parameter(s) theta1, theta2, theta3, theta4 are not" in err
     assert "cli.py" not in err and "return identify(" not in err
+
+
+def test_a_long_estimate_is_seen_to_be_alive(capsys):
+    """A new user's 4000-sample record: 41 s of default fit with nothing on the screen."""
+    import time
+
+    from symid.cli import _Heartbeat
+
+    with _Heartbeat("auto, 1 start", after=0.05, every=0.1):
+        time.sleep(0.4)
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("symid: still estimating")]
+    assert 2 <= len(lines) <= 5 and "(auto, 1 start)" in lines[0]  # at 0.05 s, then every 0.1 s until 0.4 s
+    with _Heartbeat("auto, 1 start"):  # a run shorter than `after` says nothing
+        pass
+    assert "still estimating" not in capsys.readouterr().err
