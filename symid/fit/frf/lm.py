@@ -235,6 +235,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
     default_chain_start: ClassVar[bool] = False
     default_confirm: ClassVar[int] = 0
     _loose_fits_matter: bool = True  # a fit exact only at the 1e-10 level gets more passes (choice 4)
+    _rescue: ClassVar[bool] = False  # a near-singular noisy fit gets one pass from the black box's poles (auto)
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, restarts: int | None = None,
                  spread: float = 10.0, max_iter: int = 300, positivity: bool = True, tol: float = 1e-12,
@@ -284,6 +285,9 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         self._chain: Any = None  # the chain's values (chain_start), read once per estimator
         self._chain_read = False
         self._box: tuple[np.ndarray, np.ndarray] | None = None  # bounds on φ of the start under way (bounds)
+        self._bb_theta: np.ndarray | None = None  # the black-box start (_black_box_theta), read once
+        self._bb_read = False
+        self._rescuing = False  # within the start from the black box's poles of a near-singular fit
 
     # -- parametrisation ------------------------------------------------------------------------
     def _units(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -559,6 +563,34 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 status = "repeated"
                 break
         assert best is not None
+        rescue = ""
+        if (self._rescue and not self._rescuing and best.success and best.cost > EXACT_FIT
+                and status not in ("time_limit", "stopped") and (deadline is None or time.perf_counter() < deadline)
+                and self._near_singular(best.theta)):
+            # a fit only the noise rule accepts, where the data hardly determine some combination of the parameters:
+            # often a limit the passes ran into (a stiffness and a damper 1000 times their size: a rigid axle), not
+            # the least-squares estimate; one pass from the black box's poles (symid.fit.frf.modal) looks elsewhere
+            found = self._black_box_theta()
+            if found is not None:
+                self._rescuing = True  # the start from the black box's poles, with its own restarts, once
+                saved = opts["time_limit"]
+                try:
+                    if deadline is not None:
+                        opts["time_limit"] = max(deadline - time.perf_counter(), 1e-3)
+                    other = self.run(found)
+                finally:
+                    self._rescuing = False
+                    opts["time_limit"] = saved
+                total_nfev += other.iterations
+                passes += 1 + len(other.passes)
+                cand = self.outcome(start, other.theta, finished=other.finished, status="converged", message="",
+                                    iterations=total_nfev, wall_time=time.perf_counter() - t0)
+                visited.extend((cand, *other.passes))
+                rescue = (f"; the fit was near-singular: a start from the black box's poles ({1 + len(other.passes)} "
+                          f"pass(es)) ended at misfit {cand.cost:.3e}")
+                if cand.cost < best.cost * (1 - 1e-6):
+                    best = cand
+                    rescue += ", kept"
         if status == "max_restarts" and best.success:
             status = "fits"
         wall = time.perf_counter() - t0
@@ -569,10 +601,31 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 "repeated": f"{_REPEATS} of {passes} passes ended at the same best misfit"}[status]
         out = self.outcome(start, best.theta, finished=status not in ("time_limit", "stopped"), status=status,
                            message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}{chain_note}"
-                                   f"{moved}{self._on_bounds(best.theta)}",
+                                   f"{rescue}{moved}{self._on_bounds(best.theta)}",
                            iterations=total_nfev, wall_time=wall)
         others = tuple(c for c in visited if c is not best)
         return dataclasses.replace(out, passes=others) if others else out
+
+    def _near_singular(self, theta: np.ndarray) -> bool:
+        """Whether the Fisher information at θ is near-singular (:data:`~symid.fit.uncertainty.NEAR_SINGULAR`)."""
+        try:
+            unc = self.uncertainty(theta, self.model.parameter_names)
+        except (ModelError, np.linalg.LinAlgError, ValueError):
+            return False
+        return bool(unc.near_singular)
+
+    def _black_box_theta(self) -> np.ndarray | None:
+        """The black-box start of :func:`~symid.fit.frf.modal.black_box_start` (read once), or None."""
+        if not self._bb_read:
+            from symid.fit.frf.modal import black_box_start
+
+            self._bb_read = True
+            try:
+                found = black_box_start(self.model, self.data, self.scale, seed=self.options["seed"])
+            except (ModelError, np.linalg.LinAlgError, ValueError):
+                found = None
+            self._bb_theta = None if found is None else np.asarray(found.theta, dtype=float)
+        return self._bb_theta
 
     def _on_bounds(self, theta: np.ndarray) -> str:
         """Which entries of the estimate sit on the user's bounds ('' without bounds)."""
@@ -611,6 +664,7 @@ class AutoFRF(LmFRF):
     default_time_limit: ClassVar[float | None] = 120.0
     default_chain_start: ClassVar[bool] = True
     default_confirm: ClassVar[int] = 4
+    _rescue: ClassVar[bool] = True
 
 
 LmFRF.__doc__ = (LmFRF.__doc__ or "").format(variance=VARIANCE_OPTION_DOC)
