@@ -153,8 +153,11 @@ class Uncertainty:
                      f"rms {self.residual_ratio:.3g}")
         elif self.noise_units == "relative":
             noise = "relative noise " + ", ".join(f"{100 * s:.3g} %" for s in self.noise_std) + " from the residuals"
-        else:
+        elif self.noise_units == "data units":
             noise = "noise std " + ", ".join(f"{s:.3g}" for s in self.noise_std) + " from the residuals"
+        else:
+            noise = ("noise std " + ", ".join(f"{s:.3g}" for s in self.noise_std) + f" {self.noise_units} from the "
+                     "residuals")
         dof = "normal quantile" if self.dof is None else f"{self.dof} dof"
         text = f"uncertainty: Fisher information at the estimate, {noise}, {dof}; condition {self.condition:.2e}"
         if self.note:
@@ -282,9 +285,11 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
     return dataclasses.replace(unc, shift=shift, note=note, intervals=np.full((l, 2), np.nan))
 
 
-def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
+def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str, *, name: str = "noise_std",
+                    check: bool = True) -> np.ndarray:
     """``noise_std`` as a float array of ``shape``: a number, or an array that broadcasts (its leading axes
-    matching); every value finite and > 0, else a :class:`~symid.errors.DataError` naming ``what``.
+    matching); every value finite and > 0 (``check``), else a :class:`~symid.errors.DataError` naming ``what``;
+    ``name`` is the option's name in the messages.
 
     Examples
     --------
@@ -295,17 +300,17 @@ def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str) -> np.nda
     try:
         arr = np.asarray(noise_std, dtype=float)
     except (TypeError, ValueError):
-        raise DataError(f"noise_std must be a number or an array of numbers (data units); got {noise_std!r}") from None
+        raise DataError(f"{name} must be a number or an array of numbers (data units); got {noise_std!r}") from None
     if arr.ndim > len(shape):
-        raise DataError(f"noise_std has shape {arr.shape}; {what} has shape {shape}")
+        raise DataError(f"{name} has shape {arr.shape}; {what} has shape {shape}")
     arr = arr.reshape(arr.shape + (1,) * (len(shape) - arr.ndim))
     try:
         out = np.broadcast_to(arr, shape).astype(float)
     except ValueError:
-        raise DataError(f"noise_std of shape {np.shape(noise_std)} does not fit {what} of shape {shape}: give one "
+        raise DataError(f"{name} of shape {np.shape(noise_std)} does not fit {what} of shape {shape}: give one "
                         f"number, one per {'frequency' if 'H' in what or 'Phi' in what else 'sample'} "
                         f"({shape[0]},), or the full shape") from None
-    if not np.all(np.isfinite(out)) or np.any(out <= 0):
+    if check and (not np.all(np.isfinite(out)) or np.any(out <= 0)):
         raise DataError("noise_std must be finite and > 0 everywhere (a standard deviation in data units)")
     return out
 

@@ -190,6 +190,15 @@ class OutputError(Estimator, FisherInformation):
         be interrupted), then Gauss–Newton (3 s and 16 s to build there). The exact
         Hessian converges from more starts (time-series population, n = 2, 3: one
         output-error run 18 of 32 against 12 of 32), Gauss–Newton fits in the budget.
+    variance : float or array_like, optional
+        The noise variance σ² of every measured output value, in the output's units
+        squared: a number, one per sample (N,), one per output (1, p), (N, p), or a list of
+        such, one per record. The fit then minimises Σ (y − ŷ)²/σ² (relative to Σ y²/σ²),
+        the maximum-likelihood criterion for independent Gaussian noise: noise that grows
+        with the signal (a concentration measured to 5 %) weighs the small values as the
+        large ones. Only the shape matters to the estimate; the level is estimated from the
+        residuals for the intervals (in units of the given σ) unless ``noise_std`` is
+        given to :func:`symid.identify`. Default: each output weighted by its energy.
     solver : {"ipopt", "trf"}, optional
         ``"trf"`` (default): SciPy's trust-region reflective least squares
         (``scipy.optimize.least_squares``) on log-parameters (θₖ = sₖ·exp(φₖ) for a
@@ -244,7 +253,7 @@ class OutputError(Estimator, FisherInformation):
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = None, callback: Any = None, verbose: bool = False,
-                 solver: str = "trf", bounds: Any = None):
+                 solver: str = "trf", bounds: Any = None, variance: Any = None):
         self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
         self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
         if self._x0_mode == "known":
@@ -280,8 +289,16 @@ class OutputError(Estimator, FisherInformation):
                         "initial_state": self._x0_mode if self._x0_mode != "model" else model.initial_state_kind}
         p = model.n_outputs
         energy = sum(np.sum(r.y**2, axis=0) for r in self.records)
-        self._weights = 1.0 / (p * energy)  # per output channel: cost = Σ w_j ‖r_j‖²
         self._rms = np.sqrt(energy / sum(r.n_samples for r in self.records))
+        self._variance = None if variance is None else self._sample_variance(variance)
+        if self._variance is None:  # per output channel: cost = Σ_j ‖r_j‖² / (p ‖y_j‖²)
+            weights = 1.0 / (p * energy)
+            self._w = [np.broadcast_to(weights, r.y.shape) for r in self.records]
+        else:  # per value: cost = Σ r² / σ² over Σ y² / σ² (still 1 for ŷ = 0)
+            scaled = sum(float(np.sum(r.y**2 / v)) for r, v in zip(self.records, self._variance, strict=True))
+            self._w = [1.0 / (v * scaled) for v in self._variance]
+        self._sw = [np.sqrt(w) for w in self._w]
+        self.options["variance"] = None if variance is None else "given"
         self._estimate_x0 = self._x0_mode == "estimate"
         values = sum(r.n_samples * r.n_outputs for r in self.records)
         if values < self.n_unknowns():
@@ -302,6 +319,26 @@ class OutputError(Estimator, FisherInformation):
     def _matrices(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
         return tuple(self.model.state_space(theta))
 
+    def _sample_variance(self, variance: Any) -> list[np.ndarray]:
+        """``variance`` as one (N, p) array per record: a number, an array (N,) per sample, (1, p) per output or
+        (N, p), or a list of such, one per record; every value finite and > 0."""
+        items = variance if isinstance(variance, (list, tuple)) and len(self.records) > 1 else None
+        if items is not None and len(items) != len(self.records):
+            raise DataError(f"variance is a list of {len(items)}; there are {len(self.records)} records")
+        out = []
+        for e, r in enumerate(self.records):
+            where = f"the output y of record {e}" if len(self.records) > 1 else "the output y"
+            arr = broadcast_noise(variance if items is None else items[e], (r.n_samples, r.n_outputs), where,
+                                  name="variance", check=False)
+            bad = ~(np.isfinite(arr) & (arr > 0))
+            if bad.any():
+                k, j = (int(i) for i in np.argwhere(bad)[0])
+                rec = "" if items is None else f" of record {e}"
+                raise OptionError(f"variance: the value for sample {k}, output {j}{rec} is {float(arr[k, j])!r}; every "
+                                  "variance must be finite and > 0")
+            out.append(np.array(arr, dtype=float))
+        return out
+
     def initial_states(self, theta: Any) -> list[np.ndarray]:
         """x(t₀) of every record at θ: the model's, or (``x0="estimate"``) the least-squares one.
 
@@ -318,12 +355,11 @@ class OutputError(Estimator, FisherInformation):
             return [x0.copy() for _ in self.records]
         A, B, C, D = self._matrices(theta)
         out = []
-        sw = np.sqrt(self._weights)
-        for r in self.records:
+        for r, sw in zip(self.records, self._sw, strict=True):
             forced = simulate_output(A, B, C, D, r.t, r.u, np.zeros(A.shape[0]))
             Phi = state_transitions(A, r.t)  # (N, n, n)
-            O = np.einsum("pn,knr->kpr", C, Phi) * sw[None, :, None]
-            rhs = (r.y - forced) * sw[None, :]
+            O = np.einsum("pn,knr->kpr", C, Phi) * sw[:, :, None]
+            rhs = (r.y - forced) * sw
             x0, *_ = np.linalg.lstsq(O.reshape(-1, A.shape[0]), rhs.reshape(-1), rcond=None)
             out.append(x0)
         return out
@@ -343,13 +379,16 @@ class OutputError(Estimator, FisherInformation):
         except (np.linalg.LinAlgError, ValueError):
             return float("inf")
         with np.errstate(over="ignore", invalid="ignore"):  # a diverged θ: inf, said by the cost, not by numpy
-            total = sum(float(np.sum(self._weights * np.sum((r.y - s) ** 2, axis=0)))
-                        for r, s in zip(self.records, sims, strict=True))
+            total = sum(float(np.sum(w * (r.y - s) ** 2)) for r, s, w in zip(self.records, sims, self._w, strict=True))
         return total if np.isfinite(total) else float("inf")
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
-        """Residuals y − ŷ in time order (records one after the other), each channel divided by its rms."""
+        """Residuals y − ŷ in time order (records one after the other), each channel divided by its rms (by σ of
+        each value with ``variance``)."""
         sims = self.simulate(theta)
+        if self._variance is not None:
+            return np.vstack([(r.y - s) / np.sqrt(v) for r, s, v in zip(self.records, sims, self._variance,
+                                                                        strict=True)])
         return np.vstack([(r.y - s) / self._rms for r, s in zip(self.records, sims, strict=True)])
 
     def n_data(self) -> int:
@@ -378,7 +417,6 @@ class OutputError(Estimator, FisherInformation):
         A, B, C, D = _sx_state_space(self.model, theta)
         x0_map = self.model.initial_state_map if self._x0_mode == "model" else None
         res = []
-        sw = ca.DM(np.sqrt(self._weights)).T
         for e, r in enumerate(self.records):
             if self._estimate_x0:
                 x0 = v[l + n * e: l + n * (e + 1)]
@@ -389,7 +427,7 @@ class OutputError(Estimator, FisherInformation):
             else:
                 x0 = _sx_matrix(x0_map, theta)
             Y = casadi_output(A, B, C, D, r.t, r.u, x0, s_max, (q[:n], q[n:]))
-            R = (ca.DM(r.y) - Y) * ca.repmat(sw, r.n_samples, 1)
+            R = (ca.DM(r.y) - Y) * ca.DM(np.ascontiguousarray(self._sw[e]))
             res.append(ca.vec(R))
         return v, q, ca.vertcat(*res)
 
@@ -659,7 +697,6 @@ class OutputError(Estimator, FisherInformation):
         l, n = self.model.n_parameters, self.model.n_states
         theta = v[:l]
         mats, dmats = state_space_derivatives(self.model, theta)
-        sw = np.sqrt(self._weights)
         rs, Js = [], []
         if self._estimate_x0:
             x0s = [v[l + n * e: l + n * (e + 1)] for e in range(len(self.records))]
@@ -672,8 +709,9 @@ class OutputError(Estimator, FisherInformation):
             elif self._x0_mode == "model" and self.model.initial_state_map is not None:
                 dx0[:, :l] = self.model.initial_state_map.Xi[:, :, 0].T
             Y, dY = output_sensitivity(mats, dmats, r.t, r.u, x0, dx0)
+            sw = self._sw[e]
             rs.append(((r.y - Y) * sw).T.reshape(-1))
-            Js.append((-dY * sw[None, :, None]).transpose(1, 0, 2).reshape(-1, v.size))
+            Js.append((-dY * sw[:, :, None]).transpose(1, 0, 2).reshape(-1, v.size))
         return np.concatenate(rs), np.vstack(Js)
 
     def residual_channels(self) -> np.ndarray:
@@ -681,10 +719,18 @@ class OutputError(Estimator, FisherInformation):
         p = self.model.n_outputs
         return np.concatenate([np.repeat(np.arange(p), r.n_samples) for r in self.records])
 
+    @property
+    def noise_units(self) -> str:  # type: ignore[override]
+        """What the noise level estimated from the residuals measures: data units, or units of the given σ."""
+        return "data units" if self._variance is None else "× the given √variance"
+
     def noise_shape(self, theta: Any) -> np.ndarray:
-        """√wⱼ per entry: the residual of output j is √wⱼ (y − ŷ), noise of one level per output (data units)."""
-        sw = np.sqrt(self._weights)
-        return np.concatenate([np.repeat(sw, r.n_samples) for r in self.records])
+        """√w per entry: the residual is √w (y − ŷ), noise of one level per output (data units); with
+        ``variance``, σ√w (a noise of one level in units of the given σ)."""
+        if self._variance is not None:
+            return np.concatenate([(sw * np.sqrt(v)).T.reshape(-1) for sw, v in zip(self._sw, self._variance,
+                                                                                     strict=True)])
+        return np.concatenate([sw.T.reshape(-1) for sw in self._sw])
 
     def given_noise(self, noise_std: Any) -> tuple[np.ndarray, np.ndarray]:
         """Per entry of r, √wⱼ × the given standard deviation; ``noise_std`` is a number, an array (N,) per
@@ -692,12 +738,11 @@ class OutputError(Estimator, FisherInformation):
         items = noise_std if isinstance(noise_std, (list, tuple)) and len(self.records) > 1 else None
         if items is not None and len(items) != len(self.records):
             raise DataError(f"noise_std is a list of {len(items)}; there are {len(self.records)} records")
-        sw = np.sqrt(self._weights)
         std, given = [], []
         for e, r in enumerate(self.records):
             arr = broadcast_noise(noise_std if items is None else items[e], (r.n_samples, r.n_outputs),
                                   f"the output y of record {e}" if len(self.records) > 1 else "the output y")
-            std.append((arr * sw[None, :]).T.reshape(-1))  # channel by channel, as the residual
+            std.append((arr * self._sw[e]).T.reshape(-1))  # channel by channel, as the residual
             given.append(arr.reshape(-1))
         return np.concatenate(std), np.concatenate(given)
 
