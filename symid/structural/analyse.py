@@ -712,9 +712,14 @@ def _solutions_at(model, point: list) -> list[dict[str, float]]:
     """The admissible real solutions of summary(θ) = summary(point) (a run of the global step at that point)."""
     from symid.structural.global_ import global_analysis, star_and_summary
     from symid.structural.msolve import msolve_binary
+    from symid.structural.summary import KIND_TF, is_minimal_at, model_matrices
 
     params, _, _, summ, rng = star_and_summary(model, seed=0)
     star = [sp.Rational(v.numerator, v.denominator) for v in point]
+    kind = model_kind(model)
+    if summ.kind == KIND_TF and not (is_minimal_at(model_matrices(model, None), kind, getattr(model, "output", None),
+                                                   params, star) or summ.exhaustive_at(star)):
+        raise ModelError("the transfer function is not an exhaustive summary at this point")
     binary = msolve_binary()
     res = global_analysis(model, positive=list(model.positive), prepared=(params, star, True, summ, rng),
                           msolve=binary, expressions=False)
@@ -727,8 +732,8 @@ def solutions_at(model, theta, *, timeout: float | None = GLOBAL_CHECK_BUDGET) -
     not finish within ``timeout`` seconds or fails (nothing is claimed then), ``[]`` when there are none.
 
     :func:`symid.identify` calls it for an estimate of a model :func:`several_solutions` calls not unique: the
-    user sees the values the data cannot tell from the estimate (on a half car at 1 % noise, m = 620 kg beside
-    the estimate's 656 kg).
+    user sees the values the data cannot tell from the estimate. A point where the transfer function is not an
+    exhaustive summary (a pole-zero cancellation at ``theta``) or has a multiple solution gives ``None``.
 
     Examples
     --------
