@@ -31,13 +31,6 @@ fit is what ``auto`` does best (continuation over frequency, chain starts), and 
 box of noise-free records is the model's own response: every noise-free start met the
 rule, where without it output error's restarts had ended at near-fits within the budget
 on four (3-mass chains, a chain with gains, a 3-state network).
-The pass from the start is not run after a fit from the black box that predicts the
-samples as well as the black box itself (within 1 + b/N of its relative misfit on the
-samples, b = n(m + p) + mp + n its real parameters, N the values): the black box has more
-freedom than the model, so no other minimum of the model can fit much better (a new
-user's 4000-sample flexible-shaft motor: that pass took 17.7 s of 23 s to end at the same
-misfit; now 5.6 s in all; the time-series population's successes and misfits unchanged,
-README).
 
 Why not the black-box route as the estimate (N4SID, exact ``d2c``, then a similarity
 formulation), the default before: on the same problems it met the success rule from 5
