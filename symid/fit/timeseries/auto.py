@@ -135,25 +135,6 @@ class AutoOutputError(OutputError):
         self.options = {**self.options, "time_limit": budget, "restarts": self._restarts, "spread": self._spread,
                         "seed": self._seed, "black_box_start": self._black_box_start}
 
-    def _as_good_as_bb(self, cand: StartOutcome) -> bool:
-        """Whether the estimate predicts the samples as well as the N4SID black box of the model's order (the same
-        relative misfit over every output, Σ (y − ŷ)² / Σ y²), up to what the black box's extra freedom fits of the
-        noise: its b = n(m + p) + mp + n real parameters (after similarity, with its initial state) fit a share
-        about b/N of the noise more than the model does (N values), so a misfit within 1 + b/N of the black box's."""
-        bb = self._bb_response
-        if bb is None or not math.isfinite(bb.record_misfit) or self._variance is not None or len(self.records) != 1:
-            return False
-        try:
-            with np.errstate(all="ignore"):
-                sims = self.simulate(cand.theta)
-        except (np.linalg.LinAlgError, ValueError):
-            return False
-        power = sum(float(np.sum(r.y**2)) for r in self.records)
-        err = sum(float(np.sum((r.y - y) ** 2)) for r, y in zip(self.records, sims, strict=True))
-        n, m, p = self.model.n_states, self.model.n_inputs, self.model.n_outputs
-        b = n * (m + p) + m * p + n
-        return power > 0 and math.isfinite(err) and err / power <= bb.record_misfit * (1 + b / self.n_data())
-
     def _draw(self, rng: np.random.Generator, centre: np.ndarray) -> np.ndarray:
         half = math.log(self._spread)
         mag = np.where(np.abs(centre) > 0, np.abs(centre), 1.0)
@@ -213,7 +194,6 @@ class AutoOutputError(OutputError):
         best: StartOutcome | None = None
         visited: list[StartOutcome] = []
         iterations, passes, status = 0, 0, "max_restarts"
-        skipped = False
         specials, bb_pass, bb_note = self._special_starts(start, t0)  # the start, and the black box's fit
         for k in range(self._restarts + len(specials)):
             if k < len(specials):
@@ -246,12 +226,6 @@ class AutoOutputError(OutputError):
                 # the first fit may be a worse minimum that the whiteness rule accepts
                 status = "fits"
                 break
-            if best.success and best is cand and k == bb_pass and k + 1 < len(specials) and self._as_good_as_bb(cand):
-                # the fit from the black box predicts the samples as well as the black box does (a model with more
-                # freedom): no other minimum of the structured model can be much better, and the pass from the start
-                # is not run (measured: a new user's 4000-sample motor, 17.7 s of a 23 s start)
-                status, skipped = "fits", True
-                break
         assert best is not None
         if bb_pass is None:
             note = f"; {bb_note}" if bb_note else ""
@@ -260,9 +234,6 @@ class AutoOutputError(OutputError):
         else:
             why = "the budget was spent" if status == "time_limit" else "pass 0 from the start fitted to rounding"
             note = f"; {bb_note}, not run: {why}"
-        if skipped:
-            note += ("; the pass from the start not run: the fit predicts the samples as well as the black box "
-                     "itself")
         what = {"fits": f"a fit after {passes} output-error pass(es)",
                 "max_restarts": f"no fit in {passes} output-error pass(es) (restarts={self._restarts})",
                 "time_limit": f"time limit of {self._budget:g} s reached after {passes} pass(es)"}[status]
