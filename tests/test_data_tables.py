@@ -8,6 +8,7 @@ two-line example. Reference values: the conversions' definitions (ω = 2π f, |H
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -160,6 +161,51 @@ def test_a_unit_inside_another_columns_unit_is_not_read_as_its_own(tmp_path):
     with pytest.raises(si.DataError, match=r"states Hz for 'f'.*frequency unit declared is rad/s"):
         FrequencyData.from_table(path, columns={"frequency": "f", "magnitude": "mag", "phase": "ph"},
                                  units={"frequency": "rad/s", "magnitude": "dB", "phase": "deg"})
+
+
+@pytest.mark.parametrize("comment", ["# units: t [s], u [mg/h], y [mg/L]", "# units: t [s], u [L/s], y [m]",
+                                     "# units: t [s], dose_time [min], y [mg/L]"])
+def test_the_units_of_inputs_outputs_and_other_columns_are_not_read_as_the_time_unit(tmp_path, comment):
+    """A correct pharmacokinetic file (a new user's trial): mg/h is the input's unit, not a statement of hours."""
+    path = write_csv(tmp_path / "pk.csv", [comment, "t,u,y,dose_time", "0,1,0,0", "1,0,1,0", "2,1,1,0"])
+    io = IOData.from_table(path, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
+    assert io.dt == pytest.approx(1.0, rel=1e-15)
+
+
+def test_the_units_of_the_real_and_imaginary_parts_are_not_read_as_the_frequency_unit(tmp_path):
+    path = write_csv(tmp_path / "frf.csv", ["# units: f [Hz], re [(rad/s)/(N m)], im [(rad/s)/(N m)]", "f,re,im",
+                                            "1.0,0.5,-0.5", "2.0,0.2,-0.4"])
+    frf = FrequencyData.from_table(path, columns={"frequency": "f", "real": "re", "imag": "im"},
+                                   units={"frequency": "Hz"})
+    np.testing.assert_allclose(frf.w, [2 * np.pi, 4 * np.pi], rtol=1e-15)
+
+
+@pytest.mark.parametrize(("name", "declared", "stated"), [("t [s]", "ms", "s"), ("t_ms", "s", "ms"),
+                                                          ("time (h)", "s", "h")])
+def test_a_unit_in_the_time_columns_name_is_checked(tmp_path, name, declared, stated):
+    """A header ``t [s]`` read as milliseconds: the name is the file's own statement of the unit."""
+    path = write_csv(tmp_path / "io.csv", [f"{name},u,y", "0,1,0", "1,0,1", "2,1,1"])
+    columns = {"time": name, "input": "u", "output": "y"}
+    with pytest.raises(si.DataError, match=rf"the time column is named '{re.escape(name)}', which states "
+                                           rf"{stated}, but the time unit declared is {declared}"):
+        IOData.from_table(path, columns=columns, units={"time": declared})
+    assert IOData.from_table(path, columns=columns, units={"time": stated}).time_unit == "s"
+    # a DataFrame-like dict's column names are checked the same way
+    with pytest.raises(si.DataError, match="which states"):
+        IOData.from_table({name: np.arange(3.0), "u": np.ones(3), "y": np.ones(3)}, columns=columns,
+                          units={"time": declared})
+
+
+def test_a_unit_in_a_frequency_tables_names_is_checked(tmp_path):
+    path = write_csv(tmp_path / "frf.csv", ["f_rad/s,mag_dB,ph_deg", "1,-20,-90", "2,-26,-95"])
+    columns = {"frequency": "f_rad/s", "magnitude": "mag_dB", "phase": "ph_deg"}
+    frf = FrequencyData.from_table(path, columns=columns, units={"frequency": "rad/s", "magnitude": "dB",
+                                                                  "phase": "deg"})
+    np.testing.assert_allclose(frf.w, [1.0, 2.0], rtol=1e-15)
+    with pytest.raises(si.DataError, match="named 'mag_dB', which states dB, but the magnitude unit declared is "
+                                           "linear"):
+        FrequencyData.from_table(path, columns=columns, units={"frequency": "rad/s", "magnitude": "linear",
+                                                               "phase": "deg"})
 
 
 def test_a_units_comment_without_declared_units_is_an_error(tmp_path):

@@ -171,19 +171,24 @@ class _Csv:
         return out
 
     def check_unit_comments(self, declared: Mapping[str, str], example: str,
-                            columns: Mapping[str, str] | None = None) -> None:
+                            columns: Mapping[str, str] | None = None, read: Sequence[str] = ()) -> None:
         """A comment that states units must agree with the declared ones (and units must be declared).
 
         ``columns``: the name of the column of each role that has a unit (``{"t": "time"}``),
-        so that ``t [s]`` or ``t=s`` is read as the unit of that column (:func:`_stated_units`).
+        so that ``t [s]`` or ``t=s`` is read as the unit of that column; ``read``: every
+        column read, whose stated units (``u [mg/h]``) are then not taken for another
+        role's (:func:`_stated_units`).
         """
+        roles: dict[str, str | None] = dict.fromkeys(_UNIT_DIMENSION)
+        roles.update({_base_name(n): "" for n in (*read, *self.names)})
+        roles.update(columns or {})
         for line, comment in self.comments:
             if not re.search(r"\bunits?\b", comment, flags=re.IGNORECASE):
                 continue
             if not declared:
                 raise _fail(f"{self.where}, line {line}", f"the file states units ({_files._show(comment, 60)}) but "
                             "none were declared; symid never guesses units from a comment: declare them", example)
-            for name, dimension, unit in _stated_units(comment, {**dict.fromkeys(_UNIT_DIMENSION), **(columns or {})}):
+            for name, dimension, unit in _stated_units(comment, roles):
                 mine = {u for role, u in declared.items() if _UNIT_DIMENSION.get(role) == dimension}
                 if mine and unit not in mine:
                     what = f"{unit} for {name!r}" if name else unit
@@ -194,6 +199,36 @@ class _Csv:
 
 _PAIR = re.compile(r"^([^\s\[\]=:()]+)\s*(?:\[(.*)\]|\((.*)\)|[=:]\s*(.+))$")
 """``name [unit]``, ``name (unit)``, ``name = unit`` or ``name: unit`` in a units comment."""
+
+
+_ONE_UNIT = re.compile(r"[A-Za-zµμ°]+|rad\s*/\s*s(?:ec)?")
+"""A text that can be one unit's name alone (``s``, ``Hz``, ``rad/s``)."""
+
+
+_NAME_UNIT = re.compile(r"(?:\[\s*([^\[\]]+?)\s*\]|\(\s*([^()]+?)\s*\)|_([^_\s\[\]()]+))\s*$")
+"""A unit at the end of a column's name: ``t [s]``, ``f (Hz)``, ``t_ms``."""
+
+
+def _check_name_units(where: str, declared: Mapping[str, str], columns: Mapping[str, str]) -> None:
+    """A column read in a role with a unit whose name ends in a unit (``t_ms``, ``f [Hz]``)
+    must agree with the declared unit: the name is the file's own statement of it."""
+    for name, role in columns.items():
+        m = _NAME_UNIT.search(_base_name(name))
+        if not m or role not in declared:
+            continue
+        text = next(g for g in m.groups() if g is not None)
+        found = unit_tokens(text, strict=True) if _ONE_UNIT.fullmatch(text) else []
+        dimension = _UNIT_DIMENSION[role]
+        if len(found) == 1 and found[0][0] == dimension and found[0][1] != declared[role]:
+            raise DataError(f"{where}: the {role} column is named {name!r}, which states {found[0][1]}, but the "
+                            f"{dimension} unit declared is {declared[role]}; check which is right (if {text!r} "
+                            "in the name is not a unit, rename the column)")
+
+
+def _base_name(name: str) -> str:
+    """A column's name without a channel index: ``y[2]`` → ``y``."""
+    m = _CHANNEL.match(name)
+    return m.group(1) if m else name
 
 
 def _split_items(text: str) -> list[str]:
@@ -219,11 +254,14 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
     of that column: where ``name`` is a column read in a role with a unit (``roles``: name
     → role; the role names themselves, e.g. ``time=s``, count too), every unit of the
     role's dimension in the bracket is stated for it, and the others are ignored (``mag
-    [dB re 1 (rad/s)/N]`` states dB, not rad/s, for the magnitude); for another name, the
-    bracket's first unit is stated (a unit of a column not read can still contradict the
-    declaration: ``t_ms=s`` beside a time column). An item that is a unit alone (``s``,
-    ``Hz``) states it; any other item is free text, where unit words that are also common
-    words ("s", "min", "rad") are not read as units.
+    [dB re 1 (rad/s)/N]`` states dB, not rad/s, for the magnitude). A column without a
+    unit role (``roles``: name → ``""``: an input, an output, the real part of H, or a
+    column of the file not read) states nothing: ``u [mg/h]`` is the input's unit, not
+    the time's. Any other name states its bracket's unit when the bracket is a single
+    unit (a unit of a column that does not exist can still contradict the declaration:
+    ``t_ms=s`` beside a time column ``t``). An item that is a unit alone (``s``, ``Hz``)
+    states it; any other item is free text, where unit words that are also common words
+    ("s", "min", "rad") are not read as units.
 
     Examples
     --------
@@ -233,6 +271,8 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
     [('f', 'frequency', 'Hz'), ('mag', 'magnitude', 'dB'), ('ph', 'phase', 'deg')]
     >>> _stated_units("# units: s", {}), _stated_units("# units: t_ms=s", {"t": "time"})
     ([(None, 'time', 's')], [('t_ms', 'time', 's')])
+    >>> _stated_units("# units: t [s], u [mg/h]", {"t": "time", "u": ""})
+    [('t', 'time', 's')]
     """
     text = comment.lstrip("#").strip()
     head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE)
@@ -245,14 +285,14 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
             unit_text = next(g for g in pair.groups()[1:] if g is not None)
             found = unit_tokens(unit_text, strict=True)
             role = roles.get(name) if name in roles else None
-            role = role or (name if name in _UNIT_DIMENSION else None)
-            if role is not None:
+            role = role if role is not None else (name if name in _UNIT_DIMENSION else None)
+            if role:
                 out.extend((name, d, u) for d, u in found if d == _UNIT_DIMENSION[role])
-            elif found:
+            elif role is None and len(found) == 1 and _ONE_UNIT.fullmatch(unit_text.strip()):
                 out.append((name, *found[0]))
             continue
         alone = unit_tokens(item, strict=True)
-        if len(alone) == 1 and re.fullmatch(r"[A-Za-zµμ°]+|rad\s*/\s*s(?:ec)?", item):
+        if len(alone) == 1 and _ONE_UNIT.fullmatch(item):
             out.append((None, *alone[0]))
         else:
             out.extend((None, d, u) for d, u in unit_tokens(item))
@@ -489,7 +529,9 @@ def frequency_data_from_table(table: Any, *, columns: Mapping[str, Any], units: 
         src.check_unit_comments({}, FRF_EXAMPLE)  # a file that states units, read without any declared
     declared = _units(units, needed, where, FRF_EXAMPLE)
     if isinstance(src, _Csv):
-        src.check_unit_comments(declared, FRF_EXAMPLE, _unit_columns(roles, parts))
+        src.check_unit_comments(declared, FRF_EXAMPLE, _unit_columns(roles, parts),
+                                read=[n for n in names if isinstance(n, str)])
+    _check_name_units(where, declared, _unit_columns(roles, parts))
     cols = _Columns(src, FRF_EXAMPLE)
     w = cols.vector(roles["frequency"]) * DIMENSIONS["frequency"][declared["frequency"]]
     H = np.empty((w.size, p, m), dtype=np.complex128)
@@ -552,7 +594,10 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
         src.check_unit_comments({}, SERIES_EXAMPLE)
     declared = _units(units, ["time"], where, SERIES_EXAMPLE)
     if isinstance(src, _Csv):
-        src.check_unit_comments(declared, SERIES_EXAMPLE, {roles["time"]: "time"} if has_time else None)
+        src.check_unit_comments(declared, SERIES_EXAMPLE, {roles["time"]: "time"} if has_time else None,
+                                read=names)
+    if has_time:
+        _check_name_units(where, declared, {roles["time"]: "time"})
     cols = _Columns(src, SERIES_EXAMPLE)
     factor = time_factor(declared["time"], target)
     t = cols.vector(roles["time"]) * factor if has_time else None
