@@ -78,9 +78,12 @@ from symid.fit.timeseries.response import balancing, casadi_output, simulate_out
 from symid.fit.timeseries.sensitivity import output_sensitivity, state_space_derivatives
 from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
-__all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "OutputError"]
+__all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "WEIGHTED_COST_KIND", "OutputError"]
 
 SOLVERS = ("ipopt", "trf")
+
+WEIGHTED_COST_KIND = "weighted relative output misfit Σ (y − ŷ)²/σ² / Σ y²/σ², σ² the given variance"
+"""The misfit's name when ``variance=`` weighs every output value."""
 """The ``solver`` choices of :class:`OutputError`."""
 
 _LOG_BOX = math.log(1e8)  # "trf": |φₖ| ≤ log 1e8 for a parameter kept positive, no estimate beyond 1e8 × its start
@@ -196,9 +199,12 @@ class OutputError(Estimator, FisherInformation):
         such, one per record. The fit then minimises Σ (y − ŷ)²/σ² (relative to Σ y²/σ²),
         the maximum-likelihood criterion for independent Gaussian noise: noise that grows
         with the signal (a concentration measured to 5 %) weighs the small values as the
-        large ones. Only the shape matters to the estimate; the level is estimated from the
-        residuals for the intervals (in units of the given σ) unless ``noise_std`` is
-        given to :func:`symid.identify`. Default: each output weighted by its energy.
+        large ones. Only the shape matters to the estimate. The level judges the fit: unless
+        ``noise_floor`` is given, the fit succeeds when its weighted misfit is within what
+        noise of this variance leaves (Σ σ²/σ² over Σ y²/σ², χ² 99.9 % bound), as for a
+        frequency response's ``variance``. For the intervals the level is estimated from
+        the residuals (in units of the given σ) unless ``noise_std`` is given to
+        :func:`symid.identify`. Default: each output weighted by its energy.
     solver : {"ipopt", "trf"}, optional
         ``"trf"`` (default): SciPy's trust-region reflective least squares
         (``scipy.optimize.least_squares``) on log-parameters (θₖ = sₖ·exp(φₖ) for a
@@ -249,6 +255,8 @@ class OutputError(Estimator, FisherInformation):
 
     method: ClassVar[str] = "oe"
     cost_kind: ClassVar[str] = "relative output misfit to the measured samples (1/p) Σⱼ ‖yⱼ − ŷⱼ‖² / ‖yⱼ‖²"
+    _noise_floor_given: float | None = None
+    _variance_floor: float | None = None
 
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
@@ -297,6 +305,9 @@ class OutputError(Estimator, FisherInformation):
         else:  # per value: cost = Σ r² / σ² over Σ y² / σ² (still 1 for ŷ = 0)
             scaled = sum(float(np.sum(r.y**2 / v)) for r, v in zip(self.records, self._variance, strict=True))
             self._w = [1.0 / (v * scaled) for v in self._variance]
+            # the weighted misfit that noise of the given variance leaves at the truth, Σ w σ² (= values / scaled)
+            self._variance_floor = sum(float(np.sum(w * v)) for w, v in zip(self._w, self._variance, strict=True))
+            self.cost_kind = WEIGHTED_COST_KIND  # type: ignore[misc]
         self._sw = [np.sqrt(w) for w in self._w]
         self.options["variance"] = None if variance is None else "given"
         self._estimate_x0 = self._x0_mode == "estimate"
@@ -314,6 +325,17 @@ class OutputError(Estimator, FisherInformation):
         self._solvers: dict[int, ScaledIpopt] = {}
         self._jacobian_fns: dict[int, Any] = {}
         self._graphs: dict[int, tuple[Any, Any, Any]] = {}  # (v, q, r) per number of squarings, built once
+
+    @property
+    def noise_floor(self) -> float | None:  # type: ignore[override]
+        """The given ``noise_floor``; else, with a ``variance``, the weighted misfit that noise of that variance
+        leaves at the truth, Σ w σ², so that the fit is judged against the noise the user declared (as the
+        frequency response's ``variance=`` is)."""
+        return self._noise_floor_given if self._noise_floor_given is not None else self._variance_floor
+
+    @noise_floor.setter
+    def noise_floor(self, value: float | None) -> None:
+        self._noise_floor_given = value
 
     # -- the data kind's part ------------------------------------------------------------------
     def _matrices(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
