@@ -91,7 +91,7 @@ def test_a_users_start_outside_the_bounds_is_refused(frf, io, method):
 
 
 def test_equal_bounds_are_refused_with_the_known_value_to_give_instead(frf):
-    with pytest.raises(OptionError, match=r"k has equal bounds \[10, 10\].*known=\{'k': 10\}"):
+    with pytest.raises(OptionError, match=r"k has equal bounds \[10, 10\].*model.with_known\(\{'k': 10\}\)"):
         si.identify(MODEL, frf, method="auto", bounds={"k": (10, 10)})
 
 

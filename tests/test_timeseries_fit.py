@@ -329,3 +329,28 @@ def test_a_fit_of_a_model_with_two_solutions_says_so(monkeypatch):
         single = si.identify(mck, record, x0=[2.0, 1.0, 8.0])
     assert single.success and "several_solutions" not in single.options
     assert single.options["identifiability_check_s"] > 0
+
+
+def test_bounds_that_exclude_the_other_solution_make_the_estimate_unique_within_them(monkeypatch):
+    """The oral dose's flip-flop: ka ↔ ke with q·ka/ke. A user who knows absorption is faster than elimination
+    gives bounds that exclude the swapped values; the estimate is then unique within them, and symid says so
+    instead of warning (a new user's trial: NOT UNIQUE was reported whatever the bounds)."""
+    monkeypatch.setattr(analyse, "several_solutions", functools.partial(analyse.several_solutions, timeout=None))
+    monkeypatch.setattr(analyse, "solutions_at", functools.partial(analyse.solutions_at, timeout=None))
+    ka, ke, q = si.parameters("ka ke q", positive=True)
+    oral = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])
+    u = np.zeros(49)
+    u[0] = 1000.0
+    io = si.simulate_io(oral, {"ka": 1.2, "ke": 0.15, "q": 1 / 40}, u, 0.5, noise=0.05, seed=1)
+    bounds = {"ka": (0.5, 5.0), "ke": (0.01, 0.4)}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", si.IdentifiabilityWarning)
+        res = si.identify(oral, io, x0={"ka": 0.8, "ke": 0.1, "q": 0.01}, bounds=bounds)
+    assert res.success and "solutions_at_estimate" not in res.options
+    [other] = res.options["solutions_outside_bounds"]
+    np.testing.assert_allclose(other["ka"], res.theta["ke"], rtol=1e-9)  # the swap, from the 12-digit point
+    text = res.summary()
+    assert "UNIQUE WITHIN THE BOUNDS (structure)" in text and "NOT UNIQUE" not in text
+    assert "ka = " in res.options["unique_within_bounds"] and "below its lower bound 0.5" in \
+        res.options["unique_within_bounds"]
+    assert "NOT UNIQUE" not in res.uncertainty.note

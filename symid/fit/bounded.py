@@ -42,7 +42,7 @@ def bounds_option(model: Any, bounds: Any, positivity: bool) -> tuple[np.ndarray
     >>> bounds_option(model, {"k": (10, 10)}, True)
     Traceback (most recent call last):
     ...
-    symid.errors.OptionError: bounds: k has equal bounds [10, 10]: that is a known value; give it as known={'k': 10} ...
+    symid.errors.OptionError: bounds: k has equal bounds [10, 10]: that is a known value; fit model.with_known(...
     """
     lower, upper = parameter_bounds(model, bounds, positivity)
     names = model.parameter_names
@@ -50,8 +50,8 @@ def bounds_option(model: Any, bounds: Any, positivity: bool) -> tuple[np.ndarray
     if same.size:
         k = int(same[0])
         raise OptionError(f"bounds: {names[k]} has equal bounds [{lower[k]:g}, {upper[k]:g}]: that is a known "
-                          f"value; give it as known={{{names[k]!r}: {lower[k]:g}}} when building the model (or "
-                          f"ModelFile.free_model(known=...)), or leave the bounds apart")
+                          f"value; fit model.with_known({{{names[k]!r}: {lower[k]:g}}}) instead (a model file: "
+                          f"known = {{...}}, or --known on the command line), or leave the bounds apart")
     plain_lower, _ = parameter_bounds(model, None, positivity)
     given = bool(np.any(lower != plain_lower) or np.any(np.isfinite(upper)))
     return lower, upper, given

@@ -23,11 +23,35 @@ __all__ = ["identify"]
 
 _SEVERAL_INTERVALS = (
     "other parameter values give the same response (NOT UNIQUE (structure)): these intervals describe this "
-    "solution's neighbourhood only, and hold less often than they say where the other solution is near (a half car "
-    "at 1 % noise, the other solution 1.9 to 10.6 standard errors away: 95 % intervals held the truth in 68 to 98 % of "
-    "40 records, 85 to 100 % with its mass known); fix what is known (known=) for intervals that hold")
-# measured by benchmarks/interval_coverage.py
+    "solution's neighbourhood only, and hold less often than they say when another solution lies within a few "
+    "standard errors; fit model.with_known({...}) with a parameter whose value is known for intervals that hold")
+# measured by benchmarks/interval_coverage.py: a half car at 1 % noise, the other solution 1.9 to 10.6 standard errors
+# away, 95 % intervals held the truth in 68 to 98 % of 40 records, 85 to 100 % with its body mass known
 """The uncertainty's note for an estimate of a model with several solutions (:func:`identify`)."""
+
+
+def _within(solution: dict[str, float], bounds: dict[str, list[float]] | None) -> bool:
+    """Does a solution lie within the fit's bounds (with the 1e-9 relative slack of rounding)?"""
+    for name, (lo, hi) in (bounds or {}).items():
+        v, slack = solution[name], 1e-9 * max(abs(solution[name]), 1e-300)
+        if v < lo - slack or v > hi + slack:
+            return False
+    return True
+
+
+def _outside_text(outside: list[dict[str, float]], bounds: dict[str, list[float]], names: list[str]) -> str:
+    """'unique within the bounds: the other solution (m = 620.4, …) has kr = 3e5 beyond its upper bound 2e5'."""
+    sol = outside[0]
+    beyond = []
+    for name, (lo, hi) in bounds.items():
+        if sol[name] < lo:
+            beyond.append(f"{name} = {sol[name]:.6g} below its lower bound {lo:g}")
+        elif sol[name] > hi:
+            beyond.append(f"{name} = {sol[name]:.6g} above its upper bound {hi:g}")
+    values = ", ".join(f"{n} = {sol[n]:.6g}" for n in names)
+    more = f" ({len(outside) - 1} more, outside them too)" if len(outside) > 1 else ""
+    return (f"unique within the bounds: the other parameter values with this estimate's response ({values}) have "
+            f"{'; '.join(beyond)}{more}")
 
 
 def _nearest(others: list[dict[str, float]] | None, theta: np.ndarray, unc: Any) -> str:
@@ -123,7 +147,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         this kind can determine (default True); after an estimate that fits, the global
         test within about a second (:func:`symid.structural.analyse.several_solutions`,
         cached per model structure): where other parameter values give the same response
-        (a flip-flop of two rate constants), a warning says so, and ``summary()`` too.
+        (a flip-flop of two rate constants), a warning says so, and ``summary()`` too,
+        with the other values at the estimate (``options["solutions_at_estimate"]``).
+        Where every one of them lies outside the fit's ``bounds``, the estimate is unique
+        within them: no warning, and ``options["unique_within_bounds"]`` says why.
     noise_floor : float, optional
         The relative misfit noise alone leaves at the true parameters (ε² for relative
         noise of level ε); used to judge ``success`` (:mod:`symid.fit.success`). Default:
@@ -254,15 +281,23 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         extra["identifiability_check_s"] = (check_s or 0.0) + time.perf_counter() - t_check
         if several is not None:
             extra["several_solutions"] = several
-            warnings.warn(several, IdentifiabilityWarning, stacklevel=2)
             from symid.structural.analyse import solutions_at
 
             t_at = time.perf_counter()
             others = solutions_at(model, result.theta_vector)
             extra["identifiability_check_s"] += time.perf_counter() - t_at
+            bounds = result.options.get("bounds")
+            outside = [s for s in others or [] if not _within(s, bounds)]
+            others = None if others is None else [s for s in others if _within(s, bounds)]
             if others:
                 extra["solutions_at_estimate"] = others
-            if result.uncertainty is not None:
+            if outside:
+                extra["solutions_outside_bounds"] = outside
+            if others == [] and outside:  # every other solution at θ̂ is excluded by the bounds the user gave
+                extra["unique_within_bounds"] = _outside_text(outside, bounds, list(model.parameter_names))
+            else:
+                warnings.warn(several, IdentifiabilityWarning, stacklevel=2)
+            if result.uncertainty is not None and "unique_within_bounds" not in extra:
                 unc = result.uncertainty
                 nearest = _nearest(others, result.theta_vector, unc)
                 note = f"{unc.note + '. ' if unc.note else ''}{_SEVERAL_INTERVALS}{nearest}"

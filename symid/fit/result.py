@@ -382,7 +382,9 @@ class IdentificationResult:
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")
-        if self.options.get("several_solutions"):
+        if self.options.get("unique_within_bounds"):
+            lines.append(f"UNIQUE WITHIN THE BOUNDS (structure): {self.options['unique_within_bounds']}")
+        elif self.options.get("several_solutions"):
             lines.append(f"NOT UNIQUE (structure): {self.options['several_solutions']}")
         unc = self.uncertainty
         if unc is not None and not self.success:

@@ -188,6 +188,36 @@ class ParametricModel:
         vec = self.theta_vector(theta)
         return {n: m(vec) for n, m in self._maps.items()}
 
+    def with_known(self, known: Mapping[str, float]) -> Any:
+        """The same model with the parameters whose values are known replaced by those numbers.
+
+        Parameters
+        ----------
+        known : dict of str to float
+            Parameter name → value (finite); the other parameters stay free, in their order.
+
+        Returns
+        -------
+        StateSpaceModel or SecondOrderModel
+            A new model of the same class (this model when ``known`` is empty).
+
+        Raises
+        ------
+        ModelError
+            On a name that is not a parameter, or a value that is not a finite number.
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> m, c, k = si.parameters("m c k", positive=True)
+        >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+        >>> model.with_known({"m": 2.0}).parameter_names
+        ('c', 'k')
+        """
+        from symid.modelfile import substitute_known
+
+        return substitute_known(self, known)
+
     def _matrix_text(self) -> str:
         lines = []
         for n, m in self._symbolic.items():
