@@ -292,8 +292,7 @@ def test_known_scale_bounds_and_options_reach_the_estimator(tmp_path, capsys):
     assert code == 0, out
     result = json.loads((tmp_path / "result.json").read_text())
     assert result["parameter_names"] == ["c1", "c2", "k1", "k2"] and result["known"] == {"m1": 1.0, "m2": 1.0}
-    scale = result["options"]["scale"]  # JSON keeps an array option as its text
-    assert (json.loads(scale) if isinstance(scale, str) else scale) == [0.1, 0.3, 2.0, 1.0]
+    assert result["options"]["scale"] == [0.1, 0.3, 2.0, 1.0]
     assert result["options"]["time_limit"] == 60.0
     assert result["options"]["hessian"] == "limited-memory"
     # every free parameter has finite bounds? k2's low end is open, so the method's own first start is used
@@ -319,10 +318,13 @@ def test_bounds_reach_a_method_that_takes_them(capsys, method):
     code = main(["identify", "mass_damper_2dof", "--method", method, *BOUNDS, "--json"])
     captured = capsys.readouterr()
     doc = json.loads(captured.out)
-    assert "'k1': [3.0, 10.0]" in str(doc["result"]["options"]["bounds"])  # JSON keeps a dict option as its text
+    assert doc["result"]["options"]["bounds"]["k1"] == [3.0, 10.0]  # a dict option is JSON, not its repr
     # held at the bound the truth (k1 = 2, thesis (4-21)) lies below; exit status 4: no start fits the data
     assert code == 4 and doc["outside_bounds"] == {}
     assert doc["result"]["theta"]["k1"] == pytest.approx(3.0, rel=1e-9)
+    on = doc["result"]["on_bounds"]  # a field a script can read, beside the message
+    assert on["k1"] == "lower" and set(on) <= {"m1", "m2", "c1", "c2", "k1", "k2"}
+    assert "NEXT: the estimate sits on its bounds (" in captured.err and "k1 (lower)" in captured.err
     assert "does not use the bounds" not in captured.err
     assert code == NO_FIT  # no fit of these data inside the bounds: said by the exit status
 

@@ -23,7 +23,7 @@ import numpy as np
 from symid.errors import OptionError
 from symid.fit.options import parameter_bounds
 
-__all__ = ["bounds_option", "clip_into", "log_box", "named_bounds", "on_bounds", "typical_within"]
+__all__ = ["bound_sides", "bounds_option", "clip_into", "log_box", "named_bounds", "on_bounds", "typical_within"]
 
 
 def bounds_option(model: Any, bounds: Any, positivity: bool) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -137,11 +137,31 @@ def on_bounds(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, names: Se
     theta = np.asarray(theta, dtype=float)
     if theta.shape != np.shape(lower):
         return ""
-    tol = 1e-9 * np.fmax(1.0, np.abs(theta))
-    parts = []
-    for k, name in enumerate(names):
-        if np.isfinite(lower[k]) and abs(theta[k] - lower[k]) <= tol[k] and not (positive[k] and lower[k] == 0):
-            parts.append(f"{name} = {theta[k]:.6g} (lower)")
-        elif np.isfinite(upper[k]) and abs(theta[k] - upper[k]) <= tol[k]:
-            parts.append(f"{name} = {theta[k]:.6g} (upper)")
+    sides = bound_sides(theta, lower, upper, positive)
+    parts = [f"{name} = {theta[k]:.6g} ({'lower' if sides[k] < 0 else 'upper'})"
+             for k, name in enumerate(names) if sides[k]]
     return "; on its bounds: " + ", ".join(parts) if parts else ""
+
+
+def bound_sides(theta: np.ndarray, lower: np.ndarray, upper: np.ndarray, positive: np.ndarray) -> np.ndarray:
+    """Per entry of ``theta``: −1 on its lower bound, +1 on its upper, 0 inside (to 1e-9 relative, and to a
+    quarter of the box for a box narrower than that: the nearer bound). The 0 that keeps a positive
+    parameter positive is not a bound the user gave.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.bounded import bound_sides
+    >>> bound_sides(np.array([60.0, 2.0, 1.0]), np.array([60.0, 0.0, 1.0]), np.array([100.0, 3.0, 1.0 + 1e-12]),
+    ...             np.array([True, True, True])).tolist()
+    [-1, 0, -1]
+    """
+    theta = np.asarray(theta, dtype=float)
+    width = np.where(np.isfinite(upper - lower), upper - lower, np.inf)
+    tol = np.fmin(1e-9 * np.fmax(1.0, np.abs(theta)), 0.25 * width)
+    dlo, dhi = np.abs(theta - lower), np.abs(upper - theta)
+    low = np.isfinite(lower) & (dlo <= tol) & ~(positive & (lower == 0))
+    high = np.isfinite(upper) & (dhi <= tol)
+    both = low & high
+    low, high = low & (~both | (dlo <= dhi)), high & (~both | (dhi < dlo))
+    return np.where(low, -1, np.where(high, 1, 0))

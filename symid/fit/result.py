@@ -87,6 +87,22 @@ def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
     return None
 
 
+def _plain(value: Any) -> Any:
+    """An option's value as plain JSON-ready Python: numbers, strings, lists and dicts of them kept (numpy's as
+    Python's), anything else as its ``repr``."""
+    if isinstance(value, (bool, int, float, str, type(None))):
+        return value
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict) and all(isinstance(k, str) for k in value):
+        return {k: _plain(v) for k, v in value.items()}
+    return repr(value)
+
+
 def _best_index(starts: tuple[StartOutcome, ...] | list[StartOutcome]) -> int:
     """Index of the lowest data misfit (non-finite costs rank last; the first on ties)."""
     return int(np.argmin([s.cost if np.isfinite(s.cost) else np.inf for s in starts]))
@@ -376,6 +392,11 @@ class IdentificationResult:
         if not self.success:
             if self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
+            elif self.on_bounds:
+                sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
+                lines.append(f"NEXT: the estimate sits on its bounds ({sides}) and does not fit: the data want values "
+                             f"beyond them; widen those bounds if the physics allows, else check the model's "
+                             f"structure and the data's units")
             elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
                                       time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
@@ -416,6 +437,35 @@ class IdentificationResult:
             lines.append(self.polished.summary(truth))
         return "\n".join(lines)
 
+    @property
+    def on_bounds(self) -> dict[str, str]:
+        """The parameters whose estimate sits on a bound the user gave (``options["bounds"]``), by name:
+        ``"lower"`` or ``"upper"`` (empty without bounds; the 0 that keeps a positive parameter positive is
+        not a bound the user gave).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from symid.fit.result import IdentificationResult, StartOutcome
+        >>> out = StartOutcome(np.ones(2), np.array([100.0, 2.0]), 1e-3, False, True, "ok", 3, 0.1)
+        >>> res = IdentificationResult.from_starts("lm", ("k", "m"), [out], cost_kind="misfit",
+        ...                                        options={"bounds": {"k": [10.0, 100.0], "m": [0.0, np.inf]}})
+        >>> res.on_bounds
+        {'k': 'upper'}
+        """
+        bounds = self.options.get("bounds") or {}
+        out = {}
+        for name, (lo, hi) in bounds.items():
+            value = self.theta.get(name)
+            if value is None or not np.isfinite(value):
+                continue
+            tol = min(1e-9 * max(1.0, abs(value)), 0.25 * (hi - lo))
+            near_lo = lo != 0 and np.isfinite(lo) and abs(value - lo) <= tol
+            near_hi = np.isfinite(hi) and abs(value - hi) <= tol
+            if near_lo or near_hi:
+                out[name] = "lower" if near_lo and (not near_hi or value - lo <= hi - value) else "upper"
+        return out
+
     def __str__(self) -> str:
         return self.summary()
 
@@ -427,5 +477,5 @@ class IdentificationResult:
                 "message": self.message, "fit": self.fit, "starts": [s.to_dict() for s in self.starts],
                 "polished": None if self.polished is None else self.polished.to_dict(),
                 "uncertainty": None if self.uncertainty is None else self.uncertainty.to_dict(),
-                "options": {k: (v if isinstance(v, (int, float, str, bool, type(None))) else repr(v))
-                            for k, v in self.options.items()}}
+                "on_bounds": self.on_bounds,
+                "options": {k: _plain(v) for k, v in self.options.items()}}

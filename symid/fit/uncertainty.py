@@ -65,7 +65,7 @@ import numpy as np
 
 from symid.errors import DataError
 
-__all__ = ["NEAR_SINGULAR", "SHIFT_LIMIT", "FisherInformation", "Uncertainty", "broadcast_noise",
+__all__ = ["BOUND_PULL_LIMIT", "NEAR_SINGULAR", "SHIFT_LIMIT", "FisherInformation", "Uncertainty", "broadcast_noise",
            "fisher_uncertainty"]
 
 NEAR_SINGULAR = 1e-8
@@ -77,6 +77,11 @@ _NULL_PART = 1e-6
 SHIFT_LIMIT = 0.5
 """Largest distance (in standard errors) from θ̂ to the least-squares estimate at which intervals centred on θ̂
 are reported: shifted by 0.5 SE, a 95 % interval still holds the truth 93 % of the time (1 SE: 83 %)."""
+
+BOUND_PULL_LIMIT = 3.0
+"""Largest distance, in its own standard errors, by which a bound may hold a parameter back from the least-squares
+estimate for the other parameters' intervals to be given (:func:`_with_shift`): beyond it the data reject the bound
+(with the truth on the bound, the least-squares estimate lies beyond it by less than this in 99.9 % of records)."""
 
 _Z975 = 1.959963984540054  # the 0.975 quantile of the standard normal
 
@@ -247,18 +252,20 @@ class FisherInformation(abc.ABC):
         lower, upper = getattr(self, "lower", None), getattr(self, "upper", None)
         if lower is None or upper is None or np.shape(lower) != theta.shape:
             return None
-        tol = 1e-9 * np.fmax(1.0, np.abs(theta))
+        from symid.fit.bounded import bound_sides
+
         positive = np.asarray(getattr(getattr(self, "model", None), "positive", np.zeros(theta.size, bool)), bool)
-        low = np.isfinite(lower) & (np.abs(theta - lower) <= tol) & ~(positive & (lower == 0))
-        high = np.isfinite(upper) & (np.abs(theta - upper) <= tol)
-        return np.where(low, -1, np.where(high, 1, 0))
+        return bound_sides(theta, np.asarray(lower, dtype=float), np.asarray(upper, dtype=float), positive)
 
 
 
 def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarray | None = None) -> Uncertainty:
     """Add the distance from θ̂ to the least-squares estimate (one Gauss–Newton step on ‖r + J δ‖²); beyond
     ``SHIFT_LIMIT`` standard errors the intervals become NaN and the note says why (that the step leaves the
-    bounds where θ̂ sits on one, ``sides``: −1 on a lower bound, +1 on an upper, 0 inside)."""
+    bounds where θ̂ sits on one, ``sides``: −1 on a lower bound, +1 on an upper, 0 inside). Where the step
+    leaves bounds by less than ``BOUND_PULL_LIMIT`` of each such parameter's own standard error and θ̂ is the
+    least-squares estimate with those parameters held on their bounds, only their intervals are NaN (one
+    slightly active bound does not withhold every interval)."""
     import dataclasses
 
     l = unc.covariance.shape[0]
@@ -272,6 +279,21 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
     if shift <= SHIFT_LIMIT:
         return dataclasses.replace(unc, shift=shift)
     pushed = [] if sides is None else [k for k in range(l) if sides[k] and sides[k] * delta[k] > 0]
+    se = np.sqrt(np.abs(np.diag(unc.covariance)))
+    slight = bool(pushed) and all(abs(delta[k]) <= BOUND_PULL_LIMIT * se[k] for k in pushed)
+    held = _held_shift(unc, r, J, pushed) if slight else None
+    if held is not None and held <= SHIFT_LIMIT:
+        # each bound holds its parameter back by less than BOUND_PULL_LIMIT of its own standard errors (the data do not
+        # reject the bound), and with them held θ̂ is the least-squares estimate: the others' intervals hold
+        names = ", ".join(f"{unc.parameter_names[k]} ({'lower' if sides[k] < 0 else 'upper'})" for k in pushed)
+        intervals = np.array(unc.intervals, dtype=float, copy=True)
+        intervals[pushed] = np.nan
+        note = (f"{unc.note + '. ' if unc.note else ''}θ̂ sits on its bounds where the data pull it slightly "
+                f"beyond them (within {BOUND_PULL_LIMIT:g} of its own standard errors): {names}, which get no interval "
+                f"(NaN); with them held there θ̂ is the least-squares estimate "
+                f"({held:.3g} standard errors away), and the other intervals are those of the free fit around it "
+                f"(they allow the held parameters to move, so they are wider, not narrower, than with them fixed)")
+        return dataclasses.replace(unc, shift=shift, note=note, intervals=intervals)
     if pushed:
         names = ", ".join(f"{unc.parameter_names[k]} ({'lower' if sides[k] < 0 else 'upper'})" for k in pushed)
         note = (f"{unc.note + '. ' if unc.note else ''}θ̂ sits on its bounds where the data pull it beyond them: "
@@ -283,6 +305,24 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
                 f"estimate of these data (more than {SHIFT_LIMIT}): intervals around θ̂ would not hold, so none are "
                 f"given (NaN); polish=True refines θ̂ to that estimate where the method has a polisher")
     return dataclasses.replace(unc, shift=shift, note=note, intervals=np.full((l, 2), np.nan))
+
+
+def _held_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, held: list[int]) -> float | None:
+    """The distance, in standard errors of the other parameters, from θ̂ to the least-squares estimate with
+    the parameters ``held`` fixed at θ̂ (a Gauss–Newton step without their columns; nuisance unknowns stay
+    free); None where it cannot be computed."""
+    l = unc.covariance.shape[0]
+    free = [k for k in range(l) if k not in held]
+    if not free:
+        return 0.0
+    cols = free + list(range(l, J.shape[1]))
+    try:
+        delta = -np.linalg.lstsq(J[:, cols], r, rcond=None)[0][:len(free)]
+        info = np.linalg.inv(unc.covariance)[np.ix_(free, free)]  # the Fisher information of the free ones
+        value = float(delta @ info @ delta)
+    except np.linalg.LinAlgError:
+        return None
+    return float(np.sqrt(max(value, 0.0))) if np.isfinite(value) else None
 
 
 def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str, *, name: str = "noise_std",

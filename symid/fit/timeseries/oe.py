@@ -82,7 +82,8 @@ __all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "WEIGHTED_COST_KIND
 
 SOLVERS = ("ipopt", "trf")
 
-WEIGHTED_COST_KIND = "weighted relative output misfit Σ (y − ŷ)²/σ² / Σ y²/σ², σ² the given variance"
+WEIGHTED_COST_KIND = ("weighted relative output misfit to the measured samples Σ (y − ŷ)²/σ² / Σ y²/σ², σ² the given "
+                      "variance")
 """The misfit's name when ``variance=`` weighs every output value."""
 """The ``solver`` choices of :class:`OutputError`."""
 
