@@ -222,8 +222,10 @@ def test_scr_variance_given_or_from_the_data_and_none_as_before():
 
 @pytest.mark.parametrize("cls", [LinearFRF, ScrFRF])
 @pytest.mark.parametrize(("variance", "match"), [
-    (np.ones(3), r"variance must have one value per frequency \(40,\) or per entry of H \(40, 1, 1\); got shape"),
-    (np.ones((40, 2, 1)), r"variance must have one value per frequency"),
+    (np.ones(3), r"variance must be one number, one value per frequency \(40,\) or one per entry of H "
+                 r"\(40, 1, 1\); got shape"),
+    (np.ones((40, 2, 1)), r"variance must be one number, one value per frequency"),
+    (np.ones(40) * (1 + 1j), r"variance holds complex numbers"),
     (np.zeros(40), r"variance must be finite and > 0 .* entry \(0, 0, 0\)"),
     (-np.ones(40), r"variance must be finite and > 0"),
     (np.where(np.arange(40) == 7, np.nan, 1e-4), r"entry \(7, 0, 0\) .* is nan"),

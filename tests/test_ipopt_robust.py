@@ -230,7 +230,7 @@ def test_noise_weighted_fit_covers_over_many_records():
 
 def test_variance_option_is_checked_and_weights_enter_the_misfit():
     model, frf = one_dof()
-    with pytest.raises(si.OptionError, match="variance must have one value per frequency"):
+    with pytest.raises(si.OptionError, match="variance must be one number, one value per frequency"):
         IpoptFRF(model, frf, variance=np.ones(3))
     with pytest.raises(si.OptionError, match="must be finite and > 0"):
         IpoptFRF(model, frf, variance=np.zeros(20))

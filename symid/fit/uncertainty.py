@@ -326,10 +326,10 @@ def _held_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, held: list[int])
 
 
 def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str, *, name: str = "noise_std",
-                    check: bool = True) -> np.ndarray:
+                    check: bool = True, error: type[Exception] = DataError) -> np.ndarray:
     """``noise_std`` as a float array of ``shape``: a number, or an array that broadcasts (its leading axes
-    matching); every value finite and > 0 (``check``), else a :class:`~symid.errors.DataError` naming ``what``;
-    ``name`` is the option's name in the messages.
+    matching); every value finite and > 0 (``check``), else an ``error`` (:class:`~symid.errors.DataError`
+    by default) naming ``what``; ``name`` is the option's name in the messages. Complex values are refused.
 
     Examples
     --------
@@ -337,22 +337,30 @@ def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str, *, name: 
     >>> broadcast_noise([0.1, 0.2], (2, 1, 1), "H").ravel().tolist()
     [0.1, 0.2]
     """
+    if np.iscomplexobj(noise_std) or (isinstance(noise_std, (list, tuple)) and any(map(np.iscomplexobj, noise_std))):
+        raise error(f"{name} holds complex numbers; it is real and > 0 (data units)")
     try:
         arr = np.asarray(noise_std, dtype=float)
     except (TypeError, ValueError):
-        raise DataError(f"{name} must be a number or an array of numbers (data units); got {noise_std!r}") from None
+        raise error(f"{name} must be a number or an array of numbers (data units); got "
+                    f"{_short_repr(noise_std)}") from None
     if arr.ndim > len(shape):
-        raise DataError(f"{name} has shape {arr.shape}; {what} has shape {shape}")
+        raise error(f"{name} has shape {arr.shape}; {what} has shape {shape}")
     arr = arr.reshape(arr.shape + (1,) * (len(shape) - arr.ndim))
     try:
         out = np.broadcast_to(arr, shape).astype(float)
     except ValueError:
-        raise DataError(f"{name} of shape {np.shape(noise_std)} does not fit {what} of shape {shape}: give one "
-                        f"number, one per {'frequency' if 'H' in what or 'Phi' in what else 'sample'} "
-                        f"({shape[0]},), or the full shape") from None
+        raise error(f"{name} of shape {np.shape(noise_std)} does not fit {what} of shape {shape}: give one "
+                    f"number, one per {'frequency' if 'H' in what or 'Phi' in what else 'sample'} "
+                    f"({shape[0]},), or the full shape") from None
     if check and (not np.all(np.isfinite(out)) or np.any(out <= 0)):
-        raise DataError("noise_std must be finite and > 0 everywhere (a standard deviation in data units)")
+        raise error(f"{name} must be finite and > 0 everywhere (a standard deviation in data units)")
     return out
+
+
+def _short_repr(value: Any, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def _noise_levels(r: np.ndarray, J: np.ndarray, channels: np.ndarray, s: np.ndarray, p: int) -> np.ndarray:

@@ -77,16 +77,20 @@ def frf_weights(data: Any, variance: Any = "data") -> np.ndarray | None:
     elif variance is None:
         return None
     else:
+        if np.iscomplexobj(variance):
+            raise OptionError("variance holds complex numbers; a noise variance is real and > 0")
         try:
             var = np.asarray(variance, dtype=float)
         except (TypeError, ValueError):
             raise OptionError(f"variance must be 'data', None or an array of real noise variances; got "
                               f"{type(variance).__name__}") from None
+        if var.shape == ():  # one variance for every value
+            var = np.broadcast_to(var, H.shape)
         if var.shape == (H.shape[0],):
             var = np.broadcast_to(var[:, None, None], H.shape)
         if var.shape != H.shape:
-            raise OptionError(f"variance must have one value per frequency ({H.shape[0]},) or per entry of H "
-                              f"{H.shape}; got shape {var.shape}")
+            raise OptionError(f"variance must be one number, one value per frequency ({H.shape[0]},) or one per "
+                              f"entry of H {H.shape}; got shape {var.shape}")
         source = "variance"
     var = var.reshape(H.shape)
     bad = ~np.isfinite(var) | (var <= 0)
@@ -125,6 +129,8 @@ def frf_variance(data: Any, variance: Any = "data") -> np.ndarray | None:
         return None
     H = np.asarray(data.H)
     var = np.asarray(data.variance if isinstance(variance, str) else variance, dtype=float)
+    if var.shape == ():
+        var = np.broadcast_to(var, H.shape)
     if var.shape == (H.shape[0],):
         var = np.broadcast_to(var[:, None, None], H.shape)
     return np.array(var, dtype=float).reshape(H.shape)

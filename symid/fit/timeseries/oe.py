@@ -347,12 +347,17 @@ class OutputError(Estimator, FisherInformation):
         (N, p), or a list of such, one per record; every value finite and > 0."""
         items = variance if isinstance(variance, (list, tuple)) and len(self.records) > 1 else None
         if items is not None and len(items) != len(self.records):
-            raise DataError(f"variance is a list of {len(items)}; there are {len(self.records)} records")
+            raise OptionError(f"variance is a list of {len(items)}; there are {len(self.records)} records")
+        if items is None and len(self.records) > 1 and isinstance(variance, np.ndarray) and variance.ndim \
+                and variance.shape[0] > 1:
+            raise OptionError(f"variance has {variance.shape[0]} values per output (one per sample of one record); "
+                              f"there are {len(self.records)} records: give a list of arrays, one per record (a "
+                              f"number, or one per output as (1, p), is shared by every record)")
         out = []
         for e, r in enumerate(self.records):
             where = f"the output y of record {e}" if len(self.records) > 1 else "the output y"
             arr = broadcast_noise(variance if items is None else items[e], (r.n_samples, r.n_outputs), where,
-                                  name="variance", check=False)
+                                  name="variance", check=False, error=OptionError)
             bad = ~(np.isfinite(arr) & (arr > 0))
             if bad.any():
                 k, j = (int(i) for i in np.argwhere(bad)[0])
