@@ -594,8 +594,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
     g = p.add_argument_group("what you know about the parameters (extends or replaces the model file's)")
     g.add_argument("--x0", nargs="+", metavar="NAME=VALUE",
-                   help="the first start: a value for every free parameter (default: the model file's start, "
-                        "else the centre of the bounds when every parameter has finite ones, else the method's)")
+                   help="the first start, for some or all free parameters: the others keep the model file's "
+                        "start, else their scale, else the centre of their finite bounds (default: the model "
+                        "file's start, else the centre of the bounds when every parameter has finite ones, else "
+                        "the method's)")
     g.add_argument("--known", nargs="+", metavar="NAME=VALUE",
                    help="parameters whose values are known: substituted into the model before estimation")
     g.add_argument("--scale", nargs="+", metavar="NAME=VALUE",

@@ -152,8 +152,10 @@ class ModelFile:
                 where: str = "the command line") -> ModelFile:
         """The same declarations with some replaced or extended (the command line's ``--known``, ``--x0`` ...).
 
-        ``known`` and ``bounds`` extend the file's (given names win); ``start`` and ``scale``
-        replace them. A parameter newly known leaves the file's start, scale and bounds.
+        ``known`` and ``bounds`` extend the file's (given names win); ``scale`` replaces it;
+        ``start`` replaces it for the names it gives, the others keep the file's start, else
+        their scale, else the centre of their finite bounds. A parameter newly known leaves
+        the file's start, scale and bounds.
 
         Parameters
         ----------
@@ -171,18 +173,27 @@ class ModelFile:
 
         known_ = {**self.known, **_known_values(known or {}, self.model, f"{where}: known")}
         free = [n for n in self.model.parameter_names if n not in known_]
-        if start is not None:
-            start_ = _start_values(start, self.model, free, known_, f"{where}: x0")
-        elif self.start is not None and all(n in self.start for n in free):
-            start_ = {n: self.start[n] for n in free}
-        else:
-            start_ = None
         if scale is not None:
             scale_ = _scale_values(scale, free, known_, where)
         else:
             scale_ = {n: v for n, v in self.scale.items() if n in free} if all(n in self.scale for n in free) else {}
         bounds_ = {n: b for n, b in self.bounds.items() if n in free}
         bounds_.update(_bounds_values(bounds or {}, free, known_, where))
+        if start is not None:  # a partial start is completed from the file's start, the scale, then the bounds
+            given = _name_map(start, f"{where}: x0")
+            _check_free(given, free, known_, f"{where}: x0")
+            fill = {**_bounds_centres(bounds_), **scale_, **(self.start or {})}
+            missing = [n for n in free if n not in given and n not in fill]
+            if missing:
+                raise ModelError(f"{where}: x0 lacks {', '.join(missing)} and the model file gives no start, scale "
+                                 f"or finite bounds for {'it' if len(missing) == 1 else 'them'}: give "
+                                 f"{'its' if len(missing) == 1 else 'their'} value(s) too")
+            start_ = _start_values({n: given.get(n, fill.get(n)) for n in free}, self.model, free, known_,
+                                   f"{where}: x0")
+        elif self.start is not None and all(n in self.start for n in free):
+            start_ = {n: self.start[n] for n in free}
+        else:
+            start_ = None
         if start_ is not None:
             bad = {k: v for k, v in start_.items() if k in bounds_ and not bounds_[k][0] <= v <= bounds_[k][1]}
             if bad:
@@ -196,11 +207,7 @@ class ModelFile:
         free = [n for n in self.model.parameter_names if n not in self.known]
         if not free or any(n not in self.bounds or not all(map(math.isfinite, self.bounds[n])) for n in free):
             return None
-        centre = {}
-        for n in free:
-            lo, hi = self.bounds[n]
-            centre[n] = math.sqrt(lo * hi) if lo > 0 else 0.5 * (lo + hi)
-        return centre
+        return _bounds_centres({n: self.bounds[n] for n in free})
 
     def h_unit(self, output: int = 0, input: int = 0) -> str | None:
         """The physical unit of H[output, input] (``"m/N"``), or ``None`` when the units are not given."""
@@ -487,6 +494,15 @@ def _check_free(given: Mapping[str, Any], free: Sequence[str], known: Mapping[st
     if unknown:
         raise ModelError(f"{what} names {', '.join(map(repr, unknown))}, not a parameter of the model "
                          f"(free parameters: {', '.join(free)})")
+
+
+def _bounds_centres(bounds: Mapping[str, tuple[float, float]]) -> dict[str, float]:
+    """The centre of each pair of finite bounds (geometric for 0 < low); names without finite bounds are left out."""
+    out = {}
+    for n, (lo, hi) in bounds.items():
+        if math.isfinite(lo) and math.isfinite(hi):
+            out[n] = math.sqrt(lo * hi) if lo > 0 else 0.5 * (lo + hi)
+    return out
 
 
 def _start_values(value: Any, model: Any, free: list[str], known: Mapping[str, float], where: str

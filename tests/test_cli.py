@@ -284,6 +284,20 @@ def test_identify_json_for_scripts(capsys):
     assert "method: ipopt" in captured.err  # the human report moved to standard error
 
 
+def test_a_partial_x0_is_completed_from_the_scale_and_the_bounds(capsys):
+    """--x0 k1=3 changes one value (a new user's trial: every parameter had to be listed); the others come from
+    the scale, else the centre of their finite bounds."""
+    code = main(["identify", "mass_damper_2dof", "--method", "lm", "--known", "m1=1", "m2=1", "--scale", "c1=0.1",
+                 "c2=0.3", "k1=2", "k2=1", "--x0", "k1=3", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0
+    np.testing.assert_allclose(doc["result"]["starts"][0]["start"], [0.1, 0.3, 3.0, 1.0], rtol=1e-15)
+    code = main(["identify", "mass_damper_2dof", "--method", "lm", "--known", "m1=1", "m2=1", "--bounds",
+                 "c1=0.01:1", "c2=0.01:1", "k1=1:4", "k2=0.25:4", "--x0", "c1=0.2", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    np.testing.assert_allclose(doc["result"]["starts"][0]["start"], [0.2, 0.1, 2.0, 1.0], rtol=1e-12)
+
+
 def test_known_scale_bounds_and_options_reach_the_estimator(tmp_path, capsys):
     code = main(["identify", "mass_damper_2dof", "--method", "ipopt", "--known", "m1=1", "m2=1",
                  "--scale", "c1=0.1", "c2=0.3", "k1=2", "k2=1", "--bounds", "k1=0.5:5", "k2=:10",
@@ -334,7 +348,8 @@ OPTION_ERRORS = {
                       "--backend: not taken by method 'ls'"),
     "backend on ipopt": (["identify", "belt_drive", "--method", "ipopt", "--backend", "admm"],
                          "--backend: not taken by method 'ipopt'"),
-    "x0 incomplete": (["identify", "belt_drive", "--x0", "theta1=1"], "x0: start lacks theta2, theta3, theta4"),
+    "x0 incomplete": (["identify", "belt_drive", "--x0", "theta1=1"],
+                      "x0 lacks theta2, theta3, theta4 and the model file gives no start, scale or finite bounds"),
     "x0 outside bounds": (["identify", "belt_drive", "--x0", "theta1=1", "theta2=1", "theta3=1", "theta4=1",
                            "--bounds", "theta1=-2:0"], "lies outside its bounds"),
     "known not a parameter": (["identify", "belt_drive", "--known", "mass=1"], "'mass', not a parameter"),
