@@ -452,3 +452,11 @@ def test_a_header_split_by_another_separator_says_which(tmp_path):
     with pytest.raises(si.DataError, match=r"the header looks ';'-separated, not ',': read it with delimiter=';'"):
         FrequencyData.from_table(path, columns={"frequency": "f_Hz", "magnitude": "mag_dB", "phase": "phase_deg"},
                                  units={"frequency": "Hz", "magnitude": "dB", "phase": "deg"})
+
+
+def test_a_decimal_comma_is_named(tmp_path):
+    """A European export, ';' between cells and ',' as the decimal point (a new user's trial)."""
+    path = write_csv(tmp_path / "eu.csv", ["t;u;y", "0,0;1,5;0,25", "0,1;1,5;0,5"])
+    with pytest.raises(si.DataError, match=r"line 2, column 't': '0,0' is not a number \(a decimal comma\?"):
+        IOData.from_table(path, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"},
+                          delimiter=";")

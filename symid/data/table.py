@@ -163,8 +163,11 @@ class _Csv:
                     raise ValueError(cell)
                 out[r] = float(cell)
             except ValueError:
+                comma = re.fullmatch(r"[+-]?\d*,\d+(?:[eE][+-]?\d+)?", cell.strip())
                 raise DataError(f"{self.where}, line {line}, column {name!r}: {_files._show(cell)} is not a "
-                                "number") from None
+                                "number" + (" (a decimal comma? symid reads '.' as the decimal point: export the "
+                                            "file with '.', or replace ',' by '.' in its numbers)" if comma else "")
+                                ) from None
             if not np.isfinite(out[r]):
                 raise DataError(f"{self.where}, line {line}, column {name!r}: {cell} is not a finite number; "
                                 "drop or fill that row")
