@@ -108,8 +108,8 @@ def test_time_series_bad_input():
         TimeSeries([0.0, 1.0, 1.0], np.zeros(3), np.ones(3))
     with pytest.raises(si.DataError, match="sample times must increase"):
         TimeSeries([0.0, 2.0, 1.0], np.zeros(3), np.ones(3))
-    with pytest.raises(si.DataError, match=r"y\[2, 0\] is nan"):
-        TimeSeries([0.0, 1.0, 2.0], np.zeros(3), [1.0, 1.0, np.nan])
+    with pytest.raises(si.DataError, match=r"y\[2, 0\] is inf"):  # NaN is a missing output (test_missing_outputs)
+        TimeSeries([0.0, 1.0, 2.0], np.zeros(3), [1.0, 1.0, np.inf])
     with pytest.raises(si.DataError, match=r"u must have shape \(3, channels\)"):
         TimeSeries([0.0, 1.0, 2.0], np.zeros(4), np.ones(3))
 

@@ -48,7 +48,8 @@ class DataContainer:
         if type(other) is not type(self):
             return NotImplemented
         mine, theirs = self._payload(), other._payload()  # type: ignore[attr-defined]
-        return all(np.array_equal(mine[k], theirs[k]) for k in self._npz_keys)
+        return all(np.array_equal(mine[k], theirs[k], equal_nan=mine[k].dtype.kind in "fc")
+                   for k in self._npz_keys)  # a missing value (NaN) equals a missing value
 
     __hash__ = None  # type: ignore[assignment]
 

@@ -95,8 +95,15 @@ def _fail(where: str, what: str, example: str) -> DataError:
 
 # -- sources ------------------------------------------------------------------------------------------
 
+_MISSING_HINT = {"uniform": " (an output not measured at some times: read the table as a TimeSeries, "
+                             "TimeSeries.from_table or kind='TimeSeries', where an empty cell or NaN marks it)"}
+"""What to add to an error about a missing or non-finite value, by the source's ``missing_hint``."""
+
+
 class _Csv:
     """A plain CSV file: header of names, rows of text cells parsed column by column on demand."""
+
+    missing_hint = ""
 
     def __init__(self, path: _files.PathLike, delimiter: str):
         if delimiter not in (",", ";", "\t", "|", " "):
@@ -151,13 +158,18 @@ class _Csv:
     def has(self, name: str) -> bool:
         return name in self.names
 
-    def get(self, name: str) -> np.ndarray:
+    def get(self, name: str, missing_ok: bool = False) -> np.ndarray:
+        """A column's numbers; an empty cell or NaN is a missing value (NaN) where ``missing_ok``."""
         c = self.names.index(name)
         out = np.empty(len(self.rows))
         for r, (line, cells) in enumerate(self.rows):
             cell = cells[c]
+            if missing_ok and cell.strip().lower() in ("", "nan", "na"):
+                out[r] = np.nan
+                continue
             if not cell:
-                raise DataError(f"{self.where}, line {line}, column {name!r}: the value is missing")
+                raise DataError(f"{self.where}, line {line}, column {name!r}: the value is missing" +
+                                _MISSING_HINT.get(self.missing_hint, ""))
             try:
                 if not cell.isascii() or "_" in cell:
                     raise ValueError(cell)
@@ -170,7 +182,7 @@ class _Csv:
                                 ) from None
             if not np.isfinite(out[r]):
                 raise DataError(f"{self.where}, line {line}, column {name!r}: {cell} is not a finite number; "
-                                "drop or fill that row")
+                                "drop or fill that row" + _MISSING_HINT.get(self.missing_hint, ""))
         return out
 
     def check_unit_comments(self, declared: Mapping[str, str], example: str,
@@ -305,6 +317,8 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
 class _Arrays:
     """Named arrays: a dict, a DataFrame's columns, or the variables of a .mat file."""
 
+    missing_hint = ""
+
     def __init__(self, arrays: Mapping[str, Any], where: str):
         self.where = where
         self.arrays = arrays
@@ -313,7 +327,8 @@ class _Arrays:
     def has(self, name: str) -> bool:
         return name in self.arrays
 
-    def get(self, name: str) -> np.ndarray:
+    def get(self, name: str, missing_ok: bool = False) -> np.ndarray:
+        """A column's numbers; NaN is a missing value where ``missing_ok``."""
         arr = checks.as_array(self.arrays[name], f"{self.where} column {name!r}", complex_ok=True)
         if np.any(arr.imag != 0):
             raise DataError(f"{self.where}: column {name!r} holds complex numbers; give H as real and imag columns")
@@ -321,9 +336,10 @@ class _Arrays:
         if arr.ndim > 2:
             raise DataError(f"{self.where}: column {name!r} has {arr.ndim} dimensions; a column is 1-D or "
                             "samples × channels")
-        bad = np.argwhere(~np.isfinite(arr))
+        bad = np.argwhere(np.isinf(arr) if missing_ok else ~np.isfinite(arr))
         if bad.size:
-            raise DataError(f"{self.where}: column {name!r} is not finite at index {tuple(int(i) for i in bad[0])}")
+            raise DataError(f"{self.where}: column {name!r} is not finite at index {tuple(int(i) for i in bad[0])}"
+                            + _MISSING_HINT.get(self.missing_hint, ""))
         return arr
 
 
@@ -401,18 +417,18 @@ class _Columns:
                             f"expected; pick one with {name}[k]")
         return chans[:, 0]
 
-    def channels(self, name: str) -> np.ndarray:
-        """A column, or a 2-D array's channels, as (N, channels)."""
+    def channels(self, name: str, missing_ok: bool = False) -> np.ndarray:
+        """A column, or a 2-D array's channels, as (N, channels); ``missing_ok``: empty cells and NaN are NaN."""
         if not isinstance(name, str):
             raise DataError(f"column names are text; got {name!r}")
         if self.src.has(name):
-            arr = self.src.get(name)
+            arr = self.src.get(name, missing_ok)
             index = None
         else:
             match = _CHANNEL.match(name)
             if not match or not isinstance(self.src, _Arrays) or not self.src.has(match.group(1)):
                 raise self._missing(name)
-            arr = self.src.get(match.group(1))
+            arr = self.src.get(match.group(1), missing_ok)
             index = int(match.group(2))
         if arr.ndim == 0:
             raise DataError(f"{self.src.where}: {name!r} is a single number, not a column of samples")
@@ -605,7 +621,9 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
     factor = time_factor(declared["time"], target)
     t = cols.vector(roles["time"]) * factor if has_time else None
     u = np.hstack([cols.channels(n) for n in inputs])
-    y = np.hstack([cols.channels(n) for n in outputs])
+    if uniform:  # an output missing in a uniform record: say how to read it (a TimeSeries takes NaN outputs)
+        src.missing_hint = "uniform"
+    y = np.hstack([cols.channels(n, missing_ok=not uniform) for n in outputs])
     with _naming(src.where):
         if not uniform:
             return TimeSeries(t, u, y, time_unit=target)

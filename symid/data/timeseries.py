@@ -36,18 +36,27 @@ def _times(t: Any) -> np.ndarray:
     return arr.astype(float)
 
 
-def _channels(x: Any, name: str, N: int) -> np.ndarray:
+def _channels(x: Any, name: str, N: int, *, missing_ok: bool = False) -> np.ndarray:
+    """``x`` as (N, channels); NaN marks a missing value where ``missing_ok`` (the outputs), never ±inf."""
     arr = checks.as_array(x, name, complex_ok=False)
     if arr.ndim == 1:
         arr = arr.reshape(-1, 1)
     if arr.ndim != 2 or arr.shape[0] != N or arr.shape[1] < 1:
         raise DataError(f"{name} must have shape ({N}, channels) or ({N},), one row per sample time; "
                         f"got shape {checks.shape_text(arr.shape)}")
-    bad = np.argwhere(~np.isfinite(arr))
+    bad = np.argwhere(np.isinf(arr) if missing_ok else ~np.isfinite(arr))
     if bad.size:
         k, j = (int(v) for v in bad[0])
+        if missing_ok:
+            raise DataError(f"{name}[{k}, {j}] is {arr[k, j]} (at t[{k}]); an output is a finite number, or NaN "
+                            "where it was not measured")
         raise DataError(f"{name}[{k}, {j}] is {arr[k, j]} (at t[{k}]); samples must be finite: drop that sample "
-                        "time or fill the gap")
+                        "time or fill the gap" + (" (the input is known at every sample time; an output not "
+                                                  "measured there is NaN)" if name == "u" else ""))
+    if missing_ok:
+        empty = np.flatnonzero(np.all(np.isnan(arr), axis=0))
+        if empty.size:
+            raise DataError(f"{name}[:, {empty[0]}] is NaN at every sample time: that output was never measured")
     return arr
 
 
@@ -57,7 +66,10 @@ class TimeSeries(DataContainer):
 
     The input is held constant from one sample time to the next (zero-order hold), as
     :class:`~symid.data.IOData` assumes for its uniform grid; ``y[k]`` is the output at
-    ``t[k]``. A free response (no input) has ``u`` all zero.
+    ``t[k]``. A free response (no input) has ``u`` all zero. An output not measured at a
+    sample time is NaN there: a time where only the input changes (an infusion that stops
+    between two blood samples) is a row with the new input and NaN outputs. Output-error
+    fitting (``method="oe"`` or ``"auto"``) leaves missing values out of its misfit.
 
     Parameters
     ----------
@@ -67,7 +79,7 @@ class TimeSeries(DataContainer):
     u : array_like, shape (N, m) or (N,)
         Input samples; ``u[k]`` acts on [t_k, t_{k+1}).
     y : array_like, shape (N, p) or (N,)
-        Output samples.
+        Output samples; NaN where an output was not measured (above).
     time_unit : str
         Unit of ``t`` (``"s"``, the default, ``"ms"``, ``"us"``, ``"min"``, ``"h"``,
         ``"d"``): the model's time unit. Reported by :meth:`summary`, kept in files.
@@ -75,8 +87,9 @@ class TimeSeries(DataContainer):
     Raises
     ------
     DataError
-        On NaN or inf (naming the sample), duplicated or decreasing times (naming the
-        pair), shapes that do not match ``t``, or fewer than two samples.
+        On NaN or inf in ``t`` or ``u``, inf in ``y`` or an output that is NaN at every
+        time (naming the sample), duplicated or decreasing times (naming the pair), shapes
+        that do not match ``t``, or fewer than two samples.
 
     Notes
     -----
@@ -105,7 +118,7 @@ class TimeSeries(DataContainer):
         if t_.size < 2:
             raise DataError(f"a time series needs at least 2 samples; got {t_.size}")
         u_ = _channels(u, "u", t_.size)
-        y_ = _channels(y, "y", t_.size)
+        y_ = _channels(y, "y", t_.size, missing_ok=True)
         object.__setattr__(self, "t", checks.frozen(t_))
         object.__setattr__(self, "u", checks.frozen(u_))
         object.__setattr__(self, "y", checks.frozen(y_))
@@ -205,6 +218,11 @@ class TimeSeries(DataContainer):
         return int(self.y.shape[1])
 
     @property
+    def n_missing(self) -> int:
+        """Number of output values not measured (NaN in ``y``)."""
+        return int(np.count_nonzero(np.isnan(self.y)))
+
+    @property
     def uniform_dt(self) -> float | None:
         """The sample time when the times are equally spaced (to 1e-12 relative), else ``None``."""
         step = np.diff(self.t)
@@ -222,5 +240,6 @@ class TimeSeries(DataContainer):
             f"  samples N   : {self.n_samples} over {self.t[0]:.6g} … {self.t[-1]:.6g} {self.time_unit}",
             f"  spacing     : {step.min():.4g} … {step.max():.4g} {self.time_unit}",
             f"  inputs m    : {self.n_inputs}, rms {', '.join(f'{v:.4g}' for v in np.sqrt(np.mean(self.u**2, 0)))}",
-            f"  outputs p   : {self.n_outputs}, rms {', '.join(f'{v:.4g}' for v in np.sqrt(np.mean(self.y**2, 0)))}",
+            f"  outputs p   : {self.n_outputs}, rms {', '.join(f'{v:.4g}' for v in np.sqrt(np.nanmean(self.y**2, 0)))}"
+            + (f" (over the measured values; {self.n_missing} missing)" if self.n_missing else ""),
         ])

@@ -418,21 +418,25 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise DataError(f"the model cannot be simulated at θ = {model.theta_dict(th)}: {exc}") from None
     x0s = sim.initial_states(th)
-    recs = sim.records
-    N = sum(r.n_samples for r in recs)
-    if M >= min(r.n_samples for r in recs):
+    recs, observed = sim.records, sim.observed
+    ys_obs = [np.where(o, r.y, np.nan) for r, o in zip(recs, observed, strict=True)]  # NaN: not measured
+    # the correlations run over the sample times where every output was measured, lags counted in those samples
+    whole = [np.all(o, axis=1) for o in observed]
+    N = int(sum(np.count_nonzero(k) for k in whole))
+    if M >= min(np.count_nonzero(k) for k in whole):
         raise DataError(f"max_lag = {M} needs records longer than {M} samples; the shortest has "
-                        f"{min(r.n_samples for r in recs)}")
-    y_all = np.vstack([r.y for r in recs])
-    e_all = np.vstack([r.y - s for r, s in zip(recs, ys, strict=True)])
-    if not np.all(np.isfinite(e_all)):
+                        f"{min(np.count_nonzero(k) for k in whole)}" + (" with every output measured"
+                                                                         if sim.n_missing else ""))
+    y_all = np.vstack(ys_obs)
+    e_all = np.vstack([y - s for y, s in zip(ys_obs, ys, strict=True)])
+    if not np.all(np.isfinite(np.vstack(ys))):
         raise DataError(f"the simulated output at θ = {model.theta_dict(th)} overflows (an unstable model?)")
-    denom = np.linalg.norm(y_all - y_all.mean(axis=0), axis=0)
+    denom = np.sqrt(np.nansum((y_all - np.nanmean(y_all, axis=0)) ** 2, axis=0))
     with np.errstate(divide="ignore", invalid="ignore"):
-        fit = 100.0 * (1.0 - np.linalg.norm(e_all, axis=0) / denom)
-    rms = np.sqrt(np.mean(e_all**2, axis=0))
-    rho_e, rho_u, rho_eu, su = _correlations([r.y - s for r, s in zip(recs, ys, strict=True)],
-                                             [r.u for r in recs], M)
+        fit = 100.0 * (1.0 - np.sqrt(np.nansum(e_all**2, axis=0)) / denom)
+    rms = np.sqrt(np.nanmean(e_all**2, axis=0))
+    rho_e, rho_u, rho_eu, su = _correlations([(y - s)[k] for y, s, k in zip(ys_obs, ys, whole, strict=True)],
+                                             [r.u[k] for r, k in zip(recs, whole, strict=True)], M)
     z = _Z[confidence]
     taus = np.arange(1, M + 1)
     q = N * (N + 2) * np.sum(rho_e[:, 1:] ** 2 / (N - taus), axis=1)
@@ -455,8 +459,11 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         notes.append("sample times are not uniform: correlation lags are in samples, not in time")
     if len(recs) > 1:
         notes.append(f"{len(recs)} records pooled (fit over all samples; correlations summed over records)")
+    if sim.n_missing:
+        notes.append(f"{sim.n_missing} output value(s) not measured (NaN): left out of the fit; the correlations "
+                     f"run over the {N} sample times where every output was measured")
     return Validation(parameter_names=tuple(model.parameter_names), theta=th, fit_percent=fit, rms_error=rms,
-                      t=tuple(r.t for r in recs), u=tuple(r.u for r in recs), y=tuple(r.y for r in recs),
+                      t=tuple(r.t for r in recs), u=tuple(r.u for r in recs), y=tuple(ys_obs),
                       y_sim=tuple(ys), initial_states=tuple(x0s), lags=np.arange(M + 1), autocorrelation=rho_e,
                       auto_band=float(z / np.sqrt(N)), whiteness_q=q, whiteness_p=q_p,
                       cross_lags=np.arange(-M, M + 1), cross_correlation=rho_eu, cross_band=cross_band,

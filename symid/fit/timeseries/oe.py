@@ -49,6 +49,7 @@ import casadi as ca
 import numpy as np
 from scipy.optimize import least_squares
 
+from symid.data.timeseries import TimeSeries
 from symid.engine.ipopt import (
     GAUSS_NEWTON,
     HESSIANS,
@@ -265,6 +266,12 @@ class OutputError(Estimator, FisherInformation):
                  solver: str = "trf", bounds: Any = None, variance: Any = None):
         self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
         self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
+        # outputs not measured (NaN in a TimeSeries) are left out of the misfit: weight 0, the value 0 in their place
+        self._observed = [~np.isnan(r.y) for r in self.records]
+        self.n_missing = sum(int(np.count_nonzero(~o)) for o in self._observed)
+        if self.n_missing:
+            self.records = tuple(TimeSeries(r.t, r.u, np.where(o, r.y, 0.0), r.time_unit)
+                                 for r, o in zip(self.records, self._observed, strict=True))
         if self._x0_mode == "known":
             self._x0_known = _known_states(self._x0_known, model.n_states, len(self.records))
         self.model, self.data = model, data
@@ -298,21 +305,22 @@ class OutputError(Estimator, FisherInformation):
                         "initial_state": self._x0_mode if self._x0_mode != "model" else model.initial_state_kind}
         p = model.n_outputs
         energy = sum(np.sum(r.y**2, axis=0) for r in self.records)
-        self._rms = np.sqrt(energy / sum(r.n_samples for r in self.records))
+        self._rms = np.sqrt(energy / sum(np.sum(o, axis=0) for o in self._observed))
         self._variance = None if variance is None else self._sample_variance(variance)
         if self._variance is None:  # per output channel: cost = Σ_j ‖r_j‖² / (p ‖y_j‖²)
             weights = 1.0 / (p * energy)
-            self._w = [np.broadcast_to(weights, r.y.shape) for r in self.records]
+            self._w = [np.broadcast_to(weights, r.y.shape) * o for r, o in zip(self.records, self._observed,
+                                                                                strict=True)]
         else:  # per value: cost = Σ r² / σ² over Σ y² / σ² (still 1 for ŷ = 0)
             scaled = sum(float(np.sum(r.y**2 / v)) for r, v in zip(self.records, self._variance, strict=True))
-            self._w = [1.0 / (v * scaled) for v in self._variance]
+            self._w = [o / (v * scaled) for v, o in zip(self._variance, self._observed, strict=True)]
             # the weighted misfit that noise of the given variance leaves at the truth, Σ w σ² (= values / scaled)
             self._variance_floor = sum(float(np.sum(w * v)) for w, v in zip(self._w, self._variance, strict=True))
             self.cost_kind = WEIGHTED_COST_KIND  # type: ignore[misc]
         self._sw = [np.sqrt(w) for w in self._w]
         self.options["variance"] = None if variance is None else "given"
         self._estimate_x0 = self._x0_mode == "estimate"
-        values = sum(r.n_samples * r.n_outputs for r in self.records)
+        values = self.n_data()
         if values < self.n_unknowns():
             x0_part = (f" and {model.n_states} initial-state value(s) per record × {len(self.records)}"
                        if self._estimate_x0 else "")
@@ -326,6 +334,12 @@ class OutputError(Estimator, FisherInformation):
         self._solvers: dict[int, ScaledIpopt] = {}
         self._jacobian_fns: dict[int, Any] = {}
         self._graphs: dict[int, tuple[Any, Any, Any]] = {}  # (v, q, r) per number of squarings, built once
+
+    @property
+    def observed(self) -> list[np.ndarray]:
+        """Per record, (N, p) booleans: True where the output was measured (False where it was NaN; ``records``
+        hold 0 there, with weight 0)."""
+        return list(self._observed)
 
     @property
     def noise_floor(self) -> float | None:  # type: ignore[override]
@@ -358,7 +372,8 @@ class OutputError(Estimator, FisherInformation):
             where = f"the output y of record {e}" if len(self.records) > 1 else "the output y"
             arr = broadcast_noise(variance if items is None else items[e], (r.n_samples, r.n_outputs), where,
                                   name="variance", check=False, error=OptionError)
-            bad = ~(np.isfinite(arr) & (arr > 0))
+            bad = ~(np.isfinite(arr) & (arr > 0)) & self._observed[e]  # a missing value needs no variance
+            arr = np.where(self._observed[e], arr, 1.0)
             if bad.any():
                 k, j = (int(i) for i in np.argwhere(bad)[0])
                 rec = "" if items is None else f" of record {e}"
@@ -412,16 +427,18 @@ class OutputError(Estimator, FisherInformation):
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
         """Residuals y − ŷ in time order (records one after the other), each channel divided by its rms (by σ of
-        each value with ``variance``)."""
+        each value with ``variance``); a sample time where an output is missing is left out."""
         sims = self.simulate(theta)
         if self._variance is not None:
-            return np.vstack([(r.y - s) / np.sqrt(v) for r, s, v in zip(self.records, sims, self._variance,
-                                                                        strict=True)])
-        return np.vstack([(r.y - s) / self._rms for r, s in zip(self.records, sims, strict=True)])
+            out = [(r.y - s) / np.sqrt(v) for r, s, v in zip(self.records, sims, self._variance, strict=True)]
+        else:
+            out = [(r.y - s) / self._rms for r, s in zip(self.records, sims, strict=True)]
+        # the sample times where every output was measured (a missing value has no residual)
+        return np.vstack([x[np.all(o, axis=1)] for x, o in zip(out, self._observed, strict=True)])
 
     def n_data(self) -> int:
-        """Number of measured output values."""
-        return int(sum(r.n_samples * r.n_outputs for r in self.records))
+        """Number of measured output values (missing ones not counted)."""
+        return int(sum(np.count_nonzero(o) for o in self._observed))
 
     def n_unknowns(self) -> int:
         """θ plus the estimated initial states."""
@@ -769,7 +786,11 @@ class OutputError(Estimator, FisherInformation):
         std, given = [], []
         for e, r in enumerate(self.records):
             arr = broadcast_noise(noise_std if items is None else items[e], (r.n_samples, r.n_outputs),
-                                  f"the output y of record {e}" if len(self.records) > 1 else "the output y")
+                                  f"the output y of record {e}" if len(self.records) > 1 else "the output y",
+                                  check=False)
+            arr = np.where(self._observed[e], arr, 1.0)  # a missing value needs no noise level
+            if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+                raise DataError("noise_std must be finite and > 0 everywhere (a standard deviation in data units)")
             std.append((arr * self._sw[e]).T.reshape(-1))  # channel by channel, as the residual
             given.append(arr.reshape(-1))
         return np.concatenate(std), np.concatenate(given)

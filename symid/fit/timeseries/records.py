@@ -60,8 +60,9 @@ def as_records(model: Any, data: Any, *, estimate_x0: bool | None = None) -> tup
             raise DataError(f"{where} has {ts.n_inputs} input(s) and {ts.n_outputs} output(s); the model has "
                             f"{model.n_inputs} input(s) and {model.n_outputs} output(s) "
                             "(a free response still needs u, all zero)")
-        if estimate_x0 and ts.n_samples * ts.n_outputs <= model.n_states:
-            raise DataError(f"{where} holds {ts.n_samples} sample(s) of {ts.n_outputs} output(s), too few to "
+        if estimate_x0 and ts.n_samples * ts.n_outputs - ts.n_missing <= model.n_states:
+            raise DataError(f"{where} holds {ts.n_samples * ts.n_outputs - ts.n_missing} measured output value(s), "
+                            f"too few to "
                             f"estimate its initial state of {model.n_states} values on top of θ: record longer, "
                             "or give x0 (known numbers or an expression in θ)")
         out.append(ts)
@@ -69,7 +70,7 @@ def as_records(model: Any, data: Any, *, estimate_x0: bool | None = None) -> tup
     if len(units) > 1:
         raise DataError(f"the records' times are in different units ({', '.join(units)}): one θ has one time unit; "
                         "rewrite the records in one unit")
-    energy = sum(np.sum(ts.y**2, axis=0) for ts in out)
+    energy = sum(np.nansum(ts.y**2, axis=0) for ts in out)  # NaN: an output not measured at that time
     zero = np.flatnonzero(energy == 0)
     if zero.size:
         raise DataError(f"output {zero[0]} is zero in every record: there is nothing to fit it to")

@@ -37,7 +37,7 @@ def _uniform(record: Any) -> IOData | None:
     """The record as an IOData, or None when its samples are not uniform or its input is zero."""
     if isinstance(record, TimeSeries):
         dt = record.uniform_dt
-        if dt is None:
+        if dt is None or record.n_missing:
             return None
         record = IOData(u=record.u, y=record.y, dt=dt, time_unit=record.time_unit)
     if not isinstance(record, IOData) or not np.any(record.u):

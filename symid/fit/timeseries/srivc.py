@@ -52,7 +52,7 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 
-from symid.errors import ModelError, OptionError
+from symid.errors import DataError, ModelError, OptionError
 from symid.fit.options import check_choice, check_float, check_int, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import budget_message
@@ -339,6 +339,10 @@ class SimplifiedRIVC(JudgedOnSamples):
         self.model, self.data = model, data
         self.poly = transfer_polynomials(model)
         records = self.samples.records
+        if self.samples.n_missing:
+            raise DataError(f"{self.samples.n_missing} output value(s) are missing (NaN): method {self.method!r} "
+                            "filters every output sample; method='oe' or 'auto' leaves missing values out of its "
+                            "misfit")
         dt = float(np.median(np.concatenate([np.diff(r.t) for r in records])))
         self._init = check_choice("init", init, _INITS)
         self._lambda = (0.1 / dt if bandwidth is None

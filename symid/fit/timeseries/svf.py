@@ -36,7 +36,7 @@ from typing import Any, ClassVar
 import numpy as np
 import scipy.linalg
 
-from symid.errors import ModelError, OptionError
+from symid.errors import DataError, ModelError, OptionError
 from symid.fit.options import check_choice, check_float, check_int, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import budget_message
@@ -155,6 +155,10 @@ class StateVariableFilter(JudgedOnSamples):
         self.model, self.data = model, data
         self._kind = _check_model(model)
         records = self.samples.records
+        if self.samples.n_missing:
+            raise DataError(f"{self.samples.n_missing} output value(s) are missing (NaN): method {self.method!r} "
+                            "filters every output sample; method='oe' or 'auto' leaves missing values out of its "
+                            "misfit")
         need = 3 if self._kind == "second order" else 2
         self._order = need if order is None else check_int("order", order, low=need, high=12)
         dt = float(np.median(np.concatenate([np.diff(r.t) for r in records])))
