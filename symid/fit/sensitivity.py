@@ -43,6 +43,20 @@ def _outer(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return (left[:, :, None, :, None] * np.swapaxes(right, 1, 2)[:, None, :, None, :]).reshape(s, p, m, -1)
 
 
+def _left(coef: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """(s, p, m, l) array of Σₙ coef[k, p, n]·right[s, n, m] (Cₖ R), as one matrix product."""
+    l, p, n = coef.shape
+    out = coef.reshape(l * p, n) @ right  # (s, l·p, m)
+    return out.reshape(right.shape[0], l, p, -1).transpose(0, 2, 3, 1)
+
+
+def _right(left: np.ndarray, coef: np.ndarray) -> np.ndarray:
+    """(s, p, m, l) array of Σₙ left[s, p, n]·coef[k, n, m] (L Bₖ), as one matrix product."""
+    l, n, m = coef.shape
+    out = left @ coef.transpose(1, 0, 2).reshape(n, l * m)  # (s, p, l·m)
+    return out.reshape(left.shape[0], left.shape[1], l, m).transpose(0, 1, 3, 2)
+
+
 def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndarray]:
     """H(ωᵢ, θ) and its exact derivative with respect to θ.
 
@@ -85,17 +99,27 @@ def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndar
             M, V, K, B, C = (mats[k] for k in "MVKBC")
             W = w[:, None, None]
             Z = K - W**2 * M + 1j * W * V
-            ZB = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
-            CZ = np.swapaxes(np.linalg.solve(np.swapaxes(Z, 1, 2),
-                                             np.broadcast_to(C.T.astype(complex), (w.size, *C.T.shape))), 1, 2)
+            m_in = B.shape[1]
+            if np.array_equal(M, M.T) and np.array_equal(V, V.T) and np.array_equal(K, K.T):
+                # Z is symmetric (a mechanical model): Zᵀ = Z, so Z⁻¹B and Z⁻ᵀCᵀ come from one solve
+                rhs = np.concatenate([B, C.T], axis=1).astype(complex)
+                sol = np.linalg.solve(Z, np.broadcast_to(rhs, (w.size, *rhs.shape)))
+                ZB, CZ = sol[:, :, :m_in], np.swapaxes(sol[:, :, m_in:], 1, 2)
+            else:
+                ZB = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
+                CZ = np.swapaxes(np.linalg.solve(np.swapaxes(Z, 1, 2),
+                                                 np.broadcast_to(C.T.astype(complex), (w.size, *C.T.shape))), 1, 2)
             G = C @ ZB
             # C Z⁻¹ Xₖ Z⁻¹ B for X = K, M, V: the outer products (C Z⁻¹)ₚₙ (Z⁻¹ B)ᵣₘ against the coefficients
-            # flattened over (n, r): one matrix product each, never an (s, l, n, n) array
-            outer = _outer(CZ, ZB)
+            # flattened over (n, r): one matrix product for the three, never an (s, l, n, n) array
+            l = th.size
+            KMV = _outer(CZ, ZB) @ np.concatenate([_flat(maps["K"]), _flat(maps["M"]), _flat(maps["V"])], axis=1)
             wc = w[:, None, None, None]
-            dG = (np.einsum("kpn,snm->spmk", _coef(maps["C"]), ZB)
-                  - outer @ _flat(maps["K"]) + wc**2 * (outer @ _flat(maps["M"])) - 1j * wc * (outer @ _flat(maps["V"]))
-                  + np.einsum("spn,knm->spmk", CZ, _coef(maps["B"])))
+            dG = -KMV[..., :l] + wc**2 * KMV[..., l:2 * l] - 1j * wc * KMV[..., 2 * l:]
+            if not maps["C"].is_constant:  # gains in C (most models measure a known combination of states)
+                dG = dG + _left(_coef(maps["C"]), ZB)
+            if not maps["B"].is_constant:
+                dG = dG + _right(CZ, _coef(maps["B"]))
             f = {"position": np.ones(w.size, complex), "velocity": 1j * w,
                  "acceleration": -(w**2) + 0j}[model.output]
             return f[:, None, None] * G, f[:, None, None, None] * dG
@@ -106,9 +130,11 @@ def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndar
         CR = np.swapaxes(np.linalg.solve(np.swapaxes(Zs, 1, 2),
                                          np.broadcast_to(C.T.astype(complex), (w.size, *C.T.shape))), 1, 2)
         H = C @ RB + D
-        dH = (np.einsum("kpn,snm->spmk", _coef(maps["C"]), RB)
-              + _outer(CR, RB) @ _flat(maps["A"])
-              + np.einsum("spn,knm->spmk", CR, _coef(maps["B"])))
+        dH = _outer(CR, RB) @ _flat(maps["A"])
+        if not maps["C"].is_constant:
+            dH = dH + _left(_coef(maps["C"]), RB)
+        if not maps["B"].is_constant:
+            dH = dH + _right(CR, _coef(maps["B"]))
         if "D" in maps:
             dH = dH + np.moveaxis(_coef(maps["D"]), 0, -1)[None]
         return H, dH
