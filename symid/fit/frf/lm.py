@@ -643,7 +643,8 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 "repeated": f"{_REPEATS} of {passes} passes ended at the same best misfit"}[status]
         out = self.outcome(start, best.theta, finished=status not in ("time_limit", "stopped"), status=status,
                            message=f"{what}; {total_nfev} evaluations; best misfit {best.cost:.3e}{chain_note}"
-                                   f"{rescue}{moved}{self._on_bounds(best.theta)}",
+                                   f"{rescue}{moved}{self._on_bounds(best.theta)}"
+                                   f"{self._at_edge(best.theta, centre, unit)}",
                            iterations=total_nfev, wall_time=wall)
         others = tuple(c for c in visited if c is not best)
         return dataclasses.replace(out, passes=others) if others else out
@@ -655,6 +656,23 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         except (ModelError, np.linalg.LinAlgError, ValueError):
             return False
         return bool(unc.near_singular)
+
+    def _edge(self, theta: np.ndarray, centre: np.ndarray, unit: np.ndarray) -> np.ndarray:
+        """The positive parameters θ has run to the solver's limit, 1e6 times their start (not a user's bound)."""
+        edge = self._positive & (np.abs(self._phi(theta, centre, unit)) >= _LOG_BOX * (1 - 1e-9))
+        if self._bounded:  # an edge of the user's bounds is theirs (on_bounds), not a parameter run off
+            edge &= ~(np.isclose(theta, self.lower, rtol=1e-9, atol=0)
+                      | np.isclose(theta, self.upper, rtol=1e-9, atol=0))
+        return edge
+
+    def _at_edge(self, theta: np.ndarray, centre: np.ndarray, unit: np.ndarray) -> str:
+        """The message's warning for parameters at the solver's limit ('' if none)."""
+        edge = self._edge(theta, centre, unit)
+        if not edge.any():
+            return ""
+        names = ", ".join(n for n, e in zip(self.model.parameter_names, edge, strict=True) if e)
+        return (f"; {names} stopped at 1e6 times the start, the solver's limit: a limit the passes ran into rather "
+                f"than a minimum; a start nearer the typical values (x0= or scale=) may fit better")
 
     def _saturated(self, theta: np.ndarray) -> np.ndarray:
         """The positive parameters the response does not feel at θ (choice 9): their column of the Jacobian
@@ -676,11 +694,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         is left). ``nfev``: the evaluations so far, for the outcomes' counts."""
         if deadline is not None and time.perf_counter() >= deadline:
             return None
-        phi = self._phi(best.theta, centre, unit)
-        edge = self._positive & (np.abs(phi) >= _LOG_BOX * (1 - 1e-9))  # run to 1e6 × their start
-        if self._bounded:  # an edge of the user's bounds is theirs (on_bounds), not a parameter run off
-            edge &= ~(np.isclose(best.theta, self.lower, rtol=1e-9, atol=0)
-                      | np.isclose(best.theta, self.upper, rtol=1e-9, atol=0))
+        edge = self._edge(best.theta, centre, unit)  # run to 1e6 × their start
         which = edge | (self._saturated(best.theta) if self._near_singular(best.theta) else False)
         if not which.any():
             return None
