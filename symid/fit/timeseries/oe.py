@@ -82,11 +82,11 @@ from symid.fit.uncertainty import FisherInformation, broadcast_noise
 __all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "WEIGHTED_COST_KIND", "OutputError"]
 
 SOLVERS = ("ipopt", "trf")
+"""The ``solver`` choices of :class:`OutputError`."""
 
 WEIGHTED_COST_KIND = ("weighted relative output misfit to the measured samples Σ (y − ŷ)²/σ² / Σ y²/σ², σ² the given "
                       "variance")
 """The misfit's name when ``variance=`` weighs every output value."""
-"""The ``solver`` choices of :class:`OutputError`."""
 
 _LOG_BOX = math.log(1e8)  # "trf": |φₖ| ≤ log 1e8 for a parameter kept positive, no estimate beyond 1e8 × its start
 
