@@ -40,7 +40,8 @@ def _within(solution: dict[str, float], bounds: dict[str, list[float]] | None) -
 
 
 def _outside_text(outside: list[dict[str, float]], bounds: dict[str, list[float]], names: list[str]) -> str:
-    """'unique within the bounds: the other solution (m = 620.4, …) has kr = 3e5 beyond its upper bound 2e5'."""
+    """'the other parameter values with this estimate's response (m = 620.4, …) have kr = 3e+05 above its upper
+    bound 2e+05' (the reason the estimate is unique within the bounds)."""
     sol = outside[0]
     beyond = []
     for name, (lo, hi) in bounds.items():
@@ -50,8 +51,7 @@ def _outside_text(outside: list[dict[str, float]], bounds: dict[str, list[float]
             beyond.append(f"{name} = {sol[name]:.6g} above its upper bound {hi:g}")
     values = ", ".join(f"{n} = {sol[n]:.6g}" for n in names)
     more = f" ({len(outside) - 1} more, outside them too)" if len(outside) > 1 else ""
-    return (f"unique within the bounds: the other parameter values with this estimate's response ({values}) have "
-            f"{'; '.join(beyond)}{more}")
+    return f"the other parameter values with this estimate's response ({values}) have {'; '.join(beyond)}{more}"
 
 
 def _nearest(others: list[dict[str, float]] | None, theta: np.ndarray, unc: Any) -> str:
