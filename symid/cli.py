@@ -126,9 +126,8 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
     spec = load_model(args.model)
     if args.json:
-        import json
 
-        print(json.dumps(spec.to_dict(), indent=2, default=_json_default))
+        _print_json(spec.to_dict())
     else:
         print(spec.summary())
     return 0
@@ -396,12 +395,11 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     written = (_write_identify(out, spec, model, data, res, truth, args, validation=validation)
                if out is not None else [])
     if args.json:
-        import json
 
         doc = {"model": spec.name, "data": source, "known": spec.known, "result": res.to_dict(),
                "fitted": fitted, "outside_bounds": {k: v[0] for k, v in outside.items()},
                "exit_status": code, "written": [str(p) for p in written]}
-        print(json.dumps(doc, indent=2, default=_json_default))
+        _print_json(doc)
     return code
 
 
@@ -409,14 +407,14 @@ NO_FIT = 4
 """Exit status of ``symid identify`` when it ran and wrote its result but no start fitted the data."""
 
 
-def _json_default(value):
-    import numpy as np
+def _print_json(obj) -> None:
+    """Standard JSON on standard output, as the files --out writes: numpy values as numbers and lists, NaN and
+    ±inf (an infinite standard error, say) as null, so that any JSON reader (jq, JavaScript) takes it."""
+    import json
 
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+    from symid.runlog import json_safe
+
+    print(json.dumps(json_safe(obj), indent=2, allow_nan=False))
 
 
 def _time_series_validation(model, data, res, args):
@@ -496,9 +494,8 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     if out is not None:
         _write_compare(out, cmp)
     if args.json:
-        import json
 
-        print(json.dumps(cmp.to_dict(), indent=2, default=_json_default))
+        _print_json(cmp.to_dict())
     return 0
 
 
@@ -522,9 +519,8 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
                              timeout=args.timeout, exact_count=args.exact_count, seed=args.seed,
                              engine=args.engine)
     if args.json:
-        import json
 
-        print(json.dumps(report.to_dict(), indent=2, default=_json_default))
+        _print_json(report.to_dict())
     else:
         print(report.summary())
     return 0

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import symid as si
 from symid.cli import NO_FIT, build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,7 +51,6 @@ def test_unknown_model_is_a_clear_error(capsys):
 
 def test_identify_writes_results(tmp_path, capsys):
     data = tmp_path / "frf.csv"
-    import symid as si
 
     entry = si.load_model("belt_drive")
     entry.data().to_csv(data)
@@ -113,7 +113,6 @@ def test_compare_scr_polish_ipopt(capsys):
 def test_data_that_does_not_fit_the_model_is_a_clear_error(tmp_path, capsys):
     import numpy as np
 
-    import symid as si
 
     path = tmp_path / "two_outputs.npz"
     si.FrequencyData(np.array([0.4, 0.5, 0.6]), np.ones((3, 2, 1), dtype=complex)).to_npz(path)
@@ -397,3 +396,22 @@ def test_a_long_estimate_is_seen_to_be_alive(capsys):
     with _Heartbeat("auto, 1 start"):  # a run shorter than `after` says nothing
         pass
     assert "still estimating" not in capsys.readouterr().err
+
+
+def _strict(text):
+    """json.loads that refuses NaN and Infinity, as jq or a JavaScript reader would."""
+    def refuse(name):
+        raise ValueError(f"non-standard JSON constant {name}")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_json_output_is_standard_json(capsys):
+    """An open bound (k1 = 0.5: has no upper side, inf) and infinite values anywhere in the
+    result are written as null, as result.json does, so that any JSON reader (jq, JavaScript) takes the --json
+    output; json.dumps alone writes Infinity, which they refuse."""
+    code = main(["identify", "mass_damper_2dof", "--method", "lm", "--known", "m1=1", "m2=1", "--bounds",
+                 "k1=0.5:", "--json"])
+    doc = _strict(capsys.readouterr().out)
+    assert code == 0 and doc["result"]["options"]["bounds"]["k1"] == [0.5, None]  # an open upper side: null
+    assert main(["identifiability", "mass_damper_2dof", "--json"]) == 0
+    _strict(capsys.readouterr().out)
