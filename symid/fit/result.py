@@ -89,11 +89,13 @@ def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
 
 def _plain(value: Any) -> Any:
     """An option's value as plain JSON-ready Python: numbers, strings, lists and dicts of them kept (numpy's as
-    Python's), anything else as its ``repr``."""
-    if isinstance(value, (bool, int, float, str, type(None))):
+    Python's; NaN and ±inf, an open bound, as None), anything else as its ``repr``."""
+    if isinstance(value, float):
+        return value if np.isfinite(value) else None
+    if isinstance(value, (bool, int, str, type(None))):
         return value
     if isinstance(value, np.generic):
-        return value.item()
+        return _plain(value.item())
     if isinstance(value, np.ndarray):
         return _plain(value.tolist())
     if isinstance(value, (list, tuple)):
