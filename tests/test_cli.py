@@ -415,3 +415,26 @@ def test_json_output_is_standard_json(capsys):
     assert code == 0 and doc["result"]["options"]["bounds"]["k1"] == [0.5, None]  # an open upper side: null
     assert main(["identifiability", "mass_damper_2dof", "--json"]) == 0
     _strict(capsys.readouterr().out)
+
+
+def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
+    """--option 'variance={"proportional": …, "additive": …}': the combined error model of a concentration
+    record, read from the user's own CSV (an infusion stopping between samples, the stop a row with no output)."""
+    (tmp_path / "pk.py").write_text(
+        "import symid as si\n"
+        "k, q = si.parameters('k q', positive=True)\n"
+        "model = si.StateSpaceModel(A=[[-k]], B=[[1]], C=[[q]])\n"
+        "start = {'k': 0.5, 'q': 0.1}\n")
+    k, q = si.parameters("k q", positive=True)
+    t = np.array([0.0, 0.5, 0.75, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0])
+    u = np.where(t < 0.75, 100.0, 0.0)
+    y = si.simulate_io(si.StateSpaceModel(A=[[-k]], B=[[1]], C=[[q]]), {"k": 0.3, "q": 0.05},
+                       np.where(np.arange(0, 12.0001, 0.25) < 0.75, 100.0, 0.0), 0.25).y[(t / 0.25).astype(int), 0]
+    rows = "\n".join(f"{a},{b},{'' if a == 0.75 else repr(float(c))}" for a, b, c in zip(t, u, y, strict=True))
+    (tmp_path / "pk.csv").write_text(f"# units: t [h], dose [mg/h], conc [mg/L]\nt,dose,conc\n{rows}\n")
+    code = main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), "--columns", "time=t",
+                 "input=dose", "output=conc", "--units", "time=h", "--time-unit", "h", "--kind", "TimeSeries",
+                 "--option", 'variance={"proportional": 0.02, "additive": 0.01}', "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and doc["result"]["cost_kind"].startswith("weighted relative output misfit")
+    np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["q"]], [0.3, 0.05], rtol=1e-6)

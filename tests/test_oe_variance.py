@@ -127,3 +127,31 @@ def test_a_complex_or_text_variance_is_an_option_error(record, bad):
     io, _ = record
     with pytest.raises(OptionError, match=r"variance (holds complex numbers|must be a number)"):
         prepare(ONE, io, "oe", {"variance": bad})
+
+
+def test_an_error_model_gives_the_variance_from_the_measured_values(record):
+    """{"proportional": a, "additive": b} is σ² = (a·y)² + b² from the measured y: the same fit as that array
+    (rtol 1e-12), and the same for every record of a list."""
+    io, clean = record
+    model = {"proportional": 0.05, "additive": 0.01}
+    by_model = prepare(ONE, io, "oe", {"variance": model})
+    by_array = prepare(ONE, io, "oe", {"variance": (0.05 * io.y) ** 2 + 0.01**2})
+    theta = np.array([0.12, 0.2])
+    np.testing.assert_allclose(by_model.misfit(theta), by_array.misfit(theta), rtol=1e-12)
+    other = si.IOData(io.u, clean.y * 1.02, 1.0)
+    both = prepare(ONE, [io, other], "oe", {"variance": model})
+    listed = prepare(ONE, [io, other], "oe", {"variance": [(0.05 * r.y) ** 2 + 0.01**2 for r in (io, other)]})
+    np.testing.assert_allclose(both.misfit(theta), listed.misfit(theta), rtol=1e-12)
+
+
+@pytest.mark.parametrize(("model", "match"), [
+    ({"proportional": 0.05, "extra": 1.0}, r"keys 'proportional' and 'additive' .* got 'extra'"),
+    ({"proportional": -0.05}, r"proportional must be a finite number ≥ 0"),
+    ({"additive": "1"}, r"additive must be a finite number ≥ 0"),
+    ({"proportional": 0.0}, r"proportional = additive = 0 has no noise"),
+    ({"proportional": 0.05}, r"sample 0, output 0 \(it is 0\) no noise; add an additive part"),
+])
+def test_a_bad_error_model_is_named(record, model, match):
+    io, _ = record  # its first concentration is 0 (before the infusion acts)
+    with pytest.raises(OptionError, match=match):
+        prepare(ONE, io, "oe", {"variance": model})

@@ -79,7 +79,8 @@ from symid.fit.timeseries.response import balancing, casadi_output, simulate_out
 from symid.fit.timeseries.sensitivity import output_sensitivity, state_space_derivatives
 from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
-__all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "WEIGHTED_COST_KIND", "OutputError"]
+__all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "WEIGHTED_COST_KIND", "OutputError",
+           "error_model_variance"]
 
 SOLVERS = ("ipopt", "trf")
 """The ``solver`` choices of :class:`OutputError`."""
@@ -160,6 +161,46 @@ def _known_states(value: Any, n: int, n_records: int) -> list[np.ndarray]:
     return out
 
 
+def error_model_variance(model: dict[str, Any], y: np.ndarray) -> np.ndarray:
+    """The variance of every measured value of ``y`` under an error model ``{"proportional": a, "additive": b}``:
+    σ² = (a·y)² + b², the combined error model of pharmacokinetics (either part may be left out).
+
+    Raises
+    ------
+    OptionError
+        On other keys, values that are not finite numbers ≥ 0, both parts 0, or a proportional-only model
+        where a measured value is 0 (its variance would be 0: add an additive part).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.timeseries.oe import error_model_variance
+    >>> error_model_variance({"proportional": 0.1, "additive": 0.5}, np.array([[10.0], [0.0]])).ravel().tolist()
+    [1.25, 0.25]
+    """
+    unknown = sorted(set(model) - {"proportional", "additive"})
+    if unknown:
+        raise OptionError(f"variance: an error model has the keys 'proportional' and 'additive' (σ² = (a·y)² + b²); "
+                          f"got {unknown[0]!r}")
+    parts = {}
+    for key in ("proportional", "additive"):
+        value = model.get(key, 0.0)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                or not math.isfinite(float(value)) or float(value) < 0:
+            raise OptionError(f"variance: {key} must be a finite number ≥ 0 (a relative or an absolute standard "
+                              f"deviation); got {value!r}")
+        parts[key] = float(value)
+    if parts["proportional"] == 0 and parts["additive"] == 0:
+        raise OptionError("variance: an error model with proportional = additive = 0 has no noise; give one of them")
+    var = (parts["proportional"] * y) ** 2 + parts["additive"] ** 2
+    if parts["additive"] == 0 and np.any(var == 0):
+        k, j = (int(i) for i in np.argwhere(var == 0)[0])
+        raise OptionError(f"variance: the proportional error model gives the value for sample {k}, output {j} (it is "
+                          f"0) no noise; add an additive part, e.g. {{'proportional': {parts['proportional']:g}, "
+                          f"'additive': …}} in the output's units")
+    return var
+
+
 class OutputError(Estimator, FisherInformation):
     """Output-error estimation on sampled records: trust-region least squares (default) or IPOPT, per start.
 
@@ -195,18 +236,20 @@ class OutputError(Estimator, FisherInformation):
         be interrupted), then Gauss–Newton (3 s and 16 s to build there). The exact
         Hessian converges from more starts (time-series population, n = 2, 3: one
         output-error run 18 of 32 against 12 of 32), Gauss–Newton fits in the budget.
-    variance : float or array_like, optional
-        The noise variance σ² of every measured output value, in the output's units
-        squared: a number, one per sample (N,), one per output (1, p), (N, p), or a list of
-        such, one per record. The fit then minimises Σ (y − ŷ)²/σ² (relative to Σ y²/σ²),
-        the maximum-likelihood criterion for independent Gaussian noise: noise that grows
-        with the signal (a concentration measured to 5 %) weighs the small values as the
+    variance : float, array_like or dict, optional
+        The noise variance σ² of every measured output value, in the output's units squared: a
+        number, one per sample (N,), one per output (1, p), (N, p), or a list of such, one per
+        record; or an error model ``{"proportional": a, "additive": b}``, σ² = (a·y)² + b² from
+        the measured values (:func:`error_model_variance`; on the command line
+        ``--option 'variance={"proportional": 0.05}'``). The fit then minimises Σ (y − ŷ)²/σ² (relative to
+        Σ y²/σ²), the maximum-likelihood criterion for independent Gaussian noise: noise that
+        grows with the signal (a concentration measured to 5 %) weighs the small values as the
         large ones. Only the shape matters to the estimate. The level judges the fit: unless
-        ``noise_floor`` is given, the fit succeeds when its weighted misfit is within what
-        noise of this variance leaves (Σ σ²/σ² over Σ y²/σ², χ² 99.9 % bound), as for a
-        frequency response's ``variance``. For the intervals the level is estimated from
-        the residuals (in units of the given σ) unless ``noise_std`` is given to
-        :func:`symid.identify`. Default: each output weighted by its energy.
+        ``noise_floor`` is given, the fit succeeds when its weighted misfit is within what noise
+        of this variance leaves (Σ σ²/σ² over Σ y²/σ², χ² 99.9 % bound), as for a frequency
+        response's ``variance``. For the intervals the level is estimated from the residuals (in
+        units of the given σ) unless ``noise_std`` is given to :func:`symid.identify`. Default:
+        each output weighted by its energy.
     solver : {"ipopt", "trf"}, optional
         ``"trf"`` (default): SciPy's trust-region reflective least squares
         (``scipy.optimize.least_squares``) on log-parameters (θₖ = sₖ·exp(φₖ) for a
@@ -358,7 +401,13 @@ class OutputError(Estimator, FisherInformation):
 
     def _sample_variance(self, variance: Any) -> list[np.ndarray]:
         """``variance`` as one (N, p) array per record: a number, an array (N,) per sample, (1, p) per output or
-        (N, p), or a list of such, one per record; every value finite and > 0."""
+        (N, p), or a list of such, one per record, or an error model (:func:`error_model_variance`); every
+        value finite and > 0."""
+        if isinstance(variance, dict):
+            variance = [error_model_variance(variance, np.where(o, r.y, np.nan))
+                        for r, o in zip(self.records, self._observed, strict=True)]
+            if len(variance) == 1:
+                variance = variance[0]
         items = variance if isinstance(variance, (list, tuple)) and len(self.records) > 1 else None
         if items is not None and len(items) != len(self.records):
             raise OptionError(f"variance is a list of {len(items)}; there are {len(self.records)} records")
