@@ -288,9 +288,12 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
     ([(None, 'time', 's')], [('t_ms', 'time', 's')])
     >>> _stated_units("# units: t [s], u [mg/h]", {"t": "time", "u": ""})
     [('t', 'time', 's')]
+    >>> _stated_units("# exported by X; units: f_Hz [Hz]", {"f_Hz": "frequency"})
+    [('f_Hz', 'frequency', 'Hz')]
     """
     text = comment.lstrip("#").strip()
-    head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE)
+    head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE) or \
+        re.search(r"\bunits?\s*[:=]\s*", text, flags=re.IGNORECASE)  # "exported by X; units: ..." too
     body = text[head.end():] if head else text
     out: list[tuple[str | None, str, str]] = []
     for item in _split_items(body):
