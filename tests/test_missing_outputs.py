@@ -130,3 +130,15 @@ def test_both_solvers_leave_the_missing_value_out_alike():
     trf = si.identify(PK, infusion(), method="oe", x0=START)
     ipopt = si.identify(PK, infusion(), method="oe", solver="ipopt", x0=START)
     np.testing.assert_allclose(ipopt.theta_vector, trf.theta_vector, rtol=1e-6)
+
+
+def test_without_the_switch_row_the_infusion_is_misplaced():
+    """The same record without the row at the stop time: the input is held to the next sample (1 h instead of
+    0.75 h), a third more drug than was given, and output error cannot fit it (measured: k12 = 114 for 0.5, the
+    fit refused). The row with a NaN output is what places the switch."""
+    rec = infusion()
+    keep = ~np.isnan(rec.y[:, 0])
+    dropped = TimeSeries(rec.t[keep], rec.u[keep], rec.y[keep], time_unit="h")
+    res = si.identify(PK, dropped, method="oe", x0=START)
+    err = np.abs(res.theta_vector / np.array(list(TRUTH.values())) - 1)
+    assert not res.success and err.max() > 1.0
