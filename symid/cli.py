@@ -600,7 +600,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="typical magnitude of every free parameter (or one number for all), for the methods "
                         "that take scale= (the unknowns become θ / scale)")
     g.add_argument("--bounds", nargs="+", metavar="NAME=LOW:HIGH",
-                   help="plausible ranges (either end may be empty): the start must lie inside; the methods "
+                   help="plausible ranges (either end may be empty, an open side; a parameter's range here "
+                        "replaces the model file's for it, both ends): the start must lie inside; the methods "
                         "that take bounds= (auto, lm, oe, ipopt) keep the estimate inside and say which parameters "
                         "sit on a bound; for the others an estimate outside is reported")
     g = p.add_argument_group("method options (an option the method does not take is an error naming the flag)")

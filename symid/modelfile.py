@@ -483,7 +483,13 @@ def _known_values(value: Any, model: Any, what: str) -> dict[str, float]:
     if unknown:
         raise ModelError(f"{what} names {', '.join(map(repr, unknown))}, not a parameter of the model "
                          f"({', '.join(model.parameter_names)})")
-    return {k: _number(v, f"{what} {k}") for k, v in given.items()}
+    out = {k: _number(v, f"{what} {k}") for k, v in given.items()}
+    positive = dict(zip(model.parameter_names, model.positive, strict=True))
+    bad = [k for k, v in out.items() if positive[k] and v < 0]
+    if bad:
+        raise ModelError(f"{what} {bad[0]} = {out[bad[0]]:g}, but {bad[0]} is declared positive; give its value ≥ 0 "
+                         f"(or declare it without positive=True)")
+    return out
 
 
 def _check_free(given: Mapping[str, Any], free: Sequence[str], known: Mapping[str, float], what: str) -> None:

@@ -155,3 +155,16 @@ def test_a_bound_that_holds_one_parameter_back_slightly_withholds_only_its_inter
     assert np.all(np.isnan(ci[2])) and np.all(np.isfinite(ci[:2]))
     assert ci[0, 0] <= TRUTH["m"] <= ci[0, 1] and ci[1, 0] <= TRUTH["c"] <= ci[1, 1]
     assert "pull it slightly beyond them" in res.uncertainty.note and "k (upper)" in res.uncertainty.note
+
+
+def test_the_interval_of_a_parameter_on_its_bound_is_cut_there():
+    """k's upper bound at the truth, 1 % noise, seed 2: the least-squares k lies 0.1 SE beyond it, θ̂ sits on it
+    and its interval would reach past the bound (a new user's trial); it is cut there, and the note says so."""
+    noisy = si.simulate_frf(MODEL, TRUTH, W, noise=0.01, seed=2)
+    res = si.identify(MODEL, noisy, method="lm", bounds={"k": (1e3, 3e4)}, x0=[2.0, 0.5, 2.5e4],
+                      identifiability_check=False)
+    assert res.on_bounds == {"k": "upper"}
+    ci = res.uncertainty.intervals
+    assert ci[2, 1] == 3e4 and ci[2, 0] < 3e4 and np.all(np.isfinite(ci))
+    assert "the intervals of k (upper; the data alone would reach" in res.uncertainty.note
+    assert res.success and "ON BOUNDS: k (upper); the fit is accepted" in res.summary()  # said even for a fit

@@ -202,6 +202,11 @@ def test_a_unit_in_a_frequency_tables_names_is_checked(tmp_path):
     frf = FrequencyData.from_table(path, columns=columns, units={"frequency": "rad/s", "magnitude": "dB",
                                                                   "phase": "deg"})
     np.testing.assert_allclose(frf.w, [1.0, 2.0], rtol=1e-15)
+    renamed = write_csv(tmp_path / "frf2.csv", ["freq_rad_s,mag_dB,ph_deg", "1,-20,-90", "2,-26,-95"])
+    with pytest.raises(si.DataError, match="named 'freq_rad_s', which states rad/s, but the frequency unit declared "
+                                           "is Hz"):
+        FrequencyData.from_table(renamed, columns={**columns, "frequency": "freq_rad_s"},
+                                 units={"frequency": "Hz", "magnitude": "dB", "phase": "deg"})
     with pytest.raises(si.DataError, match="named 'mag_dB', which states dB, but the magnitude unit declared is "
                                            "linear"):
         FrequencyData.from_table(path, columns=columns, units={"frequency": "rad/s", "magnitude": "linear",

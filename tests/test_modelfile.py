@@ -195,3 +195,12 @@ def test_a_model_file_passed_where_a_model_goes_names_the_step_to_take(tmp_path)
             call()
     with pytest.raises(si.ModelError, match=r"pass its .free_model\(\)"):
         si.identifiability(spec)
+
+
+def test_a_known_value_below_zero_for_a_positive_parameter_is_refused():
+    """with_known({"q": -1.0}) for a q declared positive (a new user's trial: accepted)."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    with pytest.raises(si.ModelError, match=r"known m = -1, but m is declared positive"):
+        model.with_known({"m": -1.0})
+    assert model.with_known({"c": 0.0}).parameter_names == ("m", "k")  # 0 is not negative

@@ -144,12 +144,15 @@ def test_an_error_model_gives_the_variance_from_the_measured_values(record):
     np.testing.assert_allclose(both.misfit(theta), listed.misfit(theta), rtol=1e-12)
 
 
-@pytest.mark.parametrize(("model", "match"), [
+@pytest.mark.parametrize(("model", "match"), [  # an error model, or a value that is no variance
     ({"proportional": 0.05, "extra": 1.0}, r"keys 'proportional' and 'additive' .* got 'extra'"),
     ({"proportional": -0.05}, r"proportional must be a finite number ≥ 0"),
     ({"additive": "1"}, r"additive must be a finite number ≥ 0"),
     ({"proportional": 0.0}, r"proportional = additive = 0 has no noise"),
-    ({"proportional": 0.05}, r"sample 0, output 0 \(it is 0\) no noise; add an additive part"),
+    ({"proportional": 0.05}, r"value for sample 0, output 0 is 0, so a proportional error model alone gives it "
+                             r"no noise; add an additive part"),
+    ("0.01", r"variance must be a number or an array of numbers"),
+    (True, r"variance must be a number or an array of numbers"),
 ])
 def test_a_bad_error_model_is_named(record, model, match):
     io, _ = record  # its first concentration is 0 (before the infusion acts)

@@ -228,10 +228,13 @@ def _check_name_units(where: str, declared: Mapping[str, str], columns: Mapping[
     """A column read in a role with a unit whose name ends in a unit (``t_ms``, ``f [Hz]``)
     must agree with the declared unit: the name is the file's own statement of it."""
     for name, role in columns.items():
-        m = _NAME_UNIT.search(_base_name(name))
+        base = _base_name(name)
+        m = _NAME_UNIT.search(base)
         if not m or role not in declared:
             continue
         text = next(g for g in m.groups() if g is not None)
+        if re.search(r"[_\s]rad[_\s]s(?:ec)?$", base, flags=re.IGNORECASE):  # freq_rad_s: rad/s, not s
+            text = "rad/s"
         found = unit_tokens(text, strict=True) if _ONE_UNIT.fullmatch(text) else []
         dimension = _UNIT_DIMENSION[role]
         if len(found) == 1 and found[0][0] == dimension and found[0][1] != declared[role]:

@@ -402,6 +402,10 @@ class IdentificationResult:
             elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
                                       time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
+        if self.success and self.on_bounds:
+            sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
+            lines.append(f"ON BOUNDS: {sides}; the fit is accepted, but the uncertainty's note says whether the data "
+                         f"pull the estimate beyond them (then widen those bounds if the physics allows)")
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")

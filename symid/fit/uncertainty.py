@@ -244,7 +244,9 @@ class FisherInformation(abc.ABC):
                                      sensitivity=G, note=note)
         if G is not None:
             return unc
-        return _with_shift(unc, r, J, self._bound_sides(theta))
+        lower, upper = getattr(self, "lower", None), getattr(self, "upper", None)
+        bounds = None if lower is None or upper is None else (np.asarray(lower, float), np.asarray(upper, float))
+        return _with_shift(unc, r, J, self._bound_sides(theta), bounds)
 
     def _bound_sides(self, theta: np.ndarray) -> np.ndarray | None:
         """Per parameter: −1 on its lower bound, +1 on its upper, 0 inside (None for a method without bounds).
@@ -259,13 +261,15 @@ class FisherInformation(abc.ABC):
 
 
 
-def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarray | None = None) -> Uncertainty:
+def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarray | None = None,
+                bounds: tuple[np.ndarray, np.ndarray] | None = None) -> Uncertainty:
     """Add the distance from θ̂ to the least-squares estimate (one Gauss–Newton step on ‖r + J δ‖²); beyond
     ``SHIFT_LIMIT`` standard errors the intervals become NaN and the note says why (that the step leaves the
     bounds where θ̂ sits on one, ``sides``: −1 on a lower bound, +1 on an upper, 0 inside). Where the step
     leaves bounds by less than ``BOUND_PULL_LIMIT`` of each such parameter's own standard error and θ̂ is the
     least-squares estimate with those parameters held on their bounds, only their intervals are NaN (one
-    slightly active bound does not withhold every interval)."""
+    slightly active bound does not withhold every interval). Within ``SHIFT_LIMIT``, the interval of a
+    parameter on a bound is cut at it (``bounds``: (lower, upper)), and the note says so."""
     import dataclasses
 
     l = unc.covariance.shape[0]
@@ -277,7 +281,23 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
     except np.linalg.LinAlgError:
         return unc
     if shift <= SHIFT_LIMIT:
-        return dataclasses.replace(unc, shift=shift)
+        on = [] if sides is None or bounds is None else [k for k in range(l) if sides[k]]
+        if not on:
+            return dataclasses.replace(unc, shift=shift)
+        intervals = np.array(unc.intervals, dtype=float, copy=True)
+        cut = []
+        for k in on:
+            lo, hi = intervals[k]
+            intervals[k] = np.clip(intervals[k], bounds[0][k], bounds[1][k])
+            if (lo, hi) != tuple(intervals[k]):
+                cut.append(f"{unc.parameter_names[k]} ({'lower' if sides[k] < 0 else 'upper'}; the data alone "
+                           f"would reach {lo if sides[k] < 0 else hi:.6g})")
+        if not cut:
+            return dataclasses.replace(unc, shift=shift)
+        note = (f"{unc.note + '. ' if unc.note else ''}θ̂ sits on its bounds, where the data hardly pull it "
+                f"({shift:.3g} standard errors from the least-squares estimate): the intervals of {', '.join(cut)} "
+                f"are cut at the bound")
+        return dataclasses.replace(unc, shift=shift, note=note, intervals=intervals)
     pushed = [] if sides is None else [k for k in range(l) if sides[k] and sides[k] * delta[k] > 0]
     se = np.sqrt(np.abs(np.diag(unc.covariance)))
     slight = bool(pushed) and all(abs(delta[k]) <= BOUND_PULL_LIMIT * se[k] for k in pushed)
@@ -339,6 +359,8 @@ def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str, *, name: 
     """
     if np.iscomplexobj(noise_std) or (isinstance(noise_std, (list, tuple)) and any(map(np.iscomplexobj, noise_std))):
         raise error(f"{name} holds complex numbers; it is real and > 0 (data units)")
+    if isinstance(noise_std, (str, bytes, bool, np.bool_)) or np.asarray(noise_std).dtype.kind in "bUSO":
+        raise error(f"{name} must be a number or an array of numbers (data units); got {_short_repr(noise_std)}")
     try:
         arr = np.asarray(noise_std, dtype=float)
     except (TypeError, ValueError):
@@ -350,9 +372,10 @@ def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str, *, name: 
     try:
         out = np.broadcast_to(arr, shape).astype(float)
     except ValueError:
+        per_output = f", one per output (1, {shape[1]})" if len(shape) == 2 else ""
         raise error(f"{name} of shape {np.shape(noise_std)} does not fit {what} of shape {shape}: give one "
                     f"number, one per {'frequency' if 'H' in what or 'Phi' in what else 'sample'} "
-                    f"({shape[0]},), or the full shape") from None
+                    f"({shape[0]},){per_output}, or the full shape") from None
     if check and (not np.all(np.isfinite(out)) or np.any(out <= 0)):
         raise error(f"{name} must be finite and > 0 everywhere (a standard deviation in data units)")
     return out

@@ -461,7 +461,8 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         notes.append(f"{len(recs)} records pooled (fit over all samples; correlations summed over records)")
     if sim.n_missing:
         notes.append(f"{sim.n_missing} output value(s) not measured (NaN): left out of the fit; the correlations "
-                     f"run over the {N} sample times where every output was measured")
+                     f"run over the {N} sample times where every output was measured, their lags counted in those "
+                     f"samples, not in time")
     return Validation(parameter_names=tuple(model.parameter_names), theta=th, fit_percent=fit, rms_error=rms,
                       t=tuple(r.t for r in recs), u=tuple(r.u for r in recs), y=tuple(ys_obs),
                       y_sim=tuple(ys), initial_states=tuple(x0s), lags=np.arange(M + 1), autocorrelation=rho_e,

@@ -195,9 +195,10 @@ def error_model_variance(model: dict[str, Any], y: np.ndarray) -> np.ndarray:
     var = (parts["proportional"] * y) ** 2 + parts["additive"] ** 2
     if parts["additive"] == 0 and np.any(var == 0):
         k, j = (int(i) for i in np.argwhere(var == 0)[0])
-        raise OptionError(f"variance: the proportional error model gives the value for sample {k}, output {j} (it is "
-                          f"0) no noise; add an additive part, e.g. {{'proportional': {parts['proportional']:g}, "
-                          f"'additive': …}} in the output's units")
+        raise OptionError(f"variance: the measured value for sample {k}, output {j} is 0, so a proportional error "
+                          f"model alone gives it no noise; add an additive part, e.g. {{'proportional': "
+                          f"{parts['proportional']:g}, 'additive': …}} in the output's units, or mark the value NaN "
+                          f"if it was not measured")
     return var
 
 
