@@ -168,3 +168,24 @@ def test_the_interval_of_a_parameter_on_its_bound_is_cut_there():
     assert ci[2, 1] == 3e4 and ci[2, 0] < 3e4 and np.all(np.isfinite(ci))
     assert "the intervals of k (upper; the data alone would reach" in res.uncertainty.note
     assert res.success and "ON BOUNDS: k (upper); the fit is accepted" in res.summary()  # said even for a fit
+
+
+@pytest.mark.parametrize("method", ["auto", "oe"])
+def test_a_start_at_zero_with_an_upper_bound_below_one_runs(method):
+    """A model file with bounds and no start, and --bounds k=:0.5 (a new user's trial): the drawn start put k at
+    0, centred on the typical value 1, above its upper bound, and SciPy stopped with 'Initial guess is outside of
+    provided bounds' (an internal error). The centre is moved into the bounds."""
+    k, q = si.parameters("k q", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[1]], C=[[q]])
+    t = np.array([0.0, 0.5, 0.75, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0])
+    rec = si.simulate_io(model, {"k": 0.3, "q": 0.05}, np.where(np.arange(49) * 0.25 < 0.75, 100.0, 0.0), 0.25)
+    ts = si.TimeSeries(t, np.where(t < 0.75, 100.0, 0.0), rec.y[(t / 0.25).astype(int)])
+    res = si.identify(model, ts, method=method, bounds={"k": (None, 0.5), "q": (0.001, 1.0)},
+                      identifiability_check=False)
+    np.testing.assert_allclose(res.theta_vector, [0.3, 0.05], rtol=1e-6)
+
+
+def test_a_frequency_response_start_at_zero_with_an_upper_bound_below_one_runs(frf):
+    res = si.identify(MODEL, frf, method="lm", x0=[0.0, 0.5, 3e4], bounds={"m": (None, 3.0)},
+                      identifiability_check=False)
+    assert np.isfinite(res.cost) and res.theta["m"] <= 3.0

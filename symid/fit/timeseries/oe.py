@@ -704,6 +704,8 @@ class OutputError(Estimator, FisherInformation):
         positive = np.zeros(v0.size, dtype=bool)
         positive[:l] = np.isfinite(self._lower) & (self._lower >= 0)  # kept positive (positivity)
         centre = np.where(positive, np.where(v0 > 0, v0, unit), v0)
+        if self._bounded:  # a start at 0 is centred on its typical value, moved into the bounds (φ = 0 inside them)
+            centre[:l] = np.where(positive[:l], np.clip(centre[:l], self.lower, self.upper), centre[:l])
         big = 1e3 * math.sqrt(self.n_data())
         best = {"cost": math.inf, "v": v0.copy(), "evals": 0, "refused": 0}
         costs: dict[bytes, float] = {}  # every finite evaluation's misfit, by φ
