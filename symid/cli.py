@@ -147,7 +147,9 @@ def _pairs(items: Sequence[str] | None, flag: str, command: str, repeatable: tup
         role, sep, value = item.partition("=")
         role, value = role.strip(), value.strip()
         if not sep or not role or not value:
-            raise _UsageError(f"symid {command}: error: {flag} expects ROLE=NAME items, got {item!r}")
+            shape = {"--columns": "ROLE=NAME", "--units": "ROLE=UNIT", "--option": "NAME=VALUE",
+                     "--bounds": "NAME=LOW:HIGH"}.get(flag, "NAME=VALUE")
+            raise _UsageError(f"symid {command}: error: {flag} expects {shape} items, got {item!r}")
         if role in repeatable:
             out.setdefault(role, []).append(value)
         elif role in out:
@@ -358,6 +360,12 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     entry, data, source = _entry_and_data(args, "identify")
     spec = _spec(entry, args, "identify")
     _say(args, f"model: {spec.name}   data: {source}")
+    time_unit = _record_time_unit(data)
+    if time_unit is not None:  # the rates are per this unit: say it, and how to keep the file's own
+        stated = (dict(_pairs(args.units, "--units", "identify")) if getattr(args, "units", None) else {}).get("time")
+        keep = (f" (the file's times, in {stated}, were converted; --time-unit {stated} keeps them)"
+                if stated and stated.strip().lower() != time_unit.lower() else "")
+        _say(args, f"time unit: {time_unit}, the record's and the estimates' (rates per {time_unit}){keep}")
     if spec.known:
         _say(args, "known: " + ", ".join(f"{k} = {v:.6g}" for k, v in spec.known.items()))
     truth = _truth(spec, args)
@@ -396,7 +404,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                if out is not None else [])
     if args.json:
 
-        doc = {"model": spec.name, "data": source, "known": spec.known, "result": res.to_dict(),
+        doc = {"model": spec.name, "data": source, "time_unit": time_unit, "known": spec.known, "result": res.to_dict(),
                "fitted": fitted, "outside_bounds": {k: v[0] for k, v in outside.items()},
                "exit_status": code, "written": [str(p) for p in written]}
         _print_json(doc)
@@ -405,6 +413,12 @@ def _cmd_identify(args: argparse.Namespace) -> int:
 
 NO_FIT = 4
 """Exit status of ``symid identify`` when it ran and wrote its result but no start fitted the data."""
+
+
+def _record_time_unit(data) -> str | None:
+    """The time unit of time-series data (one record or a list), or None for other data."""
+    first = data[0] if isinstance(data, (list, tuple)) and data else data
+    return getattr(first, "time_unit", None) if hasattr(first, "t") else None
 
 
 def _print_json(obj) -> None:
@@ -544,8 +558,9 @@ def _add_data_arguments(p: argparse.ArgumentParser, default: str) -> None:
     g.add_argument("--time-unit", dest="time_unit", default="s", metavar="UNIT",
                    help="time unit of the record built, i.e. of the model (default: s)")
     g.add_argument("--kind", choices=("FrequencyData", "IOData", "TimeSeries"),
-                   help="what the table holds (default: FrequencyData with a frequency column, else IOData; "
-                        "TimeSeries for unevenly spaced times)")
+                   help="what the table holds (default: FrequencyData with a frequency column, else IOData, "
+                        "equally spaced samples; give TimeSeries for unevenly spaced times or outputs not "
+                        "measured at every time, empty cells)")
     g.add_argument("--delimiter", default=",", choices=(",", ";", "tab", "|", " "), metavar="SEP",
                    help="separator of a CSV table: , ; tab | or a space (default: ,)")
 

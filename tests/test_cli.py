@@ -435,6 +435,21 @@ def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
     code = main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), "--columns", "time=t",
                  "input=dose", "output=conc", "--units", "time=h", "--time-unit", "h", "--kind", "TimeSeries",
                  "--option", 'variance={"proportional": 0.02, "additive": 0.01}', "--json"])
-    doc = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out)
     assert code == 0 and doc["result"]["cost_kind"].startswith("weighted relative output misfit")
+    assert doc["time_unit"] == "h" and "time unit: h, the record's and the estimates' (rates per h)" in captured.err
     np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["q"]], [0.3, 0.05], rtol=1e-6)
+
+
+def test_times_converted_to_seconds_are_said(tmp_path, capsys):
+    """A file in hours read without --time-unit: the record, and so every rate, is per second. Said, with the flag
+    that keeps hours (a new user's trial: rates 3600 times smaller, with nothing said)."""
+    (tmp_path / "io.csv").write_text("t_h,u,y\n" + "\n".join(f"{0.5 * i},{1.0 if i < 3 else 0.0},{0.1 * i}"
+                                                              for i in range(20)) + "\n")
+    main(["identify", "mass_damper_2dof", "--data", str(tmp_path / "io.csv"), "--columns", "time=t_h", "input=u",
+          "output=y", "--units", "time=h", "--max-iter", "1"])
+    captured = capsys.readouterr()
+    err = captured.out + captured.err
+    assert "time unit: s, the record's and the estimates' (rates per s) (the file's times, in h, were converted; " \
+           "--time-unit h keeps them)" in err

@@ -96,7 +96,8 @@ def _fail(where: str, what: str, example: str) -> DataError:
 # -- sources ------------------------------------------------------------------------------------------
 
 _MISSING_HINT = {"uniform": " (an output not measured at some times: read the table as a TimeSeries, "
-                             "TimeSeries.from_table or kind='TimeSeries', where an empty cell or NaN marks it)"}
+                             "TimeSeries.from_table or kind='TimeSeries', --kind TimeSeries on the command line, "
+                             "where an empty cell or NaN marks it)"}
 """What to add to an error about a missing or non-finite value, by the source's ``missing_hint``."""
 
 
@@ -652,7 +653,8 @@ def _uniform_step(t: np.ndarray, where: str) -> float:
     if dev[k] > 1e-3 * step:
         raise DataError(f"{where}: the samples are not equally spaced: sample {k} is at {t[k]:.9g}, "
                         f"{dev[k] / step:.3g} sample times away from an even grid of step {step:.6g}; read "
-                        "the table as a TimeSeries (TimeSeries.from_table, or kind='TimeSeries') for uneven times")
+                        "the table as a TimeSeries (TimeSeries.from_table, or kind='TimeSeries'; --kind TimeSeries "
+                        "on the command line) for uneven times")
     return float(step)
 
 

@@ -45,6 +45,7 @@ _ALIASES = {
     "s": "s", "sec": "s", "second": "s", "seconds": "s", "ms": "ms", "millisecond": "ms", "milliseconds": "ms",
     "us": "us", "µs": "us", "μs": "us", "microsecond": "us", "microseconds": "us", "min": "min", "minute": "min",
     "minutes": "min", "h": "h", "hr": "h", "hour": "h", "hours": "h", "d": "d", "day": "d", "days": "d",
+    "secs": "s", "msec": "ms", "msecs": "ms", "usec": "us", "usecs": "us", "mins": "min", "hrs": "h",
 }
 
 
