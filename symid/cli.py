@@ -455,7 +455,10 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
     from symid.plots import bode_plot, start_convergence_plot
     from symid.runlog import write_atomic, write_json_atomic
 
-    write_json_atomic(out / "result.json", {**res.to_dict(), "known": dict(entry.known)}, indent=2)
+    # what the result is of, as --json gives it: the model, the data file and the time unit of every rate
+    head = {"model": entry.name, "data": getattr(args, "data", None) or "the zoo recipe",
+            "time_unit": _record_time_unit(data)}
+    write_json_atomic(out / "result.json", {**head, **res.to_dict(), "known": dict(entry.known)}, indent=2)
     with write_atomic(out / "summary.txt") as fh:
         fh.write(res.summary(truth=truth) + "\n")
     written = [out / "result.json", out / "summary.txt"]

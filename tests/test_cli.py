@@ -99,6 +99,8 @@ def test_identify_scr_with_polish_and_its_progress_bar(tmp_path, capsys):
     assert "scr starts" in captured.err  # the progress bar of the multi-start run (standard error)
     result = json.loads((tmp_path / "result.json").read_text())
     assert result["method"] == "scr" and result["polished"]["method"] == "scr+polish"
+    # what the result is of, as --json says it (a new user's trial: the file had no model or data)
+    assert result["model"] == "mass_damper_2dof" and result["data"] == "the zoo recipe" and result["time_unit"] is None
     assert (tmp_path / "convergence.png").stat().st_size > 10_000
 
 
@@ -439,6 +441,11 @@ def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
     doc = json.loads(captured.out)
     assert code == 0 and doc["result"]["cost_kind"].startswith("weighted relative output misfit")
     assert doc["time_unit"] == "h" and "time unit: h, the record's and the estimates' (rates per h)" in captured.err
+    main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), "--columns", "time=t",
+          "input=dose", "output=conc", "--units", "time=h", "--time-unit", "h", "--kind", "TimeSeries",
+          "--out", str(tmp_path / "out")])
+    written = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert written["time_unit"] == "h" and written["data"] == str(tmp_path / "pk.csv")
     np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["q"]], [0.3, 0.05], rtol=1e-6)
 
 
