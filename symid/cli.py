@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import sys
 import threading
 import time
@@ -368,6 +369,8 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         _say(args, f"time unit: {time_unit}, the record's and the estimates' (rates per {time_unit}){keep}")
     if spec.known:
         _say(args, "known: " + ", ".join(f"{k} = {v:.6g}" for k, v in spec.known.items()))
+    for line in _unit_mismatches(args, spec):
+        _show_text_warning(args, line)
     truth = _truth(spec, args)
     model = spec.free_model()
     x0 = spec.start if spec.start is not None else spec.bounds_centre()
@@ -413,6 +416,38 @@ def _cmd_identify(args: argparse.Namespace) -> int:
 
 NO_FIT = 4
 """Exit status of ``symid identify`` when it ran and wrote its result but no start fitted the data."""
+
+
+def _unit_mismatches(args: argparse.Namespace, spec) -> list[str]:
+    """Where a CSV file states a unit for an input or output column (``# units: dose [ug/h]``) other than the
+    model file's ``input_units``/``output_units``: symid converts neither, so a factor between them goes into
+    the estimates (a new user's trial: µg/h against mg/h, a gain 1000 times off, said nowhere)."""
+    if not args.data or args.columns is None or str(args.data).lower().endswith(".mat"):
+        return []
+    from symid.data.table import stated_column_units
+
+    try:
+        stated = stated_column_units(args.data, "\t" if args.delimiter == "tab" else args.delimiter)
+    except Exception:  # the data were read already; a comment the reader took cannot fail here, and a check never
+        return []      # costs the user the fit
+    columns = _pairs(args.columns, "--columns", "identify", repeatable=("input", "output"))
+
+    def same(a: str, b: str) -> bool:
+        norm = [re.sub(r"\s+", "", x).lower().replace("µ", "u").replace("μ", "u") for x in (a, b)]
+        return norm[0] == norm[1]
+
+    out = []
+    for role, declared in (("input", spec.input_units), ("output", spec.output_units)):
+        for i, name in enumerate(columns.get(role, [])):
+            if i < len(declared) and name in stated and not same(stated[name], declared[i]):
+                out.append(f"the file states {stated[name]} for {role} {name!r}; the model file's {role} unit is "
+                           f"{declared[i]}: symid converts neither, so a factor between them goes into the "
+                           f"estimates; convert the data or the model")
+    return out
+
+
+def _show_text_warning(args: argparse.Namespace, text: str) -> None:
+    print(f"symid: warning: {text}", file=sys.stderr)
 
 
 def _record_time_unit(data) -> str | None:

@@ -321,6 +321,35 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
     return out
 
 
+def stated_column_units(path: Any, delimiter: str = ",") -> dict[str, str]:
+    """The unit a CSV file's ``# units:`` comments state for each named column (``dose [mg/h]`` → ``{"dose":
+    "mg/h"}``), as written; {} for a file without such comments. For checks beyond the time and frequency units
+    (the command line compares the input and output units with a model file's).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from symid.data.table import stated_column_units
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "pk.csv"
+    >>> _ = path.write_text("# units: t [h], dose [mg/h], conc [mg/L]\\nt,dose,conc\\n0,1,0\\n1,0,1\\n")
+    >>> stated_column_units(path)
+    {'t': 'h', 'dose': 'mg/h', 'conc': 'mg/L'}
+    """
+    src = _Csv(path, delimiter)
+    out: dict[str, str] = {}
+    for _, comment in src.comments:
+        text = comment.lstrip("#").strip()
+        head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE) or \
+            re.search(r"\bunits?\s*[:=]\s*", text, flags=re.IGNORECASE)
+        if head is None:
+            continue
+        for item in _split_items(text[head.end():]):
+            pair = _PAIR.match(item)
+            if pair:
+                out[pair.group(1)] = next(g for g in pair.groups()[1:] if g is not None).strip()
+    return out
+
+
 class _Arrays:
     """Named arrays: a dict, a DataFrame's columns, or the variables of a .mat file."""
 
