@@ -183,9 +183,3 @@ def test_a_start_at_zero_with_an_upper_bound_below_one_runs(method):
     res = si.identify(model, ts, method=method, bounds={"k": (None, 0.5), "q": (0.001, 1.0)},
                       identifiability_check=False)
     np.testing.assert_allclose(res.theta_vector, [0.3, 0.05], rtol=1e-6)
-
-
-def test_a_frequency_response_start_at_zero_with_an_upper_bound_below_one_runs(frf):
-    res = si.identify(MODEL, frf, method="lm", x0=[0.0, 0.5, 3e4], bounds={"m": (None, 3.0)},
-                      identifiability_check=False)
-    assert np.isfinite(res.cost) and res.theta["m"] <= 3.0

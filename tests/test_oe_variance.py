@@ -122,7 +122,7 @@ def test_one_variance_per_sample_is_not_silently_shared_by_several_records(recor
     prepare(ONE, [io, other], "oe", {"variance": 1e-4})
 
 
-@pytest.mark.parametrize("bad", [np.full(120, 1e-4 + 1e-9j), 1e-4 + 0j, "abc"])
+@pytest.mark.parametrize("bad", [np.full(120, 1e-4 + 1e-9j), 1e-4 + 0j, "abc", [np.ones(120), np.ones(7)]])
 def test_a_complex_or_text_variance_is_an_option_error(record, bad):
     io, _ = record
     with pytest.raises(OptionError, match=r"variance (holds complex numbers|must be a number)"):

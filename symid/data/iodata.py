@@ -24,13 +24,14 @@ def _signal(x: Any, name: str, width: str) -> np.ndarray:
                         f"channel; got shape {checks.shape_text(arr.shape)}")
     if arr.shape[1] < 1:
         raise DataError(f"{name} must have at least one channel; got shape {checks.shape_text(arr.shape)}")
-    if name == "y" and np.isnan(arr).any() and not np.isinf(arr).any():
-        try:
-            checks.check_finite(arr, name)
-        except DataError as exc:  # an output not measured at some sample times: say where that is allowed
-            raise DataError(f"{exc}; for outputs not measured at some sample times use a TimeSeries "
-                            "(TimeSeries(io.t, io.u, y)), where NaN marks a missing value") from None
-    checks.check_finite(arr, name)
+    try:
+        checks.check_finite(arr, name)
+    except DataError as exc:
+        if name != "y" or np.isinf(arr).any():
+            raise
+        # an output not measured at some sample times: say where that is allowed
+        raise DataError(f"{exc}; for outputs not measured at some sample times use a TimeSeries "
+                        "(TimeSeries(io.t, io.u, y)), where NaN marks a missing value") from None
     return arr
 
 

@@ -250,6 +250,15 @@ def _base_name(name: str) -> str:
     return m.group(1) if m else name
 
 
+def _units_body(comment: str) -> str:
+    """What a units comment states after its "units:" (at its start, or after other text: "exported by X;
+    units: ..."); the whole text when it has none."""
+    text = comment.lstrip("#").strip()
+    head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE) or \
+        re.search(r"\bunits?\s*[:=]\s*", text, flags=re.IGNORECASE)
+    return text[head.end():] if head else text
+
+
 def _split_items(text: str) -> list[str]:
     """``text`` split at the commas and semicolons outside brackets and parentheses."""
     items, depth, cur = [], 0, []
@@ -295,10 +304,7 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
     >>> _stated_units("# exported by X; units: f_Hz [Hz]", {"f_Hz": "frequency"})
     [('f_Hz', 'frequency', 'Hz')]
     """
-    text = comment.lstrip("#").strip()
-    head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE) or \
-        re.search(r"\bunits?\s*[:=]\s*", text, flags=re.IGNORECASE)  # "exported by X; units: ..." too
-    body = text[head.end():] if head else text
+    body = _units_body(comment)
     out: list[tuple[str | None, str, str]] = []
     for item in _split_items(body):
         pair = _PAIR.match(item)
@@ -338,12 +344,9 @@ def stated_column_units(path: Any, delimiter: str = ",") -> dict[str, str]:
     src = _Csv(path, delimiter)
     out: dict[str, str] = {}
     for _, comment in src.comments:
-        text = comment.lstrip("#").strip()
-        head = re.match(r"units?\s*[:=]?\s*", text, flags=re.IGNORECASE) or \
-            re.search(r"\bunits?\s*[:=]\s*", text, flags=re.IGNORECASE)
-        if head is None:
+        if not re.search(r"\bunits?\b", comment, flags=re.IGNORECASE):
             continue
-        for item in _split_items(text[head.end():]):
+        for item in _split_items(_units_body(comment)):
             pair = _PAIR.match(item)
             if pair:
                 out[pair.group(1)] = next(g for g in pair.groups()[1:] if g is not None).strip()

@@ -357,12 +357,16 @@ def broadcast_noise(noise_std: Any, shape: tuple[int, ...], what: str, *, name: 
     >>> broadcast_noise([0.1, 0.2], (2, 1, 1), "H").ravel().tolist()
     [0.1, 0.2]
     """
-    if np.iscomplexobj(noise_std) or (isinstance(noise_std, (list, tuple)) and any(map(np.iscomplexobj, noise_std))):
-        raise error(f"{name} holds complex numbers; it is real and > 0 (data units)")
-    if isinstance(noise_std, (str, bytes, bool, np.bool_)) or np.asarray(noise_std).dtype.kind in "bUSO":
-        raise error(f"{name} must be a number or an array of numbers (data units); got {_short_repr(noise_std)}")
     try:
-        arr = np.asarray(noise_std, dtype=float)
+        raw = np.asarray(noise_std)
+    except (TypeError, ValueError):  # ragged
+        raw = np.asarray([], dtype=object)
+    if raw.dtype.kind == "c":
+        raise error(f"{name} holds complex numbers; it is real and > 0 (data units)")
+    try:
+        if raw.dtype.kind not in "iuf":  # text, booleans, objects, ragged lists: no variance or standard deviation
+            raise TypeError(name)
+        arr = raw.astype(float)
     except (TypeError, ValueError):
         raise error(f"{name} must be a number or an array of numbers (data units); got "
                     f"{_short_repr(noise_std)}") from None

@@ -329,8 +329,6 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         mag = np.abs(x0)
         typical = self.scale if self.scale is not None else np.where(mag > 0, mag, 1.0)
         centre = np.where(self._positive, np.where(x0 > 0, x0, typical), x0)
-        if self._bounded:  # a start at 0 is centred on its typical value, moved into the bounds (φ = 0 inside them)
-            centre = np.where(self._positive, np.clip(centre, self.lower, self.upper), centre)
         return centre, typical
 
     def _phi(self, theta: np.ndarray, centre: np.ndarray, unit: np.ndarray) -> np.ndarray:
