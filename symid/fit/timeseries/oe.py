@@ -79,8 +79,8 @@ from symid.fit.timeseries.response import balancing, casadi_output, simulate_out
 from symid.fit.timeseries.sensitivity import output_sensitivity, state_space_derivatives
 from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
-__all__ = ["EXACT_BUILD_RATE", "SOLVERS", "SQUARING_MARGIN", "WEIGHTED_COST_KIND", "OutputError",
-           "error_model_variance"]
+__all__ = ["ERROR_MODEL_WEIGHTS", "EXACT_BUILD_RATE", "REWEIGHTS", "REWEIGHT_TOL", "SOLVERS", "SQUARING_MARGIN",
+           "WEIGHTED_COST_KIND", "OutputError", "error_model_parts", "error_model_variance"]
 
 SOLVERS = ("ipopt", "trf")
 """The ``solver`` choices of :class:`OutputError`."""
@@ -161,9 +161,67 @@ def _known_states(value: Any, n: int, n_records: int) -> list[np.ndarray]:
     return out
 
 
+ERROR_MODEL_WEIGHTS = ("prediction", "measured")
+"""Where an error model's σ² = (a·y)² + b² takes y from (the ``"weights"`` key of ``variance=``)."""
+
+REWEIGHTS = 6
+"""Refits of one start at most when an error model's weights come from the prediction (:meth:`OutputError.run`):
+each from the last estimate, with σ² from its prediction, until θ changes by less than :data:`REWEIGHT_TOL`
+relatively. On the three-compartment model of ``benchmarks/timeseries_weighting.py`` each refit cuts the change
+10 to 30 times: 3–4 refits at 5 % proportional noise, 4–6 at 20 % (8 records each)."""
+
+REWEIGHT_TOL = 1e-5
+"""The largest relative change of any parameter between two refits at which the reweighting has settled (far
+below the estimate's own uncertainty, a few % there)."""
+
+_PREDICTION_FLOOR = 1e-3
+"""With weights from the prediction and no additive part, a predicted value below this fraction of its output's
+largest predicted value counts as that fraction (an exact 0, e.g. at t = 0 from rest, would have no noise)."""
+
+
+def error_model_parts(model: dict[str, Any]) -> tuple[dict[str, float], str]:
+    """The checked parts of an error model ``{"proportional": a, "additive": b, "weights": ...}``: ``({"proportional":
+    a, "additive": b}, weights)``, ``weights`` one of :data:`ERROR_MODEL_WEIGHTS` (default ``"prediction"``).
+
+    Raises
+    ------
+    OptionError
+        On other keys, values that are not finite numbers ≥ 0, or both parts 0.
+
+    Examples
+    --------
+    >>> from symid.fit.timeseries.oe import error_model_parts
+    >>> error_model_parts({"proportional": 0.1})
+    ({'proportional': 0.1, 'additive': 0.0}, 'prediction')
+    """
+    unknown = sorted(set(model) - {"proportional", "additive", "weights"})
+    if unknown:
+        raise OptionError(f"variance: an error model has the keys 'proportional' and 'additive' (σ² = (a·y)² + b²) "
+                          f"and 'weights' (where y comes from: {' or '.join(map(repr, ERROR_MODEL_WEIGHTS))}); "
+                          f"got {unknown[0]!r}")
+    weights = model.get("weights", "prediction")
+    if not isinstance(weights, str) or weights not in ERROR_MODEL_WEIGHTS:
+        raise OptionError(f"variance: an error model's 'weights' is {' or '.join(map(repr, ERROR_MODEL_WEIGHTS))} "
+                          f"(σ² from the model's prediction or from the measured values); got {weights!r}")
+    parts = {}
+    for key in ("proportional", "additive"):
+        value = model.get(key, 0.0)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                or not math.isfinite(float(value)) or float(value) < 0:
+            raise OptionError(f"variance: {key} must be a finite number ≥ 0 (a relative or an absolute standard "
+                              f"deviation); got {value!r}")
+        parts[key] = float(value)
+    if parts["proportional"] == 0 and parts["additive"] == 0:
+        raise OptionError("variance: an error model with proportional = additive = 0 has no noise; give one of them")
+    return parts, weights
+
+
 def error_model_variance(model: dict[str, Any], y: np.ndarray) -> np.ndarray:
     """The variance of every measured value of ``y`` under an error model ``{"proportional": a, "additive": b}``:
     σ² = (a·y)² + b², the combined error model of pharmacokinetics (either part may be left out).
+
+    :class:`OutputError` uses it on the measured values for its first fit, and then, unless the model says
+    ``"weights": "measured"``, on the model's prediction (:meth:`OutputError.run`).
 
     Raises
     ------
@@ -178,20 +236,7 @@ def error_model_variance(model: dict[str, Any], y: np.ndarray) -> np.ndarray:
     >>> error_model_variance({"proportional": 0.1, "additive": 0.5}, np.array([[10.0], [0.0]])).ravel().tolist()
     [1.25, 0.25]
     """
-    unknown = sorted(set(model) - {"proportional", "additive"})
-    if unknown:
-        raise OptionError(f"variance: an error model has the keys 'proportional' and 'additive' (σ² = (a·y)² + b²); "
-                          f"got {unknown[0]!r}")
-    parts = {}
-    for key in ("proportional", "additive"):
-        value = model.get(key, 0.0)
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-                or not math.isfinite(float(value)) or float(value) < 0:
-            raise OptionError(f"variance: {key} must be a finite number ≥ 0 (a relative or an absolute standard "
-                              f"deviation); got {value!r}")
-        parts[key] = float(value)
-    if parts["proportional"] == 0 and parts["additive"] == 0:
-        raise OptionError("variance: an error model with proportional = additive = 0 has no noise; give one of them")
+    parts, _ = error_model_parts(model)
     var = (parts["proportional"] * y) ** 2 + parts["additive"] ** 2
     if parts["additive"] == 0 and np.any(var == 0):
         k, j = (int(i) for i in np.argwhere(var == 0)[0])
@@ -245,7 +290,10 @@ class OutputError(Estimator, FisherInformation):
         ``--option 'variance={"proportional": 0.05}'``). The fit then minimises Σ (y − ŷ)²/σ² (relative to
         Σ y²/σ²), the maximum-likelihood criterion for independent Gaussian noise: noise that
         grows with the signal (a concentration measured to 5 %) weighs the small values as the
-        large ones. Only the shape matters to the estimate. The level judges the fit: unless
+        large ones. Only the shape matters to the estimate. An error model takes y from the
+        model's prediction (refits from the estimate until its weights settle: :meth:`run`), or
+        from the measured values with ``"weights": "measured"`` (biased where the noise is large:
+        a sample measured low gets too much weight). The level judges the fit: unless
         ``noise_floor`` is given, the fit succeeds when its weighted misfit is within what noise
         of this variance leaves (Σ σ²/σ² over Σ y²/σ², χ² 99.9 % bound), as for a frequency
         response's ``variance``. For the intervals the level is estimated from the residuals (in
@@ -347,22 +395,18 @@ class OutputError(Estimator, FisherInformation):
                         "callback": None if callback is None else "given", "verbose": verbose,
                         "records": len(self.records),
                         "initial_state": self._x0_mode if self._x0_mode != "model" else model.initial_state_kind}
-        p = model.n_outputs
-        energy = sum(np.sum(r.y**2, axis=0) for r in self.records)
-        self._rms = np.sqrt(energy / sum(np.sum(o, axis=0) for o in self._observed))
-        self._variance = None if variance is None else self._sample_variance(variance)
-        if self._variance is None:  # per output channel: cost = Σ_j ‖r_j‖² / (p ‖y_j‖²)
-            weights = 1.0 / (p * energy)
-            self._w = [np.broadcast_to(weights, r.y.shape) * o for r, o in zip(self.records, self._observed,
-                                                                                strict=True)]
-        else:  # per value: cost = Σ r² / σ² over Σ y² / σ² (still 1 for ŷ = 0)
-            scaled = sum(float(np.sum(r.y**2 / v)) for r, v in zip(self.records, self._variance, strict=True))
-            self._w = [o / (v * scaled) for v, o in zip(self._variance, self._observed, strict=True)]
-            # the weighted misfit that noise of the given variance leaves at the truth, Σ w σ² (= values / scaled)
-            self._variance_floor = sum(float(np.sum(w * v)) for w, v in zip(self._w, self._variance, strict=True))
+        self._energy = sum(np.sum(r.y**2, axis=0) for r in self.records)
+        self._rms = np.sqrt(self._energy / sum(np.sum(o, axis=0) for o in self._observed))
+        # an error model {"proportional": a, "additive": b}: σ² from the prediction unless "weights": "measured"
+        self._error_model, self._weights_from = error_model_parts(variance) if isinstance(variance, dict) \
+            else (None, None)
+        self._anchor_key: bytes | None = None  # the θ whose prediction set the weights (weights from the prediction)
+        self._base_variance = None if variance is None else self._sample_variance(variance)
+        self._set_variance(self._base_variance)
+        if variance is not None:
             self.cost_kind = WEIGHTED_COST_KIND  # type: ignore[misc]
-        self._sw = [np.sqrt(w) for w in self._w]
-        self.options["variance"] = None if variance is None else "given"
+        self.options["variance"] = None if variance is None else (
+            "given" if self._error_model is None else {**self._error_model, "weights": self._weights_from})
         self._estimate_x0 = self._x0_mode == "estimate"
         values = self.n_data()
         if values < self.n_unknowns():
@@ -378,6 +422,54 @@ class OutputError(Estimator, FisherInformation):
         self._solvers: dict[int, ScaledIpopt] = {}
         self._jacobian_fns: dict[int, Any] = {}
         self._graphs: dict[int, tuple[Any, Any, Any]] = {}  # (v, q, r) per number of squarings, built once
+
+    def _set_variance(self, variance: list[np.ndarray] | None) -> None:
+        """The weights of the misfit from σ² (one (N, p) array per record), or by each output's energy (None)."""
+        self._variance = variance
+        if variance is None:  # per output channel: cost = Σ_j ‖r_j‖² / (p ‖y_j‖²)
+            weights = 1.0 / (self.model.n_outputs * self._energy)
+            self._w = [np.broadcast_to(weights, r.y.shape) * o for r, o in zip(self.records, self._observed,
+                                                                                strict=True)]
+            self._variance_floor = None
+        else:  # per value: cost = Σ r² / σ² over Σ y² / σ² (still 1 for ŷ = 0)
+            scaled = sum(float(np.sum(r.y**2 / v)) for r, v in zip(self.records, variance, strict=True))
+            self._w = [o / (v * scaled) for v, o in zip(variance, self._observed, strict=True)]
+            # the weighted misfit that noise of the given variance leaves at the truth, Σ w σ² (= values / scaled)
+            self._variance_floor = sum(float(np.sum(w * v)) for w, v in zip(self._w, variance, strict=True))
+        self._sw = [np.sqrt(w) for w in self._w]
+        for cache in ("_graphs", "_solvers", "_jacobian_fns"):  # CasADi's graphs hold the weights: built again
+            if getattr(self, cache, None):
+                getattr(self, cache).clear()
+
+    def _anchor(self, theta: Any) -> None:
+        """With an error model's weights from the prediction: σ² = (a·ŷ)² + b² from the prediction ŷ at θ (the
+        measured values' σ² where the model cannot be simulated there). Nothing otherwise."""
+        if self._weights_from != "prediction":
+            return
+        theta = np.asarray(theta, dtype=float).reshape(-1)[: self.model.n_parameters]
+        key = theta.tobytes()
+        if key == self._anchor_key:
+            return
+        self._anchor_key = key
+        try:
+            with np.errstate(all="ignore"):
+                sims = self.simulate(theta) if np.all(np.isfinite(theta)) else None
+        except (ModelError, np.linalg.LinAlgError, ValueError):
+            sims = None
+        if sims is None or not all(np.all(np.isfinite(s[o])) for s, o in zip(sims, self._observed, strict=True)):
+            self._set_variance(self._base_variance)
+            return
+        assert self._error_model is not None
+        a, b = self._error_model["proportional"], self._error_model["additive"]
+        variance = []
+        for s, o in zip(sims, self._observed, strict=True):
+            top = np.max(np.where(o, np.abs(s), 0.0), axis=0) if b == 0 else 0.0  # per output
+            v = (a * np.maximum(np.abs(s), _PREDICTION_FLOOR * top)) ** 2 + b**2
+            if not np.all(v[o] > 0):  # a prediction of 0 throughout an output, with no additive part
+                self._set_variance(self._base_variance)
+                return
+            variance.append(np.where(o, v, 1.0))
+        self._set_variance(variance)
 
     @property
     def observed(self) -> list[np.ndarray]:
@@ -465,7 +557,11 @@ class OutputError(Estimator, FisherInformation):
                 for r, x0 in zip(self.records, self.initial_states(theta), strict=True)]
 
     def misfit(self, theta: np.ndarray) -> float:
-        """The relative output misfit to the measured samples; ``inf`` where the model overflows."""
+        """The relative output misfit to the measured samples; ``inf`` where the model overflows.
+
+        With an error model whose weights come from the prediction, σ² is that of θ's own prediction (the
+        weights the fit from θ would end with: :meth:`run`)."""
+        self._anchor(theta)
         try:
             with np.errstate(over="ignore", invalid="ignore"):  # an exponential that overflows: inf, said below
                 sims = self.simulate(theta)
@@ -478,6 +574,7 @@ class OutputError(Estimator, FisherInformation):
     def residuals(self, theta: np.ndarray) -> np.ndarray:
         """Residuals y − ŷ in time order (records one after the other), each channel divided by its rms (by σ of
         each value with ``variance``); a sample time where an output is missing is left out."""
+        self._anchor(theta)
         sims = self.simulate(theta)
         if self._variance is not None:
             out = [(r.y - s) / np.sqrt(v) for r, s, v in zip(self.records, sims, self._variance, strict=True)]
@@ -640,7 +737,54 @@ class OutputError(Estimator, FisherInformation):
         The exponential's balancing and squarings are set for the start; when the estimate
         needs more squarings, IPOPT runs again from it with the larger number (at most
         three rounds), with the start's scaling.
+
+        With an error model ``variance={"proportional": a, "additive": b}`` (weights from the
+        prediction, the default), the first fit weighs the measured values by σ² = (a·y)² + b²;
+        then, at most :data:`REWEIGHTS` times, σ² is taken from the estimate's prediction ŷ and
+        the fit is run again from the estimate, until no parameter moves by more than
+        :data:`REWEIGHT_TOL` relatively (iteratively reweighted least squares; all within the
+        start's ``time_limit``). Weights from the measured values favour the samples whose noise
+        happened to be negative; weights from the prediction do not (three-compartment model,
+        20 % proportional noise, 200 records: median errors 1.8–2 times smaller, the 95 %
+        intervals held the truth 94–97 % of the time against 75–91 %, as with the true σ²;
+        ``benchmarks/timeseries_weighting.py``).
         """
+        if self._weights_from != "prediction":
+            return self._run_start(x0)
+        t0 = time.perf_counter()
+        limit = self._time_limit
+        self._set_variance(self._base_variance)  # every start's first fit: σ² from the measured values
+        self._anchor_key = None
+        out = self._run_start(x0)
+        given, iterations, refits, change = out.start, out.iterations, 0, math.inf
+        try:
+            for _ in range(REWEIGHTS):
+                theta = out.theta
+                if not (np.all(np.isfinite(theta)) and np.isfinite(out.cost)):
+                    break
+                left = None if limit is None else limit - (time.perf_counter() - t0)
+                if left is not None and left <= 0:
+                    break
+                self._anchor(theta)  # σ² from this estimate's prediction
+                self._time_limit = left
+                out = self._run_start(theta)
+                refits += 1
+                iterations += out.iterations
+                scale = np.maximum(np.abs(theta), np.finfo(float).tiny)
+                change = float(np.max(np.abs(out.theta - theta) / scale)) if np.all(np.isfinite(out.theta)) \
+                    else math.inf
+                if change < REWEIGHT_TOL:
+                    break
+        finally:
+            self._time_limit = limit
+        settled = "" if change < REWEIGHT_TOL else (
+            f", not settled (the last refit moved a parameter by {change:.1e} of its value)" if refits else
+            ", none run")
+        return dataclasses.replace(out, start=given, iterations=iterations, wall_time=time.perf_counter() - t0,
+                                   message=f"{out.message}; σ² from the prediction, {refits} refit(s){settled}")
+
+    def _run_start(self, x0: np.ndarray) -> StartOutcome:
+        """One fit from ``x0`` with the weights as they are (see :meth:`run`)."""
         given = np.asarray(x0, dtype=float)
         moved = ""
         if self._bounded:  # a drawn start outside the bounds begins on them (a user's own was refused)
@@ -824,6 +968,7 @@ class OutputError(Estimator, FisherInformation):
     def noise_shape(self, theta: Any) -> np.ndarray:
         """√w per entry: the residual is √w (y − ŷ), noise of one level per output (data units); with
         ``variance``, σ√w (a noise of one level in units of the given σ)."""
+        self._anchor(theta)
         if self._variance is not None:
             return np.concatenate([(sw * np.sqrt(v)).T.reshape(-1) for sw, v in zip(self._sw, self._variance,
                                                                                      strict=True)])
@@ -857,4 +1002,5 @@ class OutputError(Estimator, FisherInformation):
         CasADi Jacobian (12 s for 2500 samples of a 5-mass chain).
         """
         theta = self.model.theta_vector(theta)
+        self._anchor(theta)
         return self._residual_and_jacobian(self._unknowns(theta))
