@@ -494,8 +494,9 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
     head = {"model": entry.name, "data": getattr(args, "data", None) or "the zoo recipe",
             "time_unit": _record_time_unit(data)}
     write_json_atomic(out / "result.json", {**head, **res.to_dict(), "known": dict(entry.known)}, indent=2)
-    with write_atomic(out / "summary.txt") as fh:
-        fh.write(res.summary(truth=truth) + "\n")
+    with write_atomic(out / "summary.txt") as fh:  # what it is of, as result.json says, then the summary
+        fh.write("".join(f"{k.replace('_', ' ')}: {v}\n" for k, v in head.items()) + "\n"
+                 + res.summary(truth=truth) + "\n")
     written = [out / "result.json", out / "summary.txt"]
     if hasattr(data, "H"):
         curves = {f"{res.method} estimate": (model, res.theta_vector)}

@@ -78,6 +78,12 @@ def write_atomic(path: str | os.PathLike, mode: str = "w", *, encoding: str | No
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        # mkstemp's file is private (0600): give it the mode a plain open would (the user's umask), or the mode of
+        # the file it replaces
+        try:
+            os.fchmod(fd, path.stat().st_mode & 0o777 if path.exists() else 0o666 & ~_umask())
+        except (AttributeError, OSError):  # no fchmod (Windows) or a file system without modes: as created
+            pass
         with os.fdopen(fd, mode, encoding=None if mode == "wb" else encoding) as fh:
             yield fh
             fh.flush()
@@ -89,6 +95,13 @@ def write_atomic(path: str | os.PathLike, mode: str = "w", *, encoding: str | No
         except FileNotFoundError:
             pass
         raise
+
+
+def _umask() -> int:
+    """The process's umask (read by setting it and putting it back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def write_json_atomic(path: str | os.PathLike, obj: Any, *, indent: int | None = 1) -> None:

@@ -62,6 +62,10 @@ def test_identify_writes_results(tmp_path, capsys):
     result = json.loads((tmp_path / "out" / "result.json").read_text())
     assert result["method"] == "ipopt" and len(result["starts"]) == 1
     assert (tmp_path / "out" / "bode.png").stat().st_size > 1000
+    # summary.txt says what it is of, as result.json does, before the summary
+    summary = (tmp_path / "out" / "summary.txt").read_text().splitlines()
+    assert summary[0] == "model: belt_drive" and summary[1] == f"data: {data}"
+    assert summary[2].startswith("time unit: ") and summary[3] == ""
 
 
 def test_compare_on_zoo_recipe(tmp_path, capsys):

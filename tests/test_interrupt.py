@@ -244,6 +244,26 @@ def test_atomic_write_leaves_the_old_file_on_interruption(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]  # no temporary file left
 
 
+def test_atomic_write_gives_the_mode_a_plain_open_would(tmp_path):
+    """The temporary file is private (0600); the file written has the umask's mode, or keeps the mode of the file
+    it replaces (a result others on the machine read stays readable)."""
+    import os
+    import stat
+
+    mask = os.umask(0o022)
+    try:
+        fresh = tmp_path / "fresh.txt"
+        with write_atomic(fresh) as fh:
+            fh.write("x")
+        assert stat.S_IMODE(fresh.stat().st_mode) == 0o644
+        fresh.chmod(0o640)
+        with write_atomic(fresh) as fh:
+            fh.write("y")
+        assert stat.S_IMODE(fresh.stat().st_mode) == 0o640 and fresh.read_text() == "y"
+    finally:
+        os.umask(mask)
+
+
 def test_start_outcome_round_trips_through_its_dict():
     out = StartOutcome(start=np.array([1.0, 2.0]), theta=np.array([1.5, 2.5]), cost=float("inf"), success=False,
                        finished=False, status="max_iter", iterations=7, wall_time=0.25, message="x", fit="y")
