@@ -495,7 +495,7 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
             "time_unit": _record_time_unit(data)}
     write_json_atomic(out / "result.json", {**head, **res.to_dict(), "known": dict(entry.known)}, indent=2)
     with write_atomic(out / "summary.txt") as fh:  # what it is of, as result.json says, then the summary
-        fh.write("".join(f"{k.replace('_', ' ')}: {v}\n" for k, v in head.items()) + "\n"
+        fh.write("".join(f"{k.replace('_', ' ')}: {v}\n" for k, v in head.items() if v is not None) + "\n"
                  + res.summary(truth=truth) + "\n")
     written = [out / "result.json", out / "summary.txt"]
     if hasattr(data, "H"):

@@ -62,10 +62,9 @@ def test_identify_writes_results(tmp_path, capsys):
     result = json.loads((tmp_path / "out" / "result.json").read_text())
     assert result["method"] == "ipopt" and len(result["starts"]) == 1
     assert (tmp_path / "out" / "bode.png").stat().st_size > 1000
-    # summary.txt says what it is of, as result.json does, before the summary
+    # summary.txt says what it is of, as result.json does, before the summary (a frequency response: no time unit)
     summary = (tmp_path / "out" / "summary.txt").read_text().splitlines()
-    assert summary[0] == "model: belt_drive" and summary[1] == f"data: {data}"
-    assert summary[2].startswith("time unit: ") and summary[3] == ""
+    assert summary[:3] == ["model: belt_drive", f"data: {data}", ""] and summary[3].startswith("method: ipopt")
 
 
 def test_compare_on_zoo_recipe(tmp_path, capsys):
@@ -450,6 +449,8 @@ def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
           "--out", str(tmp_path / "out")])
     written = json.loads((tmp_path / "out" / "result.json").read_text())
     assert written["time_unit"] == "h" and written["data"] == str(tmp_path / "pk.csv")
+    assert "time unit: h\n" in (tmp_path / "out" / "summary.txt").read_text()
+    assert doc["result"]["options"]["variance"] == {"proportional": 0.02, "additive": 0.01, "weights": "prediction"}
     np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["q"]], [0.3, 0.05], rtol=1e-6)
 
 
