@@ -516,7 +516,11 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
         with write_atomic(out / "validation.txt") as fh:
             fh.write(validation.summary() + "\n")
         written += [out / "validation.json", out / "validation.txt"]
+        columns = _pairs(args.columns, "--columns", "identify", repeatable=("input", "output")) \
+            if getattr(args, "columns", None) else {}
+        names = {role: list(columns.get(role, [])) or None for role in ("input", "output")}  # the table's own
         written += list(validation.plot(out / "validation.png", output_units=list(entry.output_units) or None,
+                                        output_names=names["output"], input_names=names["input"],
                                         title=f"{entry.name}: estimate against the measured samples"))
     _say(args, "wrote " + ", ".join(str(p) for p in written))
     return written

@@ -34,3 +34,32 @@ def test_identify_on_a_time_series_writes_the_validation(tmp_path, capsys):
     assert doc["white"] == [True] and doc["samples"] == 400
     for name in ("validation.txt", "validation_output.png", "validation_residual.png"):
         assert (out / name).stat().st_size > 0
+
+
+def test_the_validation_plot_names_the_table_columns(tmp_path, monkeypatch):
+    """A table read with --columns: the validation plot's axes name its output and input columns (not "output 0"),
+    with the model file's units."""
+    from symid.fit.validation import Validation
+
+    (tmp_path / "first_order.py").write_text(MODEL)
+    k, g = si.parameters("k g", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    u = np.random.default_rng(0).standard_normal(200)
+    rec = si.simulate_io(model, {"k": 0.5, "g": 2.0}, u, dt=0.1, noise=0.05, seed=1)
+    rows = zip(rec.t, rec.u[:, 0], rec.y[:, 0], strict=True)
+    lines = ["time,voltage,position"] + [f"{t:.17g},{a:.17g},{b:.17g}" for t, a, b in rows]
+    (tmp_path / "rec.csv").write_text("\n".join(lines) + "\n")
+    seen = {}
+    original = Validation.plot
+
+    def spy(self, path, **kwargs):
+        seen.update(kwargs)
+        return original(self, path, **kwargs)
+
+    monkeypatch.setattr(Validation, "plot", spy)
+    code = main(["identify", str(tmp_path / "first_order.py"), "--data", str(tmp_path / "rec.csv"), "--columns",
+                 "time=time", "input=voltage", "output=position", "--units", "time=s", "--method", "oe",
+                 "--out", str(tmp_path / "out")])
+    assert code == 0
+    assert seen["output_names"] == ["position"] and seen["input_names"] == ["voltage"]
+    assert seen["output_units"] == ["m"]
