@@ -465,3 +465,28 @@ def test_a_decimal_comma_is_named(tmp_path):
     with pytest.raises(si.DataError, match=r"line 2, column 't': '0,0' is not a number \(a decimal comma\?"):
         IOData.from_table(path, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"},
                           delimiter=";")
+
+
+@pytest.mark.parametrize("kind", ["IOData", "TimeSeries"])
+def test_times_out_of_order_name_the_files_lines_and_unit(tmp_path, kind):
+    """Times that repeat or go back: the file's line numbers (after a comment and the header), the column and the
+    declared unit, not the indices of the converted array."""
+    cols, units = {"time": "t", "input": "u", "output": "y"}, {"time": "ms"}
+    dup = write_csv(tmp_path / "dup.csv", ["# a rig export", "t,u,y", "0,1,0.1", "10,1,0.2", "10,1,0.3", "30,1,0.4"])
+    with pytest.raises(si.DataError, match=r"dup.csv', lines 4 and 5, column 't': both times are 10 ms: a "
+                                           r"duplicated sample time"):
+        read_data(dup, columns=cols, units=units, kind=kind)
+    back = write_csv(tmp_path / "back.csv", ["t,u,y", "0,1,0.1", "20,1,0.2", "10,1,0.3", "30,1,0.4"])
+    with pytest.raises(si.DataError, match=r"back.csv', lines 3 and 4, column 't': the time 10 ms comes after "
+                                           r"20 ms: sample times must increase; sort the rows by time"):
+        read_data(back, columns=cols, units=units, kind=kind)
+    with pytest.raises(si.DataError, match=r"the table, rows 1 and 2, column 't': both times are 10 ms"):
+        read_data({"t": [0, 10, 10], "u": [1, 1, 1], "y": [1, 2, 3]}, columns=cols, units=units, kind=kind)
+
+
+def test_numbers_in_double_quotes_are_read(tmp_path):
+    """Spreadsheets may quote every cell, numbers too: a quoted cell is its text (the header's names were already)."""
+    path = write_csv(tmp_path / "quoted.csv", ['"t","u","y"', '"0","1.5","0.25"', '"0.1","1.5","0.5"'])
+    rec = IOData.from_table(path, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
+    np.testing.assert_array_equal(rec.y[:, 0], [0.25, 0.5])
+    assert rec.dt == 0.1

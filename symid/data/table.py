@@ -138,9 +138,11 @@ class _Csv:
             if line.lstrip().startswith("#"):
                 self.comments.append((k, line.strip()))
                 continue
-            cells = [c.strip() for c in split(line)]
+            # a cell in double quotes (as spreadsheets export every cell, numbers too) is its text
+            cells = [c[1:-1].strip() if len(c) >= 2 and c[0] == c[-1] == '"' else c
+                     for c in (c.strip() for c in split(line))]
             if header is None:
-                header = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in cells]
+                header = cells
                 self.header_line = k
                 continue
             if len(cells) != len(header):
@@ -658,7 +660,10 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
         _check_name_units(where, declared, {roles["time"]: "time"})
     cols = _Columns(src, SERIES_EXAMPLE)
     factor = time_factor(declared["time"], target)
-    t = cols.vector(roles["time"]) * factor if has_time else None
+    if has_time:
+        raw = cols.vector(roles["time"])
+        _check_time_order(raw, src, roles["time"], declared["time"])
+    t = raw * factor if has_time else None
     u = np.hstack([cols.channels(n) for n in inputs])
     if uniform:  # an output missing in a uniform record: say how to read it (a TimeSeries takes NaN outputs)
         src.missing_hint = "uniform"
@@ -671,6 +676,24 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
         else:
             step = _uniform_step(t, src.where)
         return IOData(u, y, step, time_unit=target)
+
+
+def _check_time_order(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) -> None:
+    """Refuse times that repeat or go back, naming the file's lines (or the table's rows), the column and the unit."""
+    step = np.diff(t)
+    bad = np.flatnonzero(step <= 0)
+    if not bad.size:
+        return
+    k = int(bad[0])
+    if isinstance(src, _Csv):
+        place = f"{src.where}, lines {src.rows[k][0]} and {src.rows[k + 1][0]}, column {name!r}"
+    else:
+        place = f"{src.where}, rows {k} and {k + 1}, column {name!r}"
+    if step[k] == 0:
+        raise DataError(f"{place}: both times are {t[k]:.9g} {unit}: a duplicated sample time; average the two "
+                        "samples or drop one")
+    raise DataError(f"{place}: the time {t[k + 1]:.9g} {unit} comes after {t[k]:.9g} {unit}: sample times must "
+                    "increase; sort the rows by time")
 
 
 def _uniform_step(t: np.ndarray, where: str) -> float:
