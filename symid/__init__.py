@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 from symid.data import BlackBox, FrequencyData, IOData, SpectralData, TimeSeries, read_data
 from symid.errors import (
     DataError,
+    DataWarning,
     IdentifiabilityWarning,
     ModelError,
     NonAffineError,
@@ -85,6 +86,7 @@ __all__ = [
     "BlackBox",
     "Comparison",
     "DataError",
+    "DataWarning",
     "FrequencyData",
     "IOData",
     "IdentifiabilityReport",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 __all__ = [
     "DataError",
+    "DataWarning",
     "IdentifiabilityWarning",
     "ModelError",
     "NonAffineError",
@@ -63,6 +64,10 @@ class OptionError(SymidError, ValueError):
 
 class SolverError(SymidError, RuntimeError):
     """A numerical back end failed in a way that leaves no result to report."""
+
+
+class DataWarning(UserWarning):
+    """Something in the user's data that symid cannot check and does not refuse (a unit it does not know)."""
 
 
 class IdentifiabilityWarning(UserWarning):

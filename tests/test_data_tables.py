@@ -490,3 +490,16 @@ def test_numbers_in_double_quotes_are_read(tmp_path):
     rec = IOData.from_table(path, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
     np.testing.assert_array_equal(rec.y[:, 0], [0.25, 0.5])
     assert rec.dt == 0.1
+
+
+def test_a_unit_symid_does_not_know_is_warned_about_not_passed_over(tmp_path):
+    """``t [Std]`` (German hours) in a units comment: symid cannot check it against the declared unit, and says
+    so (a DataWarning naming the line, the column and the declared unit); an unknown unit of an input or output
+    column is not a time unit at all and is not warned about."""
+    path = write_csv(tmp_path / "std.csv", ["# units: t [Std], u [Skt], y [m]", "t,u,y", "0,1,0.1", "1,1,0.2"])
+    with pytest.warns(si.DataWarning) as seen:
+        rec = IOData.from_table(path, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
+    texts = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)]
+    assert len(texts) == 1 and "line 1: the file states 'Std' for 't', which symid does not read as a time unit, " \
+        "so it is not checked against the time unit declared (s)" in texts[0]
+    assert rec.dt == 1.0

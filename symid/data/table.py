@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -60,7 +61,7 @@ import numpy as np
 
 from symid.data import _files, checks
 from symid.data.units import DIMENSIONS, canonical_unit, time_factor, unit_tokens
-from symid.errors import DataError
+from symid.errors import DataError, DataWarning
 
 __all__ = ["FRF_ROLES", "MAX_TABLE_BYTES", "SERIES_ROLES", "frequency_data_from_table", "read_data",
            "series_from_table"]
@@ -206,6 +207,13 @@ class _Csv:
             if not declared:
                 raise _fail(f"{self.where}, line {line}", f"the file states units ({_files._show(comment, 60)}) but "
                             "none were declared; symid never guesses units from a comment: declare them", example)
+            for name, role, text in _unread_units(comment, roles):
+                dimension = _UNIT_DIMENSION[role]
+                mine = sorted({u for r, u in declared.items() if _UNIT_DIMENSION.get(r) == dimension})
+                warnings.warn(f"{self.where}, line {line}: the file states {_files._show(text, 30)} for {name!r}, "
+                              f"which symid does not read as a {dimension} unit, so it is not checked against the "
+                              f"{dimension} unit declared ({', '.join(mine) or 'none'}); make sure that is the "
+                              "file's", DataWarning, stacklevel=4)
             for name, dimension, unit in _stated_units(comment, roles):
                 mine = {u for role, u in declared.items() if _UNIT_DIMENSION.get(role) == dimension}
                 if mine and unit not in mine:
@@ -326,6 +334,34 @@ def _stated_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[s
             out.append((None, *alone[0]))
         else:
             out.extend((None, d, u) for d, u in unit_tokens(item))
+    return out
+
+
+def _unread_units(comment: str, roles: Mapping[str, str | None]) -> list[tuple[str, str, str]]:
+    """The items ``name [text]`` of a units comment whose ``name`` is a column read in a role with a unit (time,
+    frequency, magnitude, phase) and whose ``text`` holds no unit of that role's dimension symid knows, as
+    (name, role, text): ``t [Std]`` (German hours) cannot be checked.
+
+    Examples
+    --------
+    >>> from symid.data.table import _unread_units
+    >>> _unread_units("# units: t [Std], u [V]", {"t": "time", "u": ""})
+    [('t', 'time', 'Std')]
+    >>> _unread_units("# units: t [h], u [Std]", {"t": "time", "u": ""})
+    []
+    """
+    out = []
+    for item in _split_items(_units_body(comment)):
+        pair = _PAIR.match(item)
+        if not pair:
+            continue
+        name = pair.group(1)
+        role = roles.get(name)
+        if not role or role not in _UNIT_DIMENSION:
+            continue
+        text = next(g for g in pair.groups()[1:] if g is not None).strip()
+        if not any(d == _UNIT_DIMENSION[role] for d, _ in unit_tokens(text, strict=True)):
+            out.append((name, role, text))
     return out
 
 
