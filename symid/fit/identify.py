@@ -163,7 +163,11 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     **options
         The method's options (see each estimator's docstring and the options table in
         :mod:`symid.fit.base`); an unknown name or a bad value is an
-        :class:`~symid.errors.OptionError` before anything runs.
+        :class:`~symid.errors.OptionError` before anything runs. A ``time_limit`` is each
+        start's budget: the call also spends time outside the starts (typical values from the
+        data, the identifiability checks, the covariance at the estimate, a polish; seconds on
+        records of thousands of samples), reported as ``options["identify_s"]`` beside the
+        starts' ``wall_time``.
 
     Returns
     -------
