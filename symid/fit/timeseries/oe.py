@@ -745,8 +745,8 @@ class OutputError(Estimator, FisherInformation):
         :data:`REWEIGHT_TOL` relatively (iteratively reweighted least squares; all within the
         start's ``time_limit``). Weights from the measured values favour the samples whose noise
         happened to be negative; weights from the prediction do not (three-compartment model,
-        20 % proportional noise, 200 records: median errors 1.8–2 times smaller, the 95 %
-        intervals held the truth 94–97 % of the time against 75–91 %, as with the true σ²;
+        20 % proportional noise, 200 records: median errors 1.6–1.9 times smaller, the 95 %
+        intervals held the truth 93.5–97.5 % of the time against 75–90 %, as with the true σ²;
         ``benchmarks/timeseries_weighting.py``).
         """
         if self._weights_from != "prediction":
