@@ -160,19 +160,43 @@ def _pairs(items: Sequence[str] | None, flag: str, command: str, repeatable: tup
     return out
 
 
+def _data_files(args: argparse.Namespace) -> list[str]:
+    """The files of --data, in the order given (the flag may be repeated)."""
+    return list(getattr(args, "data", None) or [])
+
+
+def _data_source(args: argparse.Namespace) -> str | list[str] | None:
+    """What result.json and --json say the data were: the file, or the files of a repeated --data."""
+    files = _data_files(args)
+    return None if not files else files[0] if len(files) == 1 else files
+
+
 def _read_data(args: argparse.Namespace, command: str):
-    """The data of --data: a symid file as it is, or a table with --columns and --units."""
+    """The data of --data: a symid file as it is, or a table with --columns and --units; several files (a repeated
+    --data) are the records of one time-series fit, each read alike."""
     from symid.data import read_data
 
+    files = _data_files(args)
     if args.columns is None:
         extra = [f for f, v in (("--units", args.units), ("--dt", args.dt), ("--kind", args.kind)) if v is not None]
         if extra:
             raise _UsageError(f"symid {command}: error: {', '.join(extra)} describe a table: give --columns too")
-        return read_data(args.data)
-    columns = _pairs(args.columns, "--columns", command, repeatable=("input", "output"))
-    units = _pairs(args.units, "--units", command)
-    return read_data(args.data, columns=columns, units=units or None, dt=args.dt, kind=args.kind,
-                     time_unit=args.time_unit, delimiter="\t" if args.delimiter == "tab" else args.delimiter)
+        records = [read_data(f) for f in files]
+    else:
+        columns = _pairs(args.columns, "--columns", command, repeatable=("input", "output"))
+        units = _pairs(args.units, "--units", command)
+        records = [read_data(f, columns=columns, units=units or None, dt=args.dt, kind=args.kind,
+                             time_unit=args.time_unit, delimiter="\t" if args.delimiter == "tab" else args.delimiter)
+                   for f in files]
+    if len(records) == 1:
+        return records[0]
+    series = [hasattr(r, "t") and hasattr(r, "u") for r in records]
+    if not all(series):
+        k = series.index(False)
+        raise _UsageError(f"symid {command}: error: --data is given {len(files)} times, but {files[k]!r} holds "
+                          f"{type(records[k]).__name__}, not a time series: only time-series records are fitted "
+                          "together (one --data for any other data)")
+    return records
 
 
 def _entry_and_data(args: argparse.Namespace, command: str):
@@ -181,7 +205,7 @@ def _entry_and_data(args: argparse.Namespace, command: str):
     entry = load_model(args.model)
     if args.data:
         data = _read_data(args, command)
-        source = args.data
+        source = ", ".join(_data_files(args))
     elif args.columns is not None or args.units is not None:
         raise _UsageError(f"symid {command}: error: --columns and --units describe the table given with --data")
     elif isinstance(entry, ZooEntry):
@@ -407,7 +431,8 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                if out is not None else [])
     if args.json:
 
-        doc = {"model": spec.name, "data": source, "time_unit": time_unit, "known": spec.known, "result": res.to_dict(),
+        doc = {"model": spec.name, "data": _data_source(args) or source, "time_unit": time_unit, "known": spec.known,
+               "result": res.to_dict(),
                "fitted": fitted, "outside_bounds": {k: v[0] for k, v in outside.items()},
                "exit_status": code, "written": [str(p) for p in written]}
         _print_json(doc)
@@ -422,14 +447,17 @@ def _unit_mismatches(args: argparse.Namespace, spec) -> list[str]:
     """Where a CSV file states a unit for an input or output column (``# units: dose [ug/h]``) other than the
     model file's ``input_units``/``output_units``: symid converts neither, so a factor between them goes into
     the estimates (a new user's trial: µg/h against mg/h, a gain 1000 times off, said nowhere)."""
-    if not args.data or args.columns is None or str(args.data).lower().endswith(".mat"):
+    files = [f for f in _data_files(args) if not str(f).lower().endswith(".mat")]
+    if not files or args.columns is None:
         return []
     from symid.data.table import stated_column_units
 
-    try:
-        stated = stated_column_units(args.data, "\t" if args.delimiter == "tab" else args.delimiter)
-    except Exception:  # the data were read already; a comment the reader took cannot fail here, and a check never
-        return []      # costs the user the fit
+    stated: dict[str, str] = {}
+    for f in files:
+        try:
+            stated.update(stated_column_units(f, "\t" if args.delimiter == "tab" else args.delimiter))
+        except Exception:  # the data were read already; a comment the reader took cannot fail here, and a check
+            pass           # never costs the user the fit
     columns = _pairs(args.columns, "--columns", "identify", repeatable=("input", "output"))
 
     def same(a: str, b: str) -> bool:
@@ -491,11 +519,12 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
     from symid.runlog import write_atomic, write_json_atomic
 
     # what the result is of, as --json gives it: the model, the data file and the time unit of every rate
-    head = {"model": entry.name, "data": getattr(args, "data", None) or "the zoo recipe",
+    head = {"model": entry.name, "data": _data_source(args) or "the zoo recipe",
             "time_unit": _record_time_unit(data)}
     write_json_atomic(out / "result.json", {**head, **res.to_dict(), "known": dict(entry.known)}, indent=2)
     with write_atomic(out / "summary.txt") as fh:  # what it is of, as result.json says, then the summary
-        fh.write("".join(f"{k.replace('_', ' ')}: {v}\n" for k, v in head.items() if v is not None) + "\n"
+        fh.write("".join(f"{k.replace('_', ' ')}: {', '.join(v) if isinstance(v, list) else v}\n"
+                         for k, v in head.items() if v is not None) + "\n"
                  + res.summary(truth=truth) + "\n")
     written = [out / "result.json", out / "summary.txt"]
     if hasattr(data, "H"):
@@ -588,12 +617,14 @@ def _add_data_arguments(p: argparse.ArgumentParser, default: str) -> None:
         "data", "--data alone reads a file written by symid (CSV or NPZ). A table of your own (plain CSV, MATLAB "
                 ".mat) needs --columns and --units: e.g. --columns frequency=f magnitude=mag phase=ph --units "
                 "frequency=Hz magnitude=dB phase=deg, or --columns time=t input=u output=y --units time=ms")
-    g.add_argument("--data", metavar="FILE", help=f"the measurements; default: {default}")
-    g.add_argument("--columns", nargs="+", metavar="ROLE=NAME",
+    g.add_argument("--data", metavar="FILE", action="append",
+                   help=f"the measurements (repeat for several time-series records fitted together, each read "
+                        f"with the same --columns and --units); default: {default}")
+    g.add_argument("--columns", nargs="+", action="extend", metavar="ROLE=NAME",
                    help="which column plays which role: frequency, real, imag, magnitude, phase (real[i][j] ... "
                         "for several inputs or outputs); or time, input, output (repeat input=/output= for "
                         "several channels; NAME[k] picks channel k of a 2-D .mat variable)")
-    g.add_argument("--units", nargs="+", metavar="ROLE=UNIT",
+    g.add_argument("--units", nargs="+", action="extend", metavar="ROLE=UNIT",
                    help="units, never guessed: frequency=Hz|kHz|rad/s, magnitude=dB|linear, phase=deg|rad, "
                         "time=s|ms|us|min|h|d")
     g.add_argument("--dt", type=_positive_seconds, metavar="DT",
@@ -647,17 +678,17 @@ def build_parser() -> argparse.ArgumentParser:
                    help="number of starts (default: 1)")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
     g = p.add_argument_group("what you know about the parameters (extends or replaces the model file's)")
-    g.add_argument("--x0", nargs="+", metavar="NAME=VALUE",
+    g.add_argument("--x0", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="the first start, for some or all free parameters: the others keep the model file's "
                         "start, else their scale, else the centre of their finite bounds (default: the model "
                         "file's start, else the centre of the bounds when every parameter has finite ones, else "
                         "the method's)")
-    g.add_argument("--known", nargs="+", metavar="NAME=VALUE",
+    g.add_argument("--known", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="parameters whose values are known: substituted into the model before estimation")
-    g.add_argument("--scale", nargs="+", metavar="NAME=VALUE",
+    g.add_argument("--scale", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="typical magnitude of every free parameter (or one number for all), for the methods "
                         "that take scale= (the unknowns become θ / scale)")
-    g.add_argument("--bounds", nargs="+", metavar="NAME=LOW:HIGH",
+    g.add_argument("--bounds", nargs="+", action="extend", metavar="NAME=LOW:HIGH",
                    help="plausible ranges (either end may be empty, an open side; a parameter's range here "
                         "replaces the model file's for it, both ends): the start must lie inside; the methods "
                         "that take bounds= (auto, lm, oe, ipopt) keep the estimate inside and say which parameters "
@@ -669,7 +700,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--tol", type=_positive_number, metavar="TOL", help="the method's stopping tolerance")
     g.add_argument("--time-limit", type=_positive_seconds, dest="time_limit", metavar="S",
                    help="wall-time budget of one start in seconds (methods that take time_limit)")
-    g.add_argument("--option", nargs="+", metavar="NAME=VALUE",
+    g.add_argument("--option", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="any other option of the method (see the options table), e.g. aux_init=model or "
                         "substitution=both; VALUE is a number, true/false/none, JSON, or text")
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
@@ -696,8 +727,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
     p.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
                    help="SCR iterations per start (≥ 1)")
-    p.add_argument("--x0", nargs="+", metavar="NAME=VALUE", help="the first start of every method")
-    p.add_argument("--known", nargs="+", metavar="NAME=VALUE",
+    p.add_argument("--x0", nargs="+", action="extend", metavar="NAME=VALUE", help="the first start of every method")
+    p.add_argument("--known", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="parameters whose values are known: substituted into the model before estimation")
     p.add_argument("--out", metavar="DIR", help="write comparison.json and comparison.md here")
     p.add_argument("--json", action="store_true", help="print the comparison as JSON on standard output")

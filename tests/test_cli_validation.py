@@ -63,3 +63,40 @@ def test_the_validation_plot_names_the_table_columns(tmp_path, monkeypatch):
     assert code == 0
     assert seen["output_names"] == ["position"] and seen["input_names"] == ["voltage"]
     assert seen["output_units"] == ["m"]
+
+
+def test_repeated_flags_are_merged_and_repeated_data_are_several_records(tmp_path, capsys):
+    """A flag given twice is not the last one alone (a new user's trial: --known b=… --known k=… kept k only,
+    and the second --bounds dropped the first): the items are merged, a name given twice is an error; --data given
+    twice fits both time-series records together."""
+    (tmp_path / "first_order.py").write_text(MODEL)
+    k, g = si.parameters("k g", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    for seed in (0, 1):
+        u = np.random.default_rng(seed).standard_normal(300)
+        si.simulate_io(model, {"k": 0.5, "g": 2.0}, u, dt=0.1, noise=0.02, seed=seed + 5).to_csv(
+            tmp_path / f"rec{seed}.csv")
+    files = ["--data", str(tmp_path / "rec0.csv"), "--data", str(tmp_path / "rec1.csv")]
+    code = main(["identify", str(tmp_path / "first_order.py"), *files, "--method", "oe", "--x0", "k=1",
+                 "--x0", "g=1", "--bounds", "k=0.1:5", "--bounds", "g=0.5:", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and doc["result"]["options"]["records"] == 2
+    assert doc["data"] == [str(tmp_path / "rec0.csv"), str(tmp_path / "rec1.csv")]
+    assert doc["result"]["options"]["bounds"] == {"k": [0.1, 5.0], "g": [0.5, None]}
+    assert doc["result"]["starts"][0]["start"] == [1.0, 1.0]
+    np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["g"]], [0.5, 2.0], rtol=0.02)
+    assert main(["identify", str(tmp_path / "first_order.py"), *files, "--method", "oe", "--known", "g=2",
+                 "--known", "g=3"]) == 2
+    assert "--known gives 'g' twice" in capsys.readouterr().err
+    code = main(["identify", str(tmp_path / "first_order.py"), *files, "--method", "oe", "--known", "g=2",
+                 "--x0", "k=1", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and doc["known"] == {"g": 2.0} and list(doc["result"]["theta"]) == ["k"]
+
+
+def test_repeated_data_of_another_kind_is_refused(tmp_path, capsys):
+    """Only time-series records are fitted together: two frequency responses are a usage error naming the file."""
+    si.load_model("belt_drive").data().to_csv(tmp_path / "frf.csv")
+    f = str(tmp_path / "frf.csv")
+    assert main(["identify", "belt_drive", "--data", f, "--data", f]) == 2
+    assert f"but {f!r} holds FrequencyData, not a time series" in capsys.readouterr().err
