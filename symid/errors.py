@@ -12,6 +12,7 @@ __all__ = [
     "DataWarning",
     "IdentifiabilityWarning",
     "ModelError",
+    "ModelWarning",
     "NonAffineError",
     "OptionError",
     "SolverError",
@@ -68,6 +69,10 @@ class SolverError(SymidError, RuntimeError):
 
 class DataWarning(UserWarning):
     """Something in the user's data that symid cannot check and does not refuse (a unit it does not know)."""
+
+
+class ModelWarning(UserWarning):
+    """Something in a model file that symid passes over and the user probably meant (a misspelt name)."""
 
 
 class IdentifiabilityWarning(UserWarning):

@@ -36,11 +36,13 @@ different: symid reads them as data and never runs anything in them.)
 
 from __future__ import annotations
 
+import difflib
 import importlib.util
 import math
 import numbers
 import sys
 import traceback
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -50,7 +52,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from symid.errors import ModelError, SymidError
+from symid.errors import ModelError, ModelWarning, SymidError
 from symid.model.secondorder import SecondOrderModel
 from symid.model.statespace import StateSpaceModel
 
@@ -401,6 +403,7 @@ def from_module(module: ModuleType, *, name: str, where: str, path: str | None =
         raise _model_error(where, "defines entry(), the format of older symid versions; define the model at "
                                   "the top level of the file instead (and truth, make_data, recipe for a zoo entry)")
     model = _find_model(names, where)
+    _warn_near_names(names, where)
     declared = {k: names[k] for k in _OPTIONAL if k in names}
     known = _known_values(declared.get("known") or {}, model, f"{where}: known")
     free = [n for n in model.parameter_names if n not in known]
@@ -443,6 +446,23 @@ def from_module(module: ModuleType, *, name: str, where: str, path: str | None =
         raise ModelError(f"{where}: extra must be a dict; got {type(extra).__name__}")
     return ZooEntry(**common, truth={n: truth[n] for n in model.parameter_names}, recipe=_text(recipe, "recipe", where),
                     make_data=names["make_data"], extra=dict(extra))
+
+
+_READ = (*_OPTIONAL, "model", "truth", "make_data", "recipe")
+"""The top-level names symid reads in a model file (a zoo entry's too)."""
+
+
+def _warn_near_names(names: Mapping[str, Any], where: str) -> None:
+    """A ModelWarning for a top-level value whose name is nearly one symid reads (``bound``, ``Known``,
+    ``starts``): symid would pass it over, and the fit run without it."""
+    for name, value in names.items():
+        if name.startswith("_") or name in _READ or not isinstance(value, (Mapping, list, tuple, str, numbers.Real)):
+            continue
+        near = [k for k in _READ if k.lower() == name.lower()] or \
+            difflib.get_close_matches(name, _READ, n=1, cutoff=0.8)
+        if near:
+            warnings.warn(f"{where} defines {name!r}, which symid does not read; did you mean {near[0]!r}? (as "
+                          f"written it plays no part in the fit)", ModelWarning, stacklevel=4)
 
 
 def _find_model(names: Mapping[str, Any], where: str) -> Any:

@@ -204,3 +204,22 @@ def test_a_known_value_below_zero_for_a_positive_parameter_is_refused():
     with pytest.raises(si.ModelError, match=r"known m = -1, but m is declared positive"):
         model.with_known({"m": -1.0})
     assert model.with_known({"c": 0.0}).parameter_names == ("m", "k")  # 0 is not negative
+
+
+def test_a_name_nearly_one_symid_reads_is_warned_about(tmp_path):
+    """``bound`` for ``bounds``, ``Known`` for ``known``, ``starts`` for ``start`` (a new user's trial: the fit ran
+    without its bounds, on the wrong branch, and nothing said so): a ModelWarning each, naming the intended one;
+    other names (``k_max``, a helper value) are left alone."""
+    path = write(tmp_path, CHAIN + '''
+bound = {"k1": (10.0, 1000.0)}
+Known = {"m1": 0.5}
+starts = {"k1": 100.0}
+k_max = 1000.0
+''')
+    with pytest.warns(si.ModelWarning) as seen:
+        spec = si.load_model(path)
+    texts = sorted(str(w.message) for w in seen if issubclass(w.category, si.ModelWarning))
+    assert len(texts) == 3
+    for wrote, meant in (("bound", "bounds"), ("Known", "known"), ("starts", "start")):
+        assert any(f"defines {wrote!r}, which symid does not read; did you mean {meant!r}?" in t for t in texts)
+    assert spec.bounds == {} and spec.known == {} and spec.start is None  # passed over, as said
