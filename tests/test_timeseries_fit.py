@@ -88,6 +88,12 @@ def test_estimated_initial_states_over_several_forced_experiments():
     est = si.fit.registry.prepare(model, recs, "oe", {})
     for got, want in zip(est.initial_states(res.theta), x0s, strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-8)
+    # the result reports them (a new user's trial found them nowhere): options, summary and to_dict
+    for got, want in zip(res.options["initial_states"], x0s, strict=True):
+        np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-8)
+    text = res.summary()
+    assert "initial state x(t₀), estimated with θ" in text and "record 2: [" in text
+    assert res.to_dict()["options"]["initial_states"] == res.options["initial_states"]
 
 
 def test_oe_on_iodata_with_input_and_zero_initial_state():

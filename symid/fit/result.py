@@ -437,6 +437,11 @@ class IdentificationResult:
                 err = abs(self.theta[name] - t) / (abs(t) if t != 0 else 1.0)
                 row += f" {t:>14.6g} {err:>11.2e}"
             lines.append(row)
+        states = self.options.get("initial_states")
+        if states:
+            lines.append("initial state x(t₀), estimated with θ (least squares at the estimate): " + "; ".join(
+                (f"record {e}: " if len(states) > 1 else "") + "[" + ", ".join(f"{v:.6g}" for v in x) + "]"
+                for e, x in enumerate(states)))
         if self.polished is not None:
             lines.append("")
             lines.append("after polish:")
