@@ -391,6 +391,13 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         keep = (f" (the file's times, in {stated}, were converted; --time-unit {stated} keeps them)"
                 if stated and stated.strip().lower() != time_unit.lower() else "")
         _say(args, f"time unit: {time_unit}, the record's and the estimates' (rates per {time_unit}){keep}")
+        given = [w for w, v in (("known values", spec.known), ("start", spec.start), ("scale", spec.scale),
+                                ("bounds", spec.bounds)) if v]
+        if time_unit != "s" and given:  # a value written per second would be off by the factor, silently
+            _show_text_warning(args, f"the {', '.join(given)} of the model file and the command line are taken as "
+                                     f"they are, in the model's time unit {time_unit}: symid converts none of them, "
+                                     f"so a rate written per second is off by the factor between s and "
+                                     f"{time_unit}")
     if spec.known:
         _say(args, "known: " + ", ".join(f"{k} = {v:.6g}" for k, v in spec.known.items()))
     for line in _unit_mismatches(args, spec):

@@ -100,3 +100,22 @@ def test_repeated_data_of_another_kind_is_refused(tmp_path, capsys):
     f = str(tmp_path / "frf.csv")
     assert main(["identify", "belt_drive", "--data", f, "--data", f]) == 2
     assert f"but {f!r} holds FrequencyData, not a time series" in capsys.readouterr().err
+
+
+def test_values_a_model_file_gives_are_said_to_be_in_the_models_time_unit(tmp_path, capsys):
+    """--time-unit min with a known rate in the model file (a new user's trial: a gain written per second came out
+    60 times off, said nowhere): a warning that symid converts none of the file's numbers; none in seconds."""
+    (tmp_path / "first_order.py").write_text(MODEL + 'known = {"g": 2.0}\n')
+    k, g = si.parameters("k g", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    u = np.random.default_rng(0).standard_normal(200)
+    rec = si.simulate_io(model, {"k": 0.5, "g": 2.0}, u, dt=0.1, noise=0.02, seed=1)
+    rows = zip(rec.t, rec.u[:, 0], rec.y[:, 0], strict=True)
+    (tmp_path / "rec.csv").write_text("\n".join(["t,u,y"] + [f"{t:.17g},{a:.17g},{b:.17g}" for t, a, b in rows]))
+    args = ["identify", str(tmp_path / "first_order.py"), "--data", str(tmp_path / "rec.csv"), "--columns", "time=t",
+            "input=u", "output=y", "--units", "time=s", "--method", "oe"]
+    assert main(args) == 0
+    assert "symid converts none of them" not in capsys.readouterr().err
+    main([*args, "--time-unit", "min"])
+    assert ("symid: warning: the known values of the model file and the command line are taken as they are, in the "
+            "model's time unit min: symid converts none of them") in capsys.readouterr().err
