@@ -357,6 +357,10 @@ def check_start_bounds(x0: Any, lower: np.ndarray, upper: np.ndarray, names: Seq
     Traceback (most recent call last):
     ...
     symid.errors.OptionError: the start k = 5 lies outside its bounds [10, 100]; move the start inside or ...
+    >>> check_start_bounds([50.0, -1.0], np.array([10.0, 0.0]), np.array([100.0, np.inf]), ["k", "m"])
+    Traceback (most recent call last):
+    ...
+    symid.errors.OptionError: the start m = -1 is negative, and m is kept ≥ 0 (declared positive, or a lower bound ...
     """
     x = np.asarray(x0, dtype=float).reshape(-1)
     if x.size != len(names):
@@ -364,6 +368,10 @@ def check_start_bounds(x0: Any, lower: np.ndarray, upper: np.ndarray, names: Seq
     out = _outside(x, lower, upper)
     if out:
         k = out[0]
+        if lower[k] == 0 and upper[k] == np.inf and x[k] < 0:  # the 0 of a parameter declared positive
+            raise OptionError(f"the start {names[k]} = {x[k]:g} is negative, and {names[k]} is kept ≥ 0 (declared "
+                              f"positive, or a lower bound 0): start it above 0, or declare it without "
+                              f"positive=True if it may be negative")
         raise OptionError(f"the start {names[k]} = {x[k]:g} lies outside its bounds [{lower[k]:g}, {upper[k]:g}]; "
                           "move the start inside or widen the bounds")
 
