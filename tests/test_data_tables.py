@@ -108,7 +108,8 @@ def test_io_record_from_dt_and_several_channels():
 def test_uneven_times_are_refused_for_iodata_and_read_as_time_series():
     table = {"t": [0.0, 0.5, 1.0, 2.0, 4.0], "u": np.zeros(5), "c": [1.0, 0.8, 0.6, 0.4, 0.2]}
     cols = {"time": "t", "input": "u", "output": "c"}
-    with pytest.raises(si.DataError, match=r"not equally spaced.*TimeSeries"):
+    with pytest.raises(si.DataError, match=r"not equally spaced.*TimeSeries.*rounded when written, leave the time "
+                                           r"column out and give the sample time \(dt=, or --dt\)"):
         IOData.from_table(table, columns=cols, units={"time": "h"})
     ts = TimeSeries.from_table(table, columns=cols, units={"time": "h"}, time_unit="h")
     np.testing.assert_array_equal(ts.t, table["t"])

@@ -745,7 +745,8 @@ def _uniform_step(t: np.ndarray, where: str) -> float:
         raise DataError(f"{where}: the samples are not equally spaced: sample {k} is at {t[k]:.9g}, "
                         f"{dev[k] / step:.3g} sample times away from an even grid of step {step:.6g}; read "
                         "the table as a TimeSeries (TimeSeries.from_table, or kind='TimeSeries'; --kind TimeSeries "
-                        "on the command line) for uneven times")
+                        "on the command line) for uneven times; or, if the times are even but were rounded when "
+                        "written, leave the time column out and give the sample time (dt=, or --dt)")
     return float(step)
 
 
