@@ -206,6 +206,22 @@ def test_a_known_value_below_zero_for_a_positive_parameter_is_refused():
     assert model.with_known({"c": 0.0}).parameter_names == ("m", "k")  # 0 is not negative
 
 
+def test_a_start_giving_a_known_value_says_it_is_known():
+    """x0 with a parameter fixed by with_known (a new user's trial: "names unknown parameter(s) m", as if misspelt;
+    a model file already said "declared known"): the message names it as known, with its value, through twice."""
+    import numpy as np
+
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]]).with_known({"m": 2.0}).with_known(
+        {"c": 0.5})
+    frf = si.simulate_frf(model, {"k": 3.0}, np.linspace(0.5, 2.0, 20))
+    with pytest.raises(si.OptionError, match=r"x0: theta gives c, m, whose value is known in this model "
+                                             r"\(with_known: c = 0.5, m = 2\); leave it out"):
+        si.identify(model, frf, x0={"m": 1.0, "c": 1.0, "k": 1.0}, identifiability_check=False)
+    with pytest.raises(si.ModelError, match=r"theta names unknown parameter\(s\) q"):
+        model.theta_vector({"q": 1.0, "k": 1.0})
+
+
 def test_a_name_nearly_one_symid_reads_is_warned_about(tmp_path):
     """``bound`` for ``bounds``, ``Known`` for ``known``, ``starts`` for ``start`` (a new user's trial: the fit ran
     without its bounds, on the wrong branch, and nothing said so): a ModelWarning each, naming the intended one;

@@ -145,6 +145,12 @@ class ParametricModel:
             unknown = sorted(set(given) - set(names))
             missing = [n for n in names if n not in given]
             if unknown:
+                fixed = getattr(self, "_known_values", {})
+                held = [n for n in unknown if n in fixed]
+                if held:  # a value the user fixed with with_known: say so, not "unknown"
+                    raise ModelError(f"theta gives {', '.join(held)}, whose value is known in this model "
+                                     f"(with_known: {', '.join(f'{n} = {fixed[n]:g}' for n in held)}); leave it out: "
+                                     f"the model's parameters are {', '.join(names) or 'none'}")
                 raise ModelError(f"theta names unknown parameter(s) {', '.join(unknown)}; "
                                  f"the model's parameters are {', '.join(names) or 'none'}")
             if missing:
@@ -216,7 +222,12 @@ class ParametricModel:
         """
         from symid.modelfile import substitute_known
 
-        return substitute_known(self, known)
+        out = substitute_known(self, known)
+        if out is not self:  # remembered, so that a θ still giving them is told they are known (theta_vector)
+            out._known_values = {**getattr(self, "_known_values", {}),
+                                 **{(k.name if isinstance(k, sp.Symbol) else str(k)): float(v)
+                                    for k, v in known.items()}}
+        return out
 
     def _matrix_text(self) -> str:
         lines = []
