@@ -379,3 +379,22 @@ def test_the_summary_reports_the_identifiability_check_beside_the_starts_time():
     # typical values and the uncertainty left out); the whole call is now said beside the starts' time
     assert res.options["identify_s"] >= res.wall_time + res.options["identifiability_check_s"]
     assert "the whole call" in res.summary()
+
+
+def test_a_white_residual_over_ten_percent_is_said_to_look_like_noise():
+    """The correct model at 20 % noise and no noise level (a new user's trial: "far from a fit … check the model's
+    structure", for estimates within 4.6 %): still not a success without a noise level, but the fit text says the
+    residual is white and the advice is to give noise_floor= if the data are that noisy; a structured residual of
+    the same size keeps the old advice."""
+    from symid.fit.result import next_step
+
+    rng = np.random.default_rng(0)
+    white = rng.standard_normal((2000, 1))
+    test = fit_test(0.032, n_data=2000, n_parameters=3, residuals=white, noise_floor=None)
+    assert not test.fits
+    assert "over 10 % rms) and no noise floor given; its residual is white (lag-1 statistic" in test.text
+    assert "as noise of 18 % rms would leave it" in test.text
+    assert next_step(test.text, frf=False, time=True).startswith("the residual looks like noise")
+    smooth = np.cumsum(white, axis=0)  # a random walk: structured
+    test = fit_test(0.032, n_data=2000, n_parameters=3, residuals=smooth, noise_floor=None)
+    assert not test.fits and "white" not in test.text and next_step(test.text).startswith("far from a fit")

@@ -35,6 +35,10 @@ _NEXT_STEPS = (
                    "otherwise try more starts or method='auto' with scale=. A statistic just above the limit can "
                    "be chance: the least-squares estimate of a true model exceeded it in 1 of 300 records at 1 % "
                    "noise (a 3-storey building, at 3.1)"),
+    ("residual is white", "the residual looks like noise, not like a wrong model: if the data are that noisy, "
+                          "give noise_floor= the misfit such noise leaves (about this misfit; variance= for noise "
+                          "that varies), and the fit is judged against it; if they are not, try more starts "
+                          "(starts=20) and check the model's structure and the data's units"),
     ("over 10 %", "far from a fit: try more starts (starts=20), method='auto' with scale= your typical values, and "
                   "check the model's structure and the data's units; if the data are that noisy (over 10 % rms), "
                   "give noise_floor= (0.01 for 10 % noise) so that the fit is judged against the noise"),
