@@ -516,8 +516,15 @@ def _time_series_validation(model, data, res, args):
     except (DataError, ModelError) as exc:
         _say(args, f"note: no validation: {exc}")
         return None
-    _say(args, v.summary())
+    _say(args, v.summary(**_channel_names(args)))
     return v
+
+
+def _channel_names(args: argparse.Namespace) -> dict:
+    """``output_names`` and ``input_names`` from a table's --columns (None where not given)."""
+    columns = _pairs(args.columns, "--columns", "identify", repeatable=("input", "output")) \
+        if getattr(args, "columns", None) else {}
+    return {f"{role}_names": list(columns.get(role, [])) or None for role in ("output", "input")}
 
 
 def _write_identify(out, entry, model, data, res, truth, args, validation=None) -> list:
@@ -550,13 +557,10 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
     if validation is not None:
         write_json_atomic(out / "validation.json", validation.to_dict(), indent=2)
         with write_atomic(out / "validation.txt") as fh:
-            fh.write(validation.summary() + "\n")
+            fh.write(validation.summary(**_channel_names(args)) + "\n")
         written += [out / "validation.json", out / "validation.txt"]
-        columns = _pairs(args.columns, "--columns", "identify", repeatable=("input", "output")) \
-            if getattr(args, "columns", None) else {}
-        names = {role: list(columns.get(role, [])) or None for role in ("input", "output")}  # the table's own
         written += list(validation.plot(out / "validation.png", output_units=list(entry.output_units) or None,
-                                        output_names=names["output"], input_names=names["input"],
+                                        **_channel_names(args),  # the table's own column names
                                         title=f"{entry.name}: estimate against the measured samples"))
     _say(args, "wrote " + ", ".join(str(p) for p in written))
     return written

@@ -63,6 +63,9 @@ def test_the_validation_plot_names_the_table_columns(tmp_path, monkeypatch):
     assert code == 0
     assert seen["output_names"] == ["position"] and seen["input_names"] == ["voltage"]
     assert seen["output_units"] == ["m"]
+    text = (tmp_path / "out" / "validation.txt").read_text()  # the table too names them, not "output 0"
+    rows = text.splitlines()
+    assert rows[2].split()[0] == "position" and rows[4].split()[:2] == ["position", "voltage"]
 
 
 def test_repeated_flags_are_merged_and_repeated_data_are_several_records(tmp_path, capsys):

@@ -118,29 +118,33 @@ class Validation:
         with np.errstate(invalid="ignore"):
             return np.where(np.isfinite(self.independence_p), self.independence_p >= 1 - self.confidence, True)
 
-    def summary(self) -> str:
-        """A readable table: fit and tests per output (and input)."""
+    def summary(self, *, output_names: Any = None, input_names: Any = None) -> str:
+        """A readable table: fit and tests per output (and input), labelled by number or by the names given."""
         p = self.fit_percent.size
+        m = self.cross_correlation.shape[1] if self.cross_correlation.ndim == 3 else 0
+        onames = [str(j) for j in range(p)] if output_names is None else _names(output_names, p, "output")
+        inames = [str(i) for i in range(m)] if input_names is None else _names(input_names, m, "input")
+        wo = max(7, *(len(x) for x in onames))
+        wi = max(6, *(len(x) for x in inames)) if m else 6
         level = f"{100 * self.confidence:g} %"
         n = sum(tt.size for tt in self.t)
         lines = [f"validation on {len(self.t)} record(s), {n} samples; tests at {level}, lags 1…{self.lags[-1]}",
-                 f"{'output':>7s} {'fit %':>8s} {'rms error':>11s} {'whiteness Q':>12s} {'p-value':>8s} "
+                 f"{'output':>{wo}s} {'fit %':>8s} {'rms error':>11s} {'whiteness Q':>12s} {'p-value':>8s} "
                  f"{'lags out':>9s}"]
         for j in range(p):
             out = int(np.sum(np.abs(self.autocorrelation[j, 1:]) > self.auto_band))
-            lines.append(f"{j:>7d} {self.fit_percent[j]:>8.2f} {self.rms_error[j]:>11.4g} {self.whiteness_q[j]:>12.4g} "
-                         f"{self.whiteness_p[j]:>8.3g} {out:>9d}")
-        m = self.cross_correlation.shape[1] if self.cross_correlation.ndim == 3 else 0
+            lines.append(f"{onames[j]:>{wo}s} {self.fit_percent[j]:>8.2f} {self.rms_error[j]:>11.4g} "
+                         f"{self.whiteness_q[j]:>12.4g} {self.whiteness_p[j]:>8.3g} {out:>9d}")
         if m:
-            lines.append(f"{'output':>7s} {'input':>6s} {'S (τ ≥ 0)':>12s} {'p-value':>8s} {'lags out':>9s}")
+            lines.append(f"{'output':>{wo}s} {'input':>{wi}s} {'S (τ ≥ 0)':>12s} {'p-value':>8s} {'lags out':>9s}")
             for j in range(p):
                 for i in range(m):
                     if not np.isfinite(self.independence_s[j, i]):
-                        lines.append(f"{j:>7d} {i:>6d} {'constant input: not tested':>31s}")
+                        lines.append(f"{onames[j]:>{wo}s} {inames[i]:>{wi}s} {'constant input: not tested':>31s}")
                         continue
                     pos = self.cross_correlation[j, i, self.cross_lags >= 0]
                     out = int(np.sum(np.abs(pos) > self.cross_band[j, i]))
-                    lines.append(f"{j:>7d} {i:>6d} {self.independence_s[j, i]:>12.4g} "
+                    lines.append(f"{onames[j]:>{wo}s} {inames[i]:>{wi}s} {self.independence_s[j, i]:>12.4g} "
                                  f"{self.independence_p[j, i]:>8.3g} {out:>9d}")
         verdict = []
         if not np.all(self.white):
