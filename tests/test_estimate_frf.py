@@ -295,3 +295,22 @@ def test_unexcited_lines_are_left_out_and_kept_on_request():
     assert every.n_frequencies == PERIOD // 2 - 1  # every line but DC and Nyquist
     with pytest.raises(DataError, match="not excited at any line"):
         si.estimate_frf(io, period=PERIOD, band=(2 * np.pi * 130 / (PERIOD * DT), 2 * np.pi * 140 / (PERIOD * DT)))
+
+
+def test_the_estimate_says_its_variances_degrees_of_freedom():
+    """2(P − 1) from P periods; 2(n_eff − m) from Welch averages (H1), 2(n_eff − 1) for H2."""
+    from symid.signal.frf import effective_averages
+
+    rng = np.random.default_rng(0)
+    u = _multisine(rng, 9)
+    y = scipy.signal.lfilter(B_IIR, A_IIR, u) + 0.01 * rng.standard_normal(u.size)
+    frf = si.estimate_frf(si.IOData(u, y, DT), period=PERIOD, transient_periods=1, band=_band_of_lines())
+    assert frf.variance_dof == 2 * (8 - 1)
+    N, nperseg = 2**12, 256
+    u = rng.standard_normal(N)
+    io = si.IOData(u, scipy.signal.lfilter([0.5, 0.2], [1.0], u) + 0.1 * rng.standard_normal(N), DT)
+    K = (N - nperseg) // (nperseg // 2) + 1  # half-overlapping segments
+    n_eff = effective_averages("hann", nperseg, nperseg // 2, K)
+    assert si.estimate_frf(io, nperseg=nperseg).variance_dof == pytest.approx(2 * (n_eff - 1), rel=1e-12)
+    assert si.estimate_frf(io, nperseg=nperseg, estimator="h2").variance_dof == pytest.approx(2 * (n_eff - 1),
+                                                                                              rel=1e-12)

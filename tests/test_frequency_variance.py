@@ -80,3 +80,29 @@ def test_csv_with_a_variance_column_missing_is_refused(tmp_path):
     path.write_text(text)
     with pytest.raises(DataError, match="unexpected CSV header"):
         FrequencyData.from_csv(path)
+
+
+@pytest.mark.parametrize("fmt", ["csv", "npz"])
+def test_the_variances_degrees_of_freedom_travel_with_it(tmp_path, fmt):
+    """variance_dof (an estimated variance's degrees of freedom): files, pickling, copies and selection keep it;
+    equality sees it; the summary says it."""
+    f = FrequencyData(_mimo().w, _mimo().H, _mimo().variance, variance_dof=14)
+    path = tmp_path / f"frf.{fmt}"
+    (f.to_csv if fmt == "csv" else f.to_npz)(path)
+    back = load(path)
+    assert back == f and back.variance_dof == 14.0
+    assert pickle.loads(pickle.dumps(f)).variance_dof == 14.0 and copy.deepcopy(f).variance_dof == 14.0
+    assert f[1:3].variance_dof == 14.0
+    assert f != _mimo()  # the same arrays, a variance known exactly
+    assert "estimated with 14 degrees of freedom" in f.summary()
+
+
+@pytest.mark.parametrize(("dof", "variance", "match"), [
+    (0, np.ones(4), r"variance_dof must be a finite number > 0"),
+    (np.nan, np.ones(4), r"variance_dof must be a finite number > 0"),
+    ("14", np.ones(4), r"variance_dof must be a finite number > 0"),
+    (14, None, r"variance_dof is given without a variance"),
+])
+def test_bad_degrees_of_freedom_are_refused_by_name(dof, variance, match):
+    with pytest.raises(DataError, match=match):
+        FrequencyData(W, np.ones(4), variance, variance_dof=dof)

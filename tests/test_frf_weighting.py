@@ -288,3 +288,38 @@ def test_scr_options_and_its_polisher_use_the_same_variance():
     np.testing.assert_array_equal(given.polisher().line_weights, est.line_weights)
     assert ScrFRF(model, frf, variance=None).polisher().line_weights is None
     assert ScrFRF(model, frf, variance=None).options["variance"] is None
+
+
+def test_a_fit_weighted_by_an_estimated_variance_is_judged_with_its_degrees_of_freedom():
+    """The documented route, a periodic multisine through si.estimate_frf, then si.identify (a new user's trial:
+    a fit at the truth was success=False in 30 of 30 records at 8 periods): each weighted term |r|²/σ̂² is an
+    F(2, 2(P − 1)) ratio, mean (P − 1)/(P − 2), not 1. Here 4 periods (mean 1.5), 10 records of a one-mass
+    model, lm from the truth: every fit succeeds; against the floor of a known variance the misfit would have
+    exceeded its χ² 99.9 % bound in most records (8 of 10 when this test was written)."""
+    from symid.fit.frf.misfit import estimated_variance_factor
+    from symid.fit.success import chi2_bound
+
+    model, truth, _ = one_mass()
+    N, P, dt = 512, 4, 0.05
+    k = np.arange(3, 200)  # lines 0.74 … 48.8 rad/s around the 5 rad/s mode
+    wk = 2 * np.pi * np.fft.rfftfreq(N, dt)
+    rng = np.random.default_rng(0)
+    U = np.zeros(N // 2 + 1, complex)
+    U[k] = np.exp(2j * np.pi * rng.random(k.size))
+    u1 = np.fft.irfft(U, N)
+    Y = np.zeros(N // 2 + 1, complex)
+    Y[k] = model.frequency_response(truth, wk[k])[:, 0, 0] * np.fft.rfft(u1)[k]
+    y1 = np.fft.irfft(Y, N)
+    fits, over = 0, 0
+    for seed in range(10):
+        y = np.tile(y1, P) + 0.01 * np.std(y1) * np.random.default_rng(seed).standard_normal(N * P)
+        frf = si.estimate_frf(si.IOData(np.tile(u1, P), y, dt), period=N, band=(0.5, 50.0))
+        assert frf.variance_dof == 2 * (P - 1)
+        res = si.identify(model, frf, method="lm", x0=truth, identifiability_check=False)
+        fits += res.success
+        est = prepare(model, frf, "lm", {})
+        n = 2 * frf.H.size
+        known_floor = est.noise_floor / estimated_variance_factor(frf.variance_dof, n, 3)
+        over += res.cost > known_floor * chi2_bound(n, 3)
+    assert fits == 10
+    assert over >= 7

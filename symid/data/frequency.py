@@ -14,6 +14,20 @@ from symid.errors import DataError
 __all__ = ["FrequencyData"]
 
 
+def _dof(x: Any, variance: Any) -> float | None:
+    """The degrees of freedom of an estimated variance: None, or a finite number > 0 beside a variance."""
+    if x is None:
+        return None
+    if variance is None:
+        raise DataError("variance_dof is given without a variance: it counts the degrees of freedom of an estimated "
+                        "variance")
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(x) or x <= 0:
+        raise DataError(f"variance_dof must be a finite number > 0 (the degrees of freedom of the estimated "
+                        f"variance); got {x!r}")
+    return float(x)
+
+
 def _variance(x: Any, shape: tuple[int, ...]) -> np.ndarray:
     """A per-entry noise variance: real, finite, ≥ 0, of ``shape`` (a 1-D array for a SISO FRF)."""
     arr = checks.as_array(x, "variance", complex_ok=False)
@@ -53,13 +67,21 @@ class FrequencyData(DataContainer):
         (a 1-D array for a SISO FRF). A zero says the entry is known exactly. ``None``
         (default): no noise model. It is kept by :meth:`to_csv`, :meth:`to_npz`,
         pickling and frequency selection (``frf[k]``).
+    variance_dof : float, optional
+        The degrees of freedom of an estimated ``variance`` (real ones, the same for every
+        entry: 2(P − 1) from P periods, 2(n_eff − m) from Welch averages), as
+        :func:`symid.estimate_frf` sets it; ``None`` (default): the variance is known. A fit
+        weighted by the inverse of an estimated variance leaves a misfit ν/(ν − 2) times
+        what the variance says at the truth (the mean of an F(2, ν) ratio), which the fits'
+        noise floor allows for. Kept with the variance.
 
     Raises
     ------
     DataError
         On NaN or inf, a wrong number of dimensions, a length mismatch between ``w`` and
         ``H``, or non-positive, duplicated or unsorted frequencies; a ``variance`` that is
-        complex, negative, not finite or not shaped like ``H``. The message names the
+        complex, negative, not finite or not shaped like ``H``; a ``variance_dof`` that is
+        not a finite number > 0, or given without a variance. The message names the
         array and what was expected.
 
     Notes
@@ -69,6 +91,7 @@ class FrequencyData(DataContainer):
         # symid FrequencyData csv v2
         # n_outputs: p
         # n_inputs: m
+        # variance_dof: ν        (only for an estimated variance)
         # n_rows: N
         w,H[0][0].re,H[0][0].im,H[0][1].re,H[0][1].im,...
         <one row per frequency>
@@ -96,11 +119,12 @@ class FrequencyData(DataContainer):
     w: np.ndarray
     H: np.ndarray
     variance: np.ndarray | None
+    variance_dof: float | None
 
     _kind: ClassVar[str] = "FrequencyData"
     _npz_keys: ClassVar[tuple[str, ...]] = ("w", "H")
 
-    def __init__(self, w: Any, H: Any, variance: Any = None):
+    def __init__(self, w: Any, H: Any, variance: Any = None, variance_dof: Any = None):
         w_ = checks.frequencies(w, "w")
         s = w_.size
         H_ = checks.as_array(H, "H", complex_ok=True)
@@ -118,12 +142,15 @@ class FrequencyData(DataContainer):
         object.__setattr__(self, "w", w_)
         object.__setattr__(self, "H", checks.frozen(H_))
         object.__setattr__(self, "variance", None if variance is None else _variance(variance, H_.shape))
+        object.__setattr__(self, "variance_dof", _dof(variance_dof, variance))
 
     # -- optional variance: equality, pickling, files and selection keep it ------------------
     def _payload(self) -> dict[str, np.ndarray]:
         out = super()._payload()
         if self.variance is not None:
             out["variance"] = self.variance
+        if self.variance_dof is not None:
+            out["variance_dof"] = np.array(self.variance_dof)
         return out
 
     def __eq__(self, other: object) -> bool:
@@ -135,7 +162,7 @@ class FrequencyData(DataContainer):
     __hash__ = None  # type: ignore[assignment]
 
     def __reduce__(self) -> tuple[type, tuple[Any, ...]]:
-        return (type(self), (self.w, self.H, self.variance))
+        return (type(self), (self.w, self.H, self.variance, self.variance_dof))
 
     def __getitem__(self, index: Any) -> FrequencyData:
         try:
@@ -148,7 +175,8 @@ class FrequencyData(DataContainer):
             raise DataError(f"FrequencyData selects frequencies along one axis; the index {index!r} adds axes")
         if k.size == 0:
             raise DataError("the selection holds no frequency; at least one is needed")
-        return type(self)(self.w[k], self.H[k], None if self.variance is None else self.variance[k])
+        return type(self)(self.w[k], self.H[k], None if self.variance is None else self.variance[k],
+                          self.variance_dof)
 
     @classmethod
     def from_npz(cls, path: _files.PathLike) -> Self:
@@ -163,9 +191,12 @@ class FrequencyData(DataContainer):
         FileNotFoundError, IsADirectoryError, PermissionError
             If the file cannot be opened.
         """
-        arrays = _files.read_npz(path, cls._kind, cls._npz_keys, optional=("variance",))
+        arrays = _files.read_npz(path, cls._kind, cls._npz_keys, optional=("variance", "variance_dof"))
+        dof = arrays.get("variance_dof")
         with naming_file(path):
-            return cls(arrays["w"], arrays["H"], arrays.get("variance"))
+            if dof is not None and dof.shape != ():
+                raise DataError(f"variance_dof must be one number; got shape {checks.shape_text(dof.shape)}")
+            return cls(arrays["w"], arrays["H"], arrays.get("variance"), None if dof is None else dof.item())
 
     # -- properties -----------------------------------------------------------------
     @property
@@ -204,7 +235,9 @@ class FrequencyData(DataContainer):
             f"  |H|         : {mag.min():.4g} to {mag.max():.4g}",
             *([] if self.variance is None else
               [f"  noise std   : {np.sqrt(self.variance).min():.4g} to {np.sqrt(self.variance).max():.4g} "
-               "(per entry, from the variance)"]),
+               "(per entry, from the variance" + ("" if self.variance_dof is None else
+                                                  f", estimated with {self.variance_dof:.4g} degrees of freedom")
+               + ")"]),
         ])
 
     # -- CSV ------------------------------------------------------------------------
@@ -250,7 +283,10 @@ class FrequencyData(DataContainer):
         if has_var:
             table = np.hstack([table, self.variance.reshape(s, p * m)])
         rows = [[_files.fmt(x) for x in row] for row in table.tolist()]
-        _files.write_csv(path, self._kind, {"n_outputs": p, "n_inputs": m}, self._columns(p, m, has_var), rows)
+        meta = {"n_outputs": p, "n_inputs": m}
+        if self.variance_dof is not None:
+            meta["variance_dof"] = _files.fmt(self.variance_dof)
+        _files.write_csv(path, self._kind, meta, self._columns(p, m, has_var), rows)
 
     @classmethod
     def from_table(cls, table: Any, *, columns: dict[str, Any], units: dict[str, str] | None = None,
@@ -314,7 +350,7 @@ class FrequencyData(DataContainer):
         UserWarning
             For a version-1 file, whose completeness cannot be checked.
         """
-        meta, columns, rows = _files.read_csv(path, cls._kind, meta_keys=("n_outputs", "n_inputs"))
+        meta, columns, rows = _files.read_csv(path, cls._kind, meta_keys=("n_outputs", "n_inputs", "variance_dof"))
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
         has_var = len(columns) == 1 + 3 * p * m
@@ -324,5 +360,11 @@ class FrequencyData(DataContainer):
         table = _files.parse_float_rows(rows, path, len(columns))
         k = 1 + 2 * p * m
         H = _files.complex_from_parts(table[:, 1:k:2], table[:, 2:k:2]).reshape(-1, p, m)
+        dof = meta.get("variance_dof")
         with naming_file(path):
-            return cls(table[:, 0], H, table[:, k:].reshape(-1, p, m) if has_var else None)
+            if dof is not None:
+                try:
+                    dof = float(dof)
+                except ValueError:
+                    raise DataError(f"variance_dof is {dof!r}, not a number") from None
+            return cls(table[:, 0], H, table[:, k:].reshape(-1, p, m) if has_var else None, dof)

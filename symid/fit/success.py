@@ -109,7 +109,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["BLACK_BOX_MARGIN", "CEILING", "EXACT_FIT", "LOCAL_GAIN_LIMIT", "WHITENESS_LIMIT", "WHITENESS_POWER",
-           "FitTest", "black_box_ratio", "fit_test", "physical_check", "whiteness", "whiteness_reach"]
+           "FitTest", "black_box_ratio", "chi2_bound", "fit_test", "physical_check", "whiteness", "whiteness_reach"]
 
 EXACT_FIT = 1e-10
 """A relative misfit at or below this reproduces the data as noise-free data are reproduced."""
@@ -318,7 +318,9 @@ def physical_check(model: Any, theta: Any) -> str | None:
     return None
 
 
-def _chi2_bound(n_data: int, n_parameters: int) -> float:
+def chi2_bound(n_data: int, n_parameters: int) -> float:
+    """The χ² 99.9 % quantile with n_data − n_parameters degrees of freedom, over n_data: how far above its noise
+    floor a misfit of independent Gaussian noise may lie (the factor :func:`fit_test` applies to a noise floor)."""
     from scipy.stats import chi2
 
     dof = max(n_data - n_parameters, 1)
@@ -427,7 +429,7 @@ def _fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndar
     if cost <= EXACT_FIT:
         return FitTest(True, "exact", f"misfit {cost:.2e} ≤ {EXACT_FIT:g} (exact fit)")
     if noise_floor is not None:
-        bound = noise_floor * _chi2_bound(n_data, n_parameters)
+        bound = noise_floor * chi2_bound(n_data, n_parameters)
         ok = cost <= bound
         return FitTest(ok, "noise floor", f"misfit {cost:.2e} {'≤' if ok else '>'} {bound:.2e} "
                                           f"(noise floor {noise_floor:.2e} × χ² 99.9 % bound)")

@@ -94,6 +94,8 @@ class _Estimate:
     H: np.ndarray
     variance: np.ndarray | None
     coherence: np.ndarray
+    variance_dof: float | None = None
+    """Real degrees of freedom of the variance estimate (2 per complex one)."""
 
 
 # -- arguments ----------------------------------------------------------------------------
@@ -281,7 +283,7 @@ def _welch(recs: list[IOData], estimator: str, nperseg: Any, window: Any, detren
             raise DataError(f"the coherence is zero at ω = {w[i]:.6g} rad/s: the H2 estimate and its variance do not "
                             "exist there; use estimator='h1' or narrow the band")
         var = (rel * np.abs(H[:, :, 0]) ** 2 / (n_eff - 1))[:, :, None]
-    return _Estimate(w, H, var, coh)
+    return _Estimate(w, H, var, coh, 2.0 * float(dof if estimator == "h1" else n_eff - 1))
 
 
 # -- periodic ------------------------------------------------------------------------------
@@ -342,7 +344,7 @@ def _periodic(recs: list[IOData], period: Any, transient_periods: Any, band: Any
     Syu = np.einsum("ksa,ksb->sab", Yk, np.conj(Uk))
     syy = np.sum(np.abs(Yk) ** 2, axis=0)
     coh = _multiple_coherence(Suu, Syu, syy) if P * E >= m else np.zeros_like(syy)
-    return _Estimate(w, H, var, coh)
+    return _Estimate(w, H, var, coh, None if var is None else 2.0 * (P - 1))
 
 
 def _analyse(data: Any, estimator: Any, period: Any, transient_periods: Any, nperseg: Any, window: Any,
@@ -406,7 +408,9 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
     -------
     FrequencyData
         ω (rad/s), H (s, p, m) and ``variance`` (s, p, m): ``E|Ĥ − H|²`` per entry
-        (``None`` for periodic excitation with a single period).
+        (``None`` for periodic excitation with a single period), with ``variance_dof`` the
+        real degrees of freedom of that estimate: 2(P − 1) from P periods, 2(n_eff − m)
+        from Welch averages (2(n_eff − 1) for H2). A fit weighted by it allows for them.
 
     Raises
     ------
@@ -459,7 +463,7 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
     True
     """
     est = _analyse(data, estimator, period, transient_periods, nperseg, window, detrend, band, min_excitation)
-    return FrequencyData(est.w, est.H, est.variance)
+    return FrequencyData(est.w, est.H, est.variance, est.variance_dof)
 
 
 def estimate_coherence(data: IOData | Sequence[IOData], *, estimator: str = "h1", period: int | None = None,
