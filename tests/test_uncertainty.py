@@ -312,3 +312,32 @@ def test_intervals_are_withheld_wherever_the_estimate_is_not_the_least_squares_o
     C = at_minimum.covariance
     assert unc.shift == pytest.approx(3 * np.sqrt(C[0, 0] * np.linalg.inv(C)[0, 0]), rel=0.2)
     assert np.all(np.isnan(unc.intervals)) and "standard errors from the least-squares estimate" in unc.note
+
+
+def test_an_unweighted_frf_fit_takes_the_noise_shape_its_residuals_have():
+    """Additive noise (one level on every line, as a flat multisine's estimated response has it) against relative
+    noise (si.simulate_frf's): the residuals' likelihood chooses, and the standard errors match the spread of the
+    estimates over 40 records within a factor 1.35 either way (0.96–1.11 for both when this test was written;
+    with additive noise taken as relative, as before, 29–44 times too large, and a new user's 4-storey frame
+    60–150 times). Reference: the truth chosen here."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    truth = np.array([2.0, 0.4, 50.0])  # resonance at 5 rad/s, damping ratio 2 %
+    w = np.linspace(2.0, 12.0, 150)
+    clean = si.simulate_frf(model, truth, w)
+    level = 0.01 * np.sqrt(np.mean(np.abs(clean.H) ** 2))
+    for kind in ("additive", "relative"):
+        est, se = [], []
+        for seed in range(40):
+            rng = np.random.default_rng(seed)
+            if kind == "additive":
+                e = level * (rng.standard_normal(clean.H.shape) + 1j * rng.standard_normal(clean.H.shape)) / np.sqrt(2)
+                frf = si.FrequencyData(w, clean.H + e)
+            else:
+                frf = si.simulate_frf(model, truth, w, noise=0.01, seed=seed)
+            res = si.identify(model, frf, method="lm", x0=truth, identifiability_check=False)
+            assert res.uncertainty.noise_units == ("data units" if kind == "additive" else "relative")
+            est.append(res.theta_vector)
+            se.append(res.uncertainty.standard_errors)
+        ratio = np.median(se, axis=0) / np.std(est, axis=0, ddof=1)
+        assert np.all((ratio > 1 / 1.35) & (ratio < 1.35)), (kind, ratio)
