@@ -277,7 +277,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                 polished.theta_vector, model.parameter_names, noise_std=noise_std))
         result = dataclasses.replace(result, polished=polished)
     extra: dict[str, Any] = {}
-    if result.options.get("initial_state") == "estimate" and np.all(np.isfinite(result.theta_vector)):
+    if (result.options.get("initial_state") == "estimate" and hasattr(estimator, "initial_states")
+            and np.all(np.isfinite(result.theta_vector))):
         # the initial states estimated with θ (the least-squares ones at θ̂), one per record
         extra["initial_states"] = [np.asarray(x, dtype=float).tolist()
                                    for x in estimator.initial_states(result.theta_vector)]

@@ -436,13 +436,15 @@ def _fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndar
     if residuals is not None:
         z = whiteness(residuals)
         ok = z <= WHITENESS_LIMIT
-        reach = whiteness_reach(residuals)
         if cost > CEILING:
             # still refused without a noise level, but a white residual is what noise that large would leave: say so
-            white = (f"; its residual is white (lag-1 statistic {z:.1f} ≤ {WHITENESS_LIMIT:g}), as noise of "
-                     f"{100 * np.sqrt(cost):.0f} % rms would leave it" if ok and reach >= WHITENESS_POWER else "")
+            with np.errstate(over="ignore", invalid="ignore"):  # residuals of a diverged estimate overflow there
+                white = (f"; its residual is white (lag-1 statistic {z:.1f} ≤ {WHITENESS_LIMIT:g}), as noise of "
+                         f"{100 * np.sqrt(cost):.0f} % rms would leave it"
+                         if ok and np.isfinite(cost) and whiteness_reach(residuals) >= WHITENESS_POWER else "")
             return FitTest(False, "whiteness", f"misfit {cost:.2e} > {CEILING:g} (over 10 % rms) and no noise "
                                                f"floor given{white}")
+        reach = whiteness_reach(residuals)
         if ok and reach < WHITENESS_POWER:  # a verdict a black box or a Gauss–Newton step must back (fit_test)
             return FitTest(True, "weak whiteness", f"misfit {cost:.2e} with a residual too short to tell from noise "
                                                    f"(lag-1 statistic {z:.1f}, at most {reach:.1f} for any residual "
