@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
-from symid.errors import ModelError
+from symid.errors import ModelError, ModelWarning
 from symid.model.lti import StateSpaceMatrices, as_frequencies
 from symid.model.parametric import ParametricModel, Theta
 from symid.model.symbols import as_symbolic_matrix
@@ -86,6 +87,7 @@ class SecondOrderModel(ParametricModel):
         C_ = as_symbolic_matrix(C, "C", shape=(None, n))
         self.output = output
         self._setup([("M", M_), ("V", V_), ("K", K_), ("B", B_), ("C", C_)], parameters, name)
+        _warn_if_not_symmetric(self._symbolic)
 
     @property
     def n_dof(self) -> int:
@@ -234,3 +236,17 @@ class SecondOrderModel(ParametricModel):
         """Parameters and matrices as readable text."""
         head = f"SecondOrderModel{' ' + repr(self.name) if self.name else ''}: {self._shape_text()}"
         return f"{head}\nparameters: {', '.join(self.parameter_names) or '(none)'}\n{self._matrix_text()}"
+
+
+def _warn_if_not_symmetric(matrices: dict[str, sp.Matrix]) -> None:
+    """A ModelWarning naming the first entry where M, V or K is not symmetric: a passive structure's are, and an
+    asymmetry is most often a typo (a new user's trial: ``-k3`` where ``-k4`` belonged, fitted without a word)."""
+    for name in ("M", "V", "K"):
+        mat = matrices[name]
+        for i in range(mat.rows):
+            for j in range(i + 1, mat.cols):
+                if sp.expand(mat[i, j] - mat[j, i]) != 0:
+                    warnings.warn(f"{name}[{i}, {j}] = {mat[i, j]} but {name}[{j}, {i}] = {mat[j, i]}: {name} is not "
+                                  f"symmetric, as a passive structure's is (a typo?); ignore this for gyroscopic or "
+                                  f"follower forces", ModelWarning, stacklevel=3)
+                    return
