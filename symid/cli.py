@@ -429,6 +429,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     fitted = bool(final.success or any(s.success for s in res.starts))
     code = 0 if fitted else NO_FIT
     _say(args, res.summary(truth=truth))
+    modes = _modes_line(model, final.theta_vector, time_unit)
+    if modes:
+        _say(args, modes)
     validation = _time_series_validation(model, data, final, args)
     for name, (value, lo, hi) in outside.items():
         _say(args, f"warning: {name} = {value:.6g} lies outside its bounds [{lo:g}, {hi:g}]")
@@ -499,6 +502,28 @@ def _print_json(obj) -> None:
     from symid.runlog import json_safe
 
     print(json.dumps(json_safe(obj), indent=2, allow_nan=False))
+
+
+def _modes_line(model, theta, time_unit: str | None) -> str:
+    """The estimate's modes, natural frequency (Hz and rad per time unit) and damping ratio, and its real poles: a
+    check a person can make at a glance (a frequency axis in Hz read as rad/s moves every mode by 2π)."""
+    import numpy as np
+
+    try:
+        A = np.asarray(model.state_space(theta)[0], dtype=float)
+        poles = np.linalg.eigvals(A) if A.size and np.all(np.isfinite(A)) else np.array([])
+    except Exception:  # an estimate where the model cannot be evaluated: nothing to say
+        return ""
+    unit = time_unit or "s"
+    items = []
+    for p in sorted(poles, key=abs):
+        if p.imag > 0:
+            wn = abs(p)
+            hz = f"{wn / (2 * np.pi):.4g} Hz, " if unit == "s" else ""
+            items.append(f"{hz}{wn:.4g} rad/{unit}, ζ {-p.real / wn:.3g}")
+        elif p.imag == 0:
+            items.append(f"real pole {p.real:.4g} /{unit}")
+    return "modes of the estimate: " + "; ".join(items) if items else ""
 
 
 def _time_series_validation(model, data, res, args):

@@ -341,3 +341,17 @@ def test_an_unweighted_frf_fit_takes_the_noise_shape_its_residuals_have():
             se.append(res.uncertainty.standard_errors)
         ratio = np.median(se, axis=0) / np.std(est, axis=0, ddof=1)
         assert np.all((ratio > 1 / 1.35) & (ratio < 1.35)), (kind, ratio)
+
+
+def test_a_fit_to_rounding_keeps_its_intervals():
+    """Noise-free data fitted to rounding (a new user's trial: every interval NaN, "θ̂ lies 26 standard errors
+    from the least-squares estimate"): the Gauss–Newton step is rounding, so the intervals are kept, as narrow as
+    the rounding, and the note says so. Reference: the thesis's 2-DOF mass-damper (4-20), from the zoo."""
+    entry = si.load_model("mass_damper_2dof")
+    start = {k: 1.5 * v for k, v in entry.truth.items()}
+    res = si.identify(entry.model, entry.data(), method="ipopt", x0=start, identifiability_check=False)
+    unc = res.uncertainty
+    assert unc.shift > 0.5 and "a fit to rounding" in unc.note  # what withheld every interval before
+    assert np.all(np.isfinite(unc.intervals))
+    np.testing.assert_allclose(unc.intervals.mean(axis=1), res.theta_vector, rtol=1e-12)
+    assert np.all(unc.standard_errors <= 1e-12 * np.abs(res.theta_vector))

@@ -65,7 +65,8 @@ import numpy as np
 
 from symid.errors import DataError
 
-__all__ = ["BOUND_PULL_LIMIT", "NEAR_SINGULAR", "SHIFT_LIMIT", "FisherInformation", "Uncertainty", "broadcast_noise",
+__all__ = ["BOUND_PULL_LIMIT", "NEAR_SINGULAR", "ROUNDING_SHIFT", "SHIFT_LIMIT", "FisherInformation", "Uncertainty",
+           "broadcast_noise",
            "fisher_uncertainty"]
 
 NEAR_SINGULAR = 1e-8
@@ -77,6 +78,10 @@ _NULL_PART = 1e-6
 SHIFT_LIMIT = 0.5
 """Largest distance (in standard errors) from θ̂ to the least-squares estimate at which intervals centred on θ̂
 are reported: shifted by 0.5 SE, a 95 % interval still holds the truth 93 % of the time (1 SE: 83 %)."""
+
+ROUNDING_SHIFT = 1e-9
+"""A Gauss–Newton step from θ̂ no larger than this relative to every parameter is rounding: the intervals are kept
+however many standard errors it spans (a noise-free fit's are at rounding too: exact data gave NaN intervals)."""
 
 BOUND_PULL_LIMIT = 3.0
 """Largest distance, in its own standard errors, by which a bound may hold a parameter back from the least-squares
@@ -280,6 +285,15 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
         shift = float(np.sqrt(max(float(delta @ np.linalg.solve(unc.covariance, delta)), 0.0)))
     except np.linalg.LinAlgError:
         return unc
+    centre = np.mean(np.asarray(unc.intervals, dtype=float), axis=1)
+    if shift > SHIFT_LIMIT and np.all(np.abs(delta) <= ROUNDING_SHIFT * np.maximum(np.abs(centre),
+                                                                                  np.finfo(float).tiny)):
+        # a fit to rounding: θ̂ is the least-squares estimate to rounding, many of its (rounding-sized) standard
+        # errors away only because they are that small
+        note = (f"{unc.note + '. ' if unc.note else ''}a fit to rounding: θ̂ is the least-squares estimate to "
+                f"{ROUNDING_SHIFT:g} relatively ({shift:.3g} of its rounding-sized standard errors away), and the "
+                f"intervals are as narrow as the data's rounding")
+        return dataclasses.replace(unc, shift=shift, note=note)
     if shift <= SHIFT_LIMIT:
         on = [] if sides is None or bounds is None else [k for k in range(l) if sides[k]]
         if not on:
