@@ -484,3 +484,16 @@ def test_an_input_unit_the_file_states_against_the_model_files_is_said(tmp_path,
         main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), *args])
         err = capsys.readouterr().err
         assert ("warning: the file states ug/h for input 'dose'; the model file's input unit is mg/h" in err) == warned
+
+
+def test_identify_prints_the_estimates_modes(capsys):
+    """A frequency axis in Hz read as rad/s moves every mode by 2π, which a person sees at once in Hz (a new
+    user's trial asked for it): the modes of the estimate, natural frequency and damping ratio. Reference: the
+    eigenvalues of the thesis's 2-DOF mass-damper at its truth (4-20), computed here."""
+    entry = si.load_model("mass_damper_2dof")
+    assert main(["identify", "mass_damper_2dof", "--method", "ipopt"]) in (0, 4)
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("modes of the estimate: "))
+    poles = np.linalg.eigvals(entry.model.state_space(entry.truth)[0])
+    wn = sorted(abs(p) for p in poles if p.imag > 0)
+    hz = [float(x.split(" Hz")[0]) for x in line.removeprefix("modes of the estimate: ").split("; ")]
+    np.testing.assert_allclose(hz, np.array(wn) / (2 * np.pi), rtol=1e-3)  # printed to 4 digits
