@@ -366,6 +366,16 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
              confidence: float = 0.99) -> Validation:
     """Simulate the model at θ on measured records and test what is left (module text).
 
+    The simulation holds the input constant between samples (zero-order hold), as
+    :class:`~symid.data.IOData` defines a record and as a digital controller or signal
+    generator drives a plant. A band-limited input that was only sampled (a shaker's force
+    measured by an acquisition system) is not held: its simulation errs by the hold's
+    difference, which grows with frequency, and the residual then tests as coloured and
+    correlated with the input although the model is right (a new user's 4-storey frame
+    sampled at 8 times its highest mode: fit 68–78 % where the held input gives 99 %).
+    Sample such records faster than their band, or validate on the frequency response
+    (:func:`symid.estimate_frf`, whose periodic estimate needs no hold).
+
     Parameters
     ----------
     model : StateSpaceModel or SecondOrderModel
