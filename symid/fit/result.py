@@ -32,7 +32,8 @@ _NEXT_STEPS = (
                      "polish=True, or method='ipopt' started from it"),
     ("structured", "the residual is smooth across frequency: a local minimum, or noise that grows with |H|; with "
                    "noisy data give variance= (si.estimate_frf returns it) or noise_floor= (1e-4 for 1 % noise), "
-                   "otherwise try more starts or method='auto' with scale=. A statistic just above the limit can "
+                   "otherwise try more starts or method='auto' with scale=, and check that the model describes the "
+                   "data (its matrices, the data's units). A statistic just above the limit can "
                    "be chance: the least-squares estimate of a true model exceeded it in 1 of 300 records at 1 % "
                    "noise (a 3-storey building, at 3.1)"),
     ("residual is white", "the residual looks like noise, not like a wrong model: if the data are that noisy, "
@@ -43,7 +44,9 @@ _NEXT_STEPS = (
                   "check the model's structure and the data's units; if the data are that noisy (over 10 % rms), "
                   "give noise_floor= (0.01 for 10 % noise) so that the fit is judged against the noise"),
     ("χ²", "the misfit exceeds what the declared noise explains: a local minimum (more starts, "
-           "method='auto'), or a noise_floor/variance smaller than the data's noise"),
+           "method='auto'), a noise_floor/variance smaller than the data's noise, or a model that does not "
+           "describe the data (check its matrices, and how the data were made: units, a sampled input taken as "
+           "held)"),
     ("pass noise_floor=", "without a noise level only an exact fit counts: give noise_floor= (the relative misfit "
                           "the noise leaves, 1e-4 for 1 % noise) to judge a fit of noisy data"),
 )
