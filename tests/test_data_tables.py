@@ -504,3 +504,15 @@ def test_a_unit_symid_does_not_know_is_warned_about_not_passed_over(tmp_path):
     assert len(texts) == 1 and "line 1: the file states 'Std' for 't', which symid does not read as a time unit, " \
         "so it is not checked against the time unit declared (s)" in texts[0]
     assert rec.dt == 1.0
+
+
+def test_a_cell_that_is_not_a_number_in_a_dict_or_frame_is_named_with_its_row():
+    """A dict or DataFrame column holding text, or None (a new user's trial: "got objects that are not numbers",
+    no row; None was even called a complex value)."""
+    cols, units = {"time": "t", "input": "u", "output": "y"}, {"time": "s"}
+    with pytest.raises(si.DataError, match=r"column 'y' must hold numbers; got text, 'x' at \[1\]"):
+        IOData.from_table({"t": [0, 1, 2], "u": [1, 1, 1], "y": [1, "x", 3]}, columns=cols, units=units)
+    with pytest.raises(si.DataError, match=r"must hold numbers; got 'x' at \[1\]"):
+        IOData(np.array([1, "x", 3], dtype=object), np.ones(3), 1.0)
+    with pytest.raises(si.DataError, match=r"holds None at \[2\]: a missing value\?"):
+        IOData(np.array([1.0, 2.0, None], dtype=object), np.ones(3), 1.0)

@@ -68,6 +68,11 @@ def as_array(x: Any, name: str, *, complex_ok: bool) -> np.ndarray:
         arr = np.asarray(x)
     except (ValueError, TypeError):
         raise DataError(f"{name} must be a numeric array; got a ragged or non-numeric sequence") from None
+    if arr.dtype.kind in "US" and arr.size:  # text: name the first entry that does not even read as a number
+        bad = next(((idx, v) for idx, v in np.ndenumerate(arr) if not _reads_as_number(str(v))),
+                   next(np.ndenumerate(arr)))
+        raise DataError(f"{name} must hold numbers; got text, {_files_show(bad[1])} at "
+                        f"[{', '.join(map(str, bad[0]))}]")
     if arr.dtype.kind in "USV" or arr.dtype.kind == "M" or arr.dtype.kind == "m":
         raise DataError(f"{name} must hold numbers; got dtype {arr.dtype}")
     if arr.dtype.kind == "b":
@@ -76,10 +81,14 @@ def as_array(x: Any, name: str, *, complex_ok: bool) -> np.ndarray:
     if arr.dtype.kind == "c" and not complex_ok:
         raise DataError(f"{name} must be real; got complex values")
     if arr.dtype.kind == "O":
+        empty = [idx for idx, v in np.ndenumerate(arr) if v is None]
+        if empty:  # None would become NaN + NaN·j, and be called complex
+            raise DataError(f"{name} holds None at [{', '.join(map(str, empty[0]))}]: a missing value? give a number "
+                            f"(or NaN where a time series' output was not measured)")
         try:
             arr = arr.astype(np.complex128)
         except (TypeError, ValueError):
-            raise DataError(f"{name} must hold numbers; got objects that are not numbers") from None
+            raise DataError(f"{name} must hold numbers; got {_first_non_number(arr)}") from None
         if not complex_ok:
             if np.any(arr.imag != 0):
                 raise DataError(f"{name} must be real; got complex values")
@@ -168,3 +177,27 @@ def check_power_diagonal(arr: np.ndarray, name: str) -> None:
         many = f" ({bad.shape[0]} negative diagonal entries)" if bad.shape[0] > 1 else ""
         raise DataError(f"{name}[{i}, {j}, {j}] = {diag[i, j]:.6g} at frequency line {i}: the diagonal of a power "
                         f"spectrum is a power, ≥ 0{many}")
+
+
+def _first_non_number(arr: np.ndarray) -> str:
+    """Where an object array first holds something that is not a number, and what: ``'abc' at [3]``."""
+    for idx, v in np.ndenumerate(arr):
+        try:
+            complex(v)
+        except (TypeError, ValueError):
+            text = repr(v) if len(repr(v)) <= 40 else repr(v)[:37] + "..."
+            return f"{text} at [{', '.join(map(str, idx))}]"
+    return "objects that are not numbers"
+
+
+def _reads_as_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _files_show(value: object) -> str:
+    text = repr(str(value))
+    return text if len(text) <= 40 else text[:37] + "..."
