@@ -835,3 +835,15 @@ def test_parameters_the_response_never_sees_are_named():
     assert any(n.startswith("the response does not depend on k1e, ke0 at all") for n in rep.notes)
     text = rep.summary()
     assert "  fix k1e, ke0 (known=" in text and "or fix" not in text  # no "or" without a reparameterisation before it
+
+
+def test_a_locally_identifiable_report_says_how_the_solutions_differ_and_what_keeps_one():
+    """Two tanks in series, the second measured, the pump gain known (a new user's trial): the two time constants
+    can swap. The report names the parameters that differ, says they are swapped, and what keeps one solution
+    (the advice identify's bounds follow); a globally identifiable model gets no such section."""
+    k1, k12, k2, b = si.parameters("k1 k12 k2 b", positive=True)
+    tanks = si.StateSpaceModel(A=[[-k1, 0], [k12, -k2]], B=[[b], [0]], C=[[0, 1]]).with_known({"b": 6.67e-5})
+    text = si.identifiability(tanks).summary()
+    assert "another solution differs in k1, k2 (the same values, swapped)" in text
+    assert "to keep one: bounds that leave only it" in text
+    assert "telling the solutions apart" not in si.identifiability(tanks.with_known({"k1": 3e-3})).summary()

@@ -261,6 +261,10 @@ class IdentifiabilityReport:
         if self.solution_count:
             L.append("")
             L.append(f"solutions: {self.solution_count}")
+        apart = self._telling_apart()
+        if apart:
+            L.append("")
+            L.extend(apart)
         if self.combinations:
             L.append("")
             L.append("identifiable combinations:")
@@ -286,6 +290,30 @@ class IdentifiabilityReport:
             L.append("time: " + ", ".join(f"{k} {v:.3f} s" for k, v in self.timing.items())
                      + (f" (exact step: {self.engine})" if self.engine else ""))
         return "\n".join(L)
+
+    def _telling_apart(self) -> list[str]:
+        """For a model that is locally, not globally identifiable: how the admissible solutions at θ* differ (which
+        parameters; a swap said as one) and what keeps one of them."""
+        if self.verdict != "local" or len(self.solutions) < 2:
+            return []
+        first, *others = self.solutions
+        lines = ["telling the solutions apart (at θ*):"]
+        for other in others[:3]:
+            diff = [p for p in self.parameters if p in first and p in other
+                    and abs(other[p] - first[p]) > 1e-9 * max(1.0, abs(first[p]))]
+            if not diff:
+                continue
+            mine, theirs = sorted(first[p] for p in diff), sorted(other[p] for p in diff)
+            swapped = len(diff) > 1 and all(abs(a - b) <= 1e-9 * max(1.0, abs(a)) for a, b in zip(mine, theirs,
+                                                                                                   strict=True))
+            how = " (the same values, swapped)" if swapped else ""
+            lines.append(f"  another solution differs in {', '.join(diff)}{how}: "
+                         + ", ".join(f"{p} {first[p]:.4g} or {other[p]:.4g}" for p in diff))
+        if len(lines) == 1:
+            return []
+        lines.append("  to keep one: bounds that leave only it (si.identify(..., bounds=...) then says UNIQUE WITHIN "
+                     "THE BOUNDS), a known value (model.with_known), or another output that separates them")
+        return lines
 
     def __str__(self) -> str:
         return self.summary()
