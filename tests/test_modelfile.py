@@ -254,3 +254,6 @@ def test_a_non_symmetric_mass_damping_or_stiffness_matrix_is_warned_about():
         warnings.simplefilter("error")
         si.SecondOrderModel(M=[[m, 0], [0, m]], V=[[0, 0], [0, 0]], K=[[k3 + k4, -k4], [-k4, k4]], B=[[1], [0]],
                             C=[[1, 0]])
+        # a DC motor's electromechanical coupling is skew (+K, −K), and right
+        si.SecondOrderModel(M=[[5e-3, 0], [0, m]], V=[[2.0, k3], [-k3, k4]], K=[[0, 0], [0, 0]], B=[[1], [0]],
+                            C=[[0, 1]], output="velocity")

@@ -239,14 +239,17 @@ class SecondOrderModel(ParametricModel):
 
 
 def _warn_if_not_symmetric(matrices: dict[str, sp.Matrix]) -> None:
-    """A ModelWarning naming the first entry where M, V or K is not symmetric: a passive structure's are, and an
-    asymmetry is most often a typo (a new user's trial: ``-k3`` where ``-k4`` belonged, fitted without a word)."""
+    """A ModelWarning naming the first pair of entries of M, V or K that is neither symmetric nor skew: a passive
+    structure's are symmetric, a gyroscopic or electromechanical coupling (a DC motor's ±K) skew, and anything else
+    is most often a typo (a new user's trial: ``-k3`` where ``-k4`` belonged, fitted without a word)."""
     for name in ("M", "V", "K"):
         mat = matrices[name]
         for i in range(mat.rows):
             for j in range(i + 1, mat.cols):
-                if sp.expand(mat[i, j] - mat[j, i]) != 0:
+                # neither symmetric nor skew (a gyroscopic or electromechanical coupling, +K and −K, is skew)
+                if sp.expand(mat[i, j] - mat[j, i]) != 0 and sp.expand(mat[i, j] + mat[j, i]) != 0:
                     warnings.warn(f"{name}[{i}, {j}] = {mat[i, j]} but {name}[{j}, {i}] = {mat[j, i]}: {name} is not "
-                                  f"symmetric, as a passive structure's is (a typo?); ignore this for gyroscopic or "
-                                  f"follower forces", ModelWarning, stacklevel=3)
+                                  f"symmetric, as a passive structure's is, nor skew, as a gyroscopic coupling is (a "
+                                  f"typo?); ignore this for follower forces or active control", ModelWarning,
+                                  stacklevel=3)
                     return
