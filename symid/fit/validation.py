@@ -363,7 +363,7 @@ def _independence(rho_e: np.ndarray, rho_u: np.ndarray, rho: np.ndarray, N: int)
 
 
 def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, max_lag: int = 25,
-             confidence: float = 0.99) -> Validation:
+             confidence: float = 0.99, hold: str = "zoh") -> Validation:
     """Simulate the model at θ on measured records and test what is left (module text).
 
     The simulation holds the input constant between samples (zero-order hold), as
@@ -373,8 +373,11 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
     difference, which grows with frequency, and the residual then tests as coloured and
     correlated with the input although the model is right (a new user's 4-storey frame
     sampled at 8 times its highest mode: fit 68–78 % where the held input gives 99 %).
-    Sample such records faster than their band, or validate on the frequency response
-    (:func:`symid.estimate_frf`, whose periodic estimate needs no hold).
+    For such records give ``hold="foh"``: the input is then taken as linear between samples,
+    which a band-limited signal sampled well above its band nearly is. Nearly: a sum of
+    sines up to 12 rad/s through a 10 rad/s mode, acceleration measured with 2 % noise,
+    fit 80 % held and 97.3 % linear at 25 samples a second (90 % and 97.9 % at 50; the
+    noise alone leaves 98 %), and at 6000 samples the whiteness test still sees the rest.
 
     Parameters
     ----------
@@ -391,6 +394,10 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         M, the largest correlation lag in samples (default 25, MATLAB's ``resid``).
     confidence : {0.99, 0.95}
         Level of the bands and tests.
+    hold : {"zoh", "foh"}
+        How the input moves between samples in the simulation: held (``"zoh"``, default, as
+        :class:`~symid.data.IOData` defines a record) or linear (``"foh"``, for a sampled
+        band-limited input). An estimated initial state is the zero-order hold's least squares.
 
     Returns
     -------
@@ -424,14 +431,23 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         raise DataError(f"max_lag must be an int >= 1 (sample lags); got {max_lag!r}")
     if confidence not in _Z:
         raise DataError(f"confidence must be 0.95 or 0.99; got {confidence!r}")
+    if hold not in ("zoh", "foh"):
+        raise DataError(f"hold must be 'zoh' (the input held between samples) or 'foh' (linear between them); "
+                        f"got {hold!r}")
     M = int(max_lag)
     sim = OutputError(model, data, initial_state=initial_state)
     th = model.theta_vector(theta)
     try:
         ys = sim.simulate(th)
+        x0s = sim.initial_states(th)
+        if hold == "foh":  # the same initial states, the input linear between samples
+            from symid.fit.timeseries.response import simulate_output
+
+            A, B, C, D = (np.asarray(x, dtype=float) for x in model.state_space(th))
+            ys = [simulate_output(A, B, C, D, r.t, r.u, x0, hold="foh") for r, x0 in zip(sim.records, x0s,
+                                                                                         strict=True)]
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise DataError(f"the model cannot be simulated at θ = {model.theta_dict(th)}: {exc}") from None
-    x0s = sim.initial_states(th)
     recs, observed = sim.records, sim.observed
     ys_obs = [np.where(o, r.y, np.nan) for r, o in zip(recs, observed, strict=True)]  # NaN: not measured
     # the correlations run over the sample times where every output was measured, lags counted in those samples

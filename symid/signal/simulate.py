@@ -24,7 +24,7 @@ from symid.errors import DataError, ModelError
 from symid.model.lti import StateSpaceMatrices
 from symid.model.parametric import ParametricModel, Theta
 
-__all__ = ["simulate_frf", "simulate_io", "simulate_spectra", "zoh_discretize"]
+__all__ = ["foh_discretize", "simulate_frf", "simulate_io", "simulate_spectra", "zoh_discretize"]
 
 Model = ParametricModel | BlackBox | StateSpaceMatrices
 Seed = int | np.random.Generator | None
@@ -280,6 +280,30 @@ def zoh_discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray,
     big[:n, n:] = B * dt
     E = scipy.linalg.expm(big)
     return E[:n, :n], E[:n, n:]
+
+
+def foh_discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Exact first-order-hold discretisation (the input linear between samples): Ad = e^{A dt} and G1, G2 with
+    x_{k+1} = Ad x_k + G1 u_k + G2 (u_{k+1} − u_k).
+
+    G1 = ∫₀^dt e^{A σ} dσ B (the zero-order hold's Bd) and G2 = ∫₀^dt e^{A σ} B (dt − σ)/dt dσ, from one block
+    exponential ``expm([[A, B, 0], [0, 0, I/dt], [0, 0, 0]] dt) = [[Ad, G1, G2], [0, I, I], [0, 0, I]]``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> Ad, G1, G2 = foh_discretize(np.array([[-1.0]]), np.array([[1.0]]), 0.5)
+    >>> h = 0.5   # for dx/dt = −x + u, G2 = 1 − (1 − e^{−h}) / h
+    >>> bool(np.isclose(G1[0, 0], 1 - np.exp(-h))), bool(np.isclose(G2[0, 0], 1 - (1 - np.exp(-h)) / h))
+    (True, True)
+    """
+    n, m = B.shape
+    big = np.zeros((n + 2 * m, n + 2 * m))
+    big[:n, :n] = A * dt
+    big[:n, n:n + m] = B * dt
+    big[n:n + m, n + m:] = np.eye(m)
+    E = scipy.linalg.expm(big)
+    return E[:n, :n], E[:n, n:n + m], E[:n, n + m:]
 
 
 def _input_series(u: Any, m: int) -> np.ndarray:

@@ -31,7 +31,7 @@ import casadi as ca
 import numpy as np
 from scipy.linalg import matrix_balance
 
-from symid.signal.simulate import zoh_discretize
+from symid.signal.simulate import foh_discretize, zoh_discretize
 
 __all__ = ["balancing", "casadi_output", "interval_groups", "simulate_output", "squarings", "state_transitions"]
 
@@ -99,11 +99,18 @@ def squarings(A: np.ndarray, B: np.ndarray, h_max: float, balance: tuple[np.ndar
 
 
 def simulate_output(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, t: np.ndarray, u: np.ndarray,
-                    x0: np.ndarray) -> np.ndarray:
-    """ŷ(t_k), shape (N, p), from x(t_0) = x0 (shape (n,)); exact zero-order hold (scipy expm)."""
+                    x0: np.ndarray, hold: str = "zoh") -> np.ndarray:
+    """ŷ(t_k), shape (N, p), from x(t_0) = x0 (shape (n,)); exact for the input held between samples
+    (``hold="zoh"``) or linear between them (``"foh"``) (scipy expm)."""
     reps, group = interval_groups(t)
-    mats = [zoh_discretize(A, B, h) for h in reps]
-    Bu = [u[:-1] @ Bd.T for _, Bd in mats]
+    if hold == "foh":
+        three = [foh_discretize(A, B, h) for h in reps]
+        mats = [(Ad, None) for Ad, _, _ in three]
+        du = np.diff(u, axis=0)
+        Bu = [u[:-1] @ G1.T + du @ G2.T for _, G1, G2 in three]
+    else:
+        mats = [zoh_discretize(A, B, h) for h in reps]
+        Bu = [u[:-1] @ Bd.T for _, Bd in mats]
     N, n = u.shape[0], A.shape[0]
     X = np.empty((N, n))
     x = np.asarray(x0, dtype=float).reshape(n)
