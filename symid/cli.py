@@ -572,8 +572,12 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
             curves["after polish"] = (model, res.polished.theta_vector)
         if truth is not None:
             curves["truth"] = (model, model.theta_vector(truth))
-        written.append(bode_plot(data, curves, out / "bode.png", title=f"{entry.name}: data and estimate",
-                                 h_unit=entry.h_unit(), reference="truth"))
+        _, p_out, m_in = data.H.shape  # one figure per entry of H: bode.png, or bode_<output>_<input>.png
+        for i in range(p_out):
+            for j in range(m_in):
+                name = "bode.png" if p_out * m_in == 1 else f"bode_{i}_{j}.png"
+                written.append(bode_plot(data, curves, out / name, output=i, input=j, reference="truth",
+                                         title=f"{entry.name}: data and estimate", h_unit=entry.h_unit(i, j)))
     best = res.best_start
     if best.history and best.history[0].families:  # SCR: thesis Figure 3-2 for the reported start
         written.append(start_convergence_plot(
@@ -741,7 +745,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "substitution=both; VALUE is a number, true/false/none, JSON, or text")
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
     p.add_argument("--out", metavar="DIR",
-                   help="write result.json and summary.txt here, with bode.png (frequency response) or "
+                   help="write result.json and summary.txt here, with bode.png (frequency response; "
+                        "bode_<output>_<input>.png for each entry of a MIMO one) or "
                         "validation.json, validation.txt, validation_output.png and validation_residual.png (time "
                         "series), and (SCR) convergence.png")
     p.add_argument("--json", action="store_true",

@@ -497,3 +497,21 @@ def test_identify_prints_the_estimates_modes(capsys):
     wn = sorted(abs(p) for p in poles if p.imag > 0)
     hz = [float(x.split(" Hz")[0]) for x in line.removeprefix("modes of the estimate: ").split("; ")]
     np.testing.assert_allclose(hz, np.array(wn) / (2 * np.pi), rtol=1e-3)  # printed to 4 digits
+
+
+def test_a_mimo_frequency_response_gets_a_bode_figure_per_entry(tmp_path, capsys):
+    """Two sensors, one force (a new user's trial: bode.png showed output 0 alone): bode_0_0.png and bode_1_0.png."""
+    (tmp_path / "two.py").write_text(
+        "import symid as si\n"
+        "m1, m2, c1, c2, k1, k2 = si.parameters('m1 m2 c1 c2 k1 k2', positive=True)\n"
+        "model = si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],\n"
+        "                            K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[1, 0], [0, 1]])\n"
+        "start = {'m1': 1.5, 'm2': 1.5, 'c1': 0.3, 'c2': 0.3, 'k1': 3.0, 'k2': 1.5}\n")
+    model = si.load_model(tmp_path / "two.py").model
+    truth = {"m1": 1, "m2": 1, "c1": 0.2, "c2": 0.2, "k1": 2, "k2": 1}
+    si.simulate_frf(model, truth, np.linspace(0.3, 3, 60)).to_csv(tmp_path / "frf.csv")
+    assert main(["identify", str(tmp_path / "two.py"), "--data", str(tmp_path / "frf.csv"), "--out",
+                 str(tmp_path / "out")]) == 0
+    for name in ("bode_0_0.png", "bode_1_0.png"):
+        assert (tmp_path / "out" / name).stat().st_size > 1000
+    assert not (tmp_path / "out" / "bode.png").exists()
