@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from symid.data import _files
 from symid.errors import DataError
 
 __all__ = [
@@ -71,7 +72,7 @@ def as_array(x: Any, name: str, *, complex_ok: bool) -> np.ndarray:
     if arr.dtype.kind in "US" and arr.size:  # text: name the first entry that does not even read as a number
         bad = next(((idx, v) for idx, v in np.ndenumerate(arr) if not _reads_as_number(str(v))),
                    next(np.ndenumerate(arr)))
-        raise DataError(f"{name} must hold numbers; got text, {_files_show(bad[1])} at "
+        raise DataError(f"{name} must hold numbers; got text, {_files._show(str(bad[1]))} at "
                         f"[{', '.join(map(str, bad[0]))}]")
     if arr.dtype.kind in "USV" or arr.dtype.kind == "M" or arr.dtype.kind == "m":
         raise DataError(f"{name} must hold numbers; got dtype {arr.dtype}")
@@ -197,7 +198,3 @@ def _reads_as_number(text: str) -> bool:
         return False
     return True
 
-
-def _files_show(value: object) -> str:
-    text = repr(str(value))
-    return text if len(text) <= 40 else text[:37] + "..."
