@@ -307,8 +307,10 @@ def substitute_known(model: Any, known: Mapping[str, float]) -> Any:
     free = [p for p in model.parameters if p.name not in known]
     sym = {k: v.xreplace(values) for k, v in model.symbolic.items()}
     if isinstance(model, SecondOrderModel):
-        return SecondOrderModel(M=sym["M"], V=sym["V"], K=sym["K"], B=sym["B"], C=sym["C"], output=model.output,
-                                parameters=free, name=model.name)
+        with warnings.catch_warnings():  # the model's own construction said what there is to say of its matrices
+            warnings.simplefilter("ignore", ModelWarning)
+            return SecondOrderModel(M=sym["M"], V=sym["V"], K=sym["K"], B=sym["B"], C=sym["C"],
+                                    output=model.output, parameters=free, name=model.name)
     kind = model.initial_state_kind
     x0: Any = None
     if kind == "estimate":

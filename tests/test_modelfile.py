@@ -257,3 +257,24 @@ def test_a_non_symmetric_mass_damping_or_stiffness_matrix_is_warned_about():
         # a DC motor's electromechanical coupling is skew (+K, −K), and right
         si.SecondOrderModel(M=[[5e-3, 0], [0, m]], V=[[2.0, k3], [-k3, k4]], K=[[0, 0], [0, 0]], B=[[1], [0]],
                             C=[[0, 1]], output="velocity")
+
+
+def test_the_non_symmetric_warning_is_said_once_per_model_not_again_for_its_known_values(tmp_path):
+    """A new user's trial: `symid identify` printed the warning of a non-symmetric K twice, once for the file's
+    model and once for the model with its known masses substituted; the derived model says nothing more."""
+    import warnings
+
+    path = tmp_path / "asym.py"
+    path.write_text("import symid as si\n"
+                    "m1, m2, k1, k2, k3 = si.parameters('m1 m2 k1 k2 k3', positive=True)\n"
+                    "model = si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[0.1, 0], [0, 0.1]],\n"
+                    "                            K=[[k1 + k2, -k2], [-k3, k3]], B=[[1], [0]], C=[[0, 1]])\n"
+                    "known = {'m1': 2.0}\n")
+    with pytest.warns(si.ModelWarning, match=r"K\[0, 1\] = -k2 but K\[1, 0\] = -k3") as seen:
+        spec = si.load_model(str(path))
+    assert sum(issubclass(w.category, si.ModelWarning) for w in seen) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        free = spec.free_model()
+        assert free.parameter_names == ("m2", "k1", "k2", "k3")
+        spec.model.with_known({"m2": 3.0})

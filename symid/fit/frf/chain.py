@@ -59,6 +59,7 @@ stay at the caller's start).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from itertools import combinations
 from math import comb
@@ -68,7 +69,7 @@ import numpy as np
 import scipy.linalg as sla
 import sympy as sp
 
-from symid.errors import DataError, ModelError, OptionError
+from symid.errors import DataError, ModelError, ModelWarning, OptionError
 
 __all__ = ["ChainStart", "chain_start"]
 
@@ -324,7 +325,9 @@ def _siso(model: Any, i: int, j: int, gain: sp.Symbol | None = None) -> Any:
     params = [p for p in model.parameters if p in present]
     if not params:
         return None
-    return SecondOrderModel(**mats, output=model.output, parameters=params)
+    with warnings.catch_warnings():  # the whole model's construction said what there is to say of its matrices
+        warnings.simplefilter("ignore", ModelWarning)
+        return SecondOrderModel(**mats, output=model.output, parameters=params)
 
 
 def chain_start(model: Any, data: Any) -> ChainStart | None:
