@@ -323,3 +323,64 @@ def test_a_fit_weighted_by_an_estimated_variance_is_judged_with_its_degrees_of_f
         over += res.cost > known_floor * chi2_bound(n, 3)
     assert fits == 10
     assert over >= 7
+
+
+def _one_mass_multisine(P: int, seed: int, N: int = 512, dt: float = 0.05):
+    """P periods of a multisine through the one-mass model with 1 % output noise, as si.estimate_frf sees them."""
+    model, truth, _ = one_mass()
+    k = np.arange(3, 200)  # lines 0.74 … 48.8 rad/s around the 5 rad/s mode
+    wk = 2 * np.pi * np.fft.rfftfreq(N, dt)
+    U = np.zeros(N // 2 + 1, complex)
+    U[k] = np.exp(2j * np.pi * np.random.default_rng(0).random(k.size))
+    u1 = np.fft.irfft(U, N)
+    Y = np.zeros(N // 2 + 1, complex)
+    Y[k] = model.frequency_response(truth, wk[k])[:, 0, 0] * np.fft.rfft(u1)[k]
+    y1 = np.fft.irfft(Y, N)
+    y = np.tile(y1, P) + 0.01 * np.std(y1) * np.random.default_rng(seed).standard_normal(N * P)
+    return model, truth, si.estimate_frf(si.IOData(np.tile(u1, P), y, dt), period=N, band=(0.5, 50.0))
+
+
+def test_intervals_of_a_fit_weighted_by_an_estimated_variance_allow_for_its_degrees_of_freedom():
+    """A new user's trial: taking σ̂² from 4 periods as exact, the 95 % intervals held the truth in 70–87.5 % of
+    40 records. The covariance is now ν/(ν − 4) = 3 times that (ν = 6): over 40 records of the one-mass model
+    the intervals hold the truth in at least 90 % of the 120 cases (taking σ̂² as exact, 85–87 % per parameter
+    over 100 records when this test was written). The factor is exact when many lines carry the information
+    and conservative when a few do (here the lines at the lightly damped resonance): the estimates' spread is
+    0.67–0.77 of the median standard error (over 100 records 0.72–0.74); it must not exceed it by more than the
+    sampling error of 40 records (about 12 %) allows, nor fall below half of it."""
+    est, se, cover = [], [], 0
+    for seed in range(40):
+        model, truth, frf = _one_mass_multisine(4, seed)
+        res = si.identify(model, frf, method="lm", x0=truth, identifiability_check=False)
+        unc = res.uncertainty
+        assert "6 degrees of freedom" in unc.note and "3 times" in unc.note
+        est.append(res.theta_vector)
+        se.append(unc.standard_errors)
+        cover += int(np.sum((unc.intervals[:, 0] <= truth) & (truth <= unc.intervals[:, 1])))
+    assert cover >= 108
+    ratio = np.std(est, axis=0, ddof=1) / np.median(se, axis=0)
+    assert np.all((ratio > 0.5) & (ratio < 1.15)), ratio
+
+
+def test_a_variance_from_three_periods_gives_no_intervals_and_says_why():
+    """ν = 4 (3 periods): the covariance of the fit weighted by σ̂² is not finite; the intervals are NaN and the
+    note says what to do (equal weights give them)."""
+    model, truth, frf = _one_mass_multisine(3, 0)
+    assert frf.variance_dof == 4
+    unc = si.identify(model, frf, method="lm", x0=truth, identifiability_check=False).uncertainty
+    assert np.all(np.isnan(unc.intervals)) and np.all(np.isnan(unc.standard_errors))
+    assert "no finite covariance" in unc.note and "variance=None" in unc.note
+    equal = si.identify(model, frf, method="lm", x0=truth, identifiability_check=False, variance=None).uncertainty
+    assert np.all(np.isfinite(equal.intervals))
+
+
+@pytest.mark.parametrize("variance", ["data", None])
+def test_lm_started_at_the_truth_stays_there_when_noise_swamps_the_lines_above_the_mode(variance):
+    """Lines far above a mode, where a flat multisine's output noise is as large as the response (relative
+    errors of the data up to 146 % here), made stage 1's log and relative criteria noise: lm started at the
+    truth ended at m = 104, k = 1823 (misfit 0.96, 4e4 times the truth's), weighted or not (records 36 and 37 of
+    60 when this was found). The judged criterion now starts from the better of stage 1's end and the start."""
+    model, truth, frf = _one_mass_multisine(4, 36)
+    res = si.identify(model, frf, method="lm", x0=truth, identifiability_check=False, variance=variance)
+    assert res.success
+    np.testing.assert_allclose(res.theta_vector, truth, rtol=0.01)

@@ -58,6 +58,7 @@ class FrfFisher(FisherInformation):
     method: ClassVar[str]
     line_weights: np.ndarray | None = None
     line_variance: np.ndarray | None = None
+    estimated_variance_dof: float | None = None
 
     def _sqrt_weights(self) -> np.ndarray:
         """√w per entry of H (ones without noise weighting)."""
@@ -127,12 +128,38 @@ class FrfFisher(FisherInformation):
 
     def uncertainty(self, theta: Any, parameter_names: tuple[str, ...], noise_std: Any = None) -> Uncertainty:
         """As :meth:`FisherInformation.uncertainty`; a noise-weighted fit whose variance is known
-        (``line_variance``) takes σ = √variance as the given noise unless ``noise_std`` is given."""
+        (``line_variance``) takes σ = √variance as the given noise unless ``noise_std`` is given. A variance the
+        data estimated with ν degrees of freedom (``estimated_variance_dof``, from ``si.estimate_frf``) is not
+        exact: the covariance is then ν/(ν − 4) times larger
+        (:func:`~symid.fit.frf.misfit.estimated_variance_inflation`), and not finite for ν ≤ 4 (NaN, with the
+        reason in ``note``)."""
+        import dataclasses
+
+        from symid.fit.frf.misfit import estimated_variance_inflation
+
+        inflation, dof = 1.0, None
         if noise_std is None and self.line_variance is not None:
-            noise_std = np.sqrt(np.asarray(self.line_variance, dtype=float))
+            var = np.asarray(self.line_variance, dtype=float)
+            dof = self.estimated_variance_dof
+            if dof is not None:
+                inflation = estimated_variance_inflation(dof)
+            noise_std = np.sqrt(var * inflation) if np.isfinite(inflation) else np.sqrt(var)
         # the level from the residuals measures what the shape says: relative to |H|, or in H's units
         self.noise_units = "data units" if noise_std is None and self.additive_noise(theta) else "relative"
-        return super().uncertainty(theta, parameter_names, noise_std=noise_std)
+        unc = super().uncertainty(theta, parameter_names, noise_std=noise_std)
+        if dof is None:
+            return unc
+        if np.isfinite(inflation):
+            said = (f"the data's variance is an estimate with {dof:g} degrees of freedom: the covariance of the fit "
+                    f"weighted by it is {inflation:.3g} times the one that takes it as exact")
+            return dataclasses.replace(unc, note=f"{unc.note}; {said}" if unc.note else said)
+        nan = np.full_like(np.asarray(unc.covariance, dtype=float), np.nan)
+        said = (f"intervals withheld: the data's variance is an estimate with {dof:g} degrees of freedom (2 or 3 "
+                f"periods), and a fit weighted by it has no finite covariance (4 periods or more are needed); fit "
+                f"with variance=None (equal weights) for intervals, or measure more periods")
+        return dataclasses.replace(unc, covariance=nan, standard_errors=np.full(nan.shape[0], np.nan),
+                                   intervals=np.full((nan.shape[0], 2), np.nan),
+                                   note=f"{unc.note}; {said}" if unc.note else said)
 
     def estimate_sensitivity(self, theta: Any) -> np.ndarray | None:
         """For ``ls``: the first-order map from the noise on H to θ̂ of the equation-error least squares."""

@@ -11,9 +11,8 @@ from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
 from symid.fit.frf.fisher import FrfFisher
 
-__all__ = ["FrfEstimator", "NoiseWeighted", "check_frf", "estimated_variance_factor", "frf_variance", "frf_weights",
-           "misfit_residuals",
-           "relative_misfit", "relative_residuals"]
+__all__ = ["FrfEstimator", "NoiseWeighted", "check_frf", "estimated_variance_factor", "estimated_variance_inflation",
+           "frf_variance", "frf_weights", "misfit_residuals", "relative_misfit", "relative_residuals"]
 
 VARIANCE_OPTION_DOC = """variance : "data", None or array_like, optional
         Noise weighting of the FRF criterion, Σᵢ Σ_jk |Hᵢ,jk − H(ωᵢ, θ)_jk|² / σ²ᵢ,jk
@@ -281,6 +280,32 @@ def estimated_variance_factor(dof: float, n_data: int, n_parameters: int) -> flo
     return dof / (dof - 2) * (1 + b * spread) / (1 + b)
 
 
+def estimated_variance_inflation(dof: float) -> float:
+    """How much larger the covariance of a fit weighted by 1/σ̂² is, σ̂² estimated with ``dof`` real degrees of
+    freedom ν, than the inverse Fisher information that takes σ̂² as the exact variance: ν/(ν − 4); ``inf`` for
+    ν ≤ 4, where the covariance is not finite.
+
+    Two factors: the information Σ J²/σ̂² is on average ν/(ν − 2) times Σ J²/σ² (the mean of ν/χ²_ν), and
+    weights from a variance estimated over M = ν/2 + 1 periods lose efficiency against the true ones by
+    (M − 2)/(M − 3) = (ν − 2)/(ν − 4) (the sample maximum likelihood estimator: Schoukens, Pintelon,
+    Vandersteen and Guillaume, *Automatica* 33(6), 1997; Pintelon & Schoukens, *System Identification: A
+    Frequency Domain Approach*, 2nd ed., §10.3). Both factors hold when many lines carry the information;
+    when a few do (a lightly damped mode's), the weights' noise does not average out, and the factor is
+    conservative. Measured (``benchmarks/frf_estimated_variance.py``, 100 records each, a periodic
+    multisine, 1 % output noise): on a 3-mass chain (6 parameters) the 95 % intervals held the truth in
+    73–83 % of the records per parameter at 4 periods taking σ̂² as exact and 94–99 % with this factor
+    (84–94 % and 88–99 % at 8 periods); on one mass, 85–87 % and 97–99 % at 4 periods (the estimates'
+    spread 0.72–0.74 of the standard error: conservative).
+
+    Examples
+    --------
+    >>> from symid.fit.frf.misfit import estimated_variance_inflation
+    >>> estimated_variance_inflation(6), estimated_variance_inflation(14), estimated_variance_inflation(4)
+    (3.0, 1.4, inf)
+    """
+    return float(dof / (dof - 4)) if dof > 4 else float("inf")
+
+
 class NoiseWeighted:
     """Mixin of an FRF method with a ``variance=`` option: the weights, the variance, and the noise floor it
     gives, as :class:`~symid.fit.frf.ipopt.IpoptFRF` has them.
@@ -295,6 +320,7 @@ class NoiseWeighted:
     data: Any
     line_weights: np.ndarray | None = None
     line_variance: np.ndarray | None = None
+    estimated_variance_dof: float | None = None
     _noise_floor: float | None = None
     _variance_floor: float | None = None
 
@@ -303,12 +329,14 @@ class NoiseWeighted:
         self.line_weights = frf_weights(self.data, variance)
         self.line_variance = frf_variance(self.data, variance) if self.line_weights is not None else None
         self._variance_floor = None
+        self.estimated_variance_dof = None
         if self.line_variance is not None:
             w = self.line_weights
             self._variance_floor = float(np.sum(w * self.line_variance) /
                                          np.sum(w * np.abs(np.asarray(self.data.H)) ** 2))
             dof = getattr(self.data, "variance_dof", None)
             if isinstance(variance, str) and dof is not None:  # the data's own variance, estimated
+                self.estimated_variance_dof = float(dof)
                 factor = estimated_variance_factor(dof, 2 * int(np.asarray(self.data.H).size),
                                                    int(self.model.n_parameters))
                 self._variance_floor = None if factor is None else self._variance_floor * factor
