@@ -536,8 +536,10 @@ def _time_series_validation(model, data, res, args):
     if data_kind(data).name != "time series":
         return None
     initial = res.options.get("initial_state") if res.options.get("initial_state") == "estimate" else None
+    variance = res.options.get("variance")  # the fit's error model standardises the residual tests too
     try:
-        v = validate(model, res.theta, data, initial_state=initial)
+        v = validate(model, res.theta, data, initial_state=initial,
+                     variance=variance if isinstance(variance, dict) else None)
     except (DataError, ModelError) as exc:
         _say(args, f"note: no validation: {exc}")
         return None

@@ -454,6 +454,29 @@ def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
     np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["q"]], [0.3, 0.05], rtol=1e-6)
 
 
+def test_the_validation_of_identify_uses_the_fits_error_model(tmp_path, capsys):
+    """A one-compartment infusion record with 15 % proportional noise (193 samples): `symid identify` with the
+    error model validates with it too, the residual tests on (y − ŷ)/σ (without it the true model's residual
+    tests as coloured: si.validate's test in tests/test_validation.py)."""
+    (tmp_path / "pk.py").write_text(
+        "import symid as si\n"
+        "ke, q = si.parameters('ke q', positive=True)\n"
+        "model = si.StateSpaceModel(A=[[-ke]], B=[[q]], C=[[1]])\n"
+        "start = {'ke': 0.3, 'q': 0.05}\n")
+    ke, q = si.parameters("ke q", positive=True)
+    t = np.arange(0, 48.125, 0.25)
+    u = np.where(t < 2, 500.0, 0.0) + np.where((t >= 12) & (t < 13), 500.0, 0.0)
+    y0 = si.simulate_io(si.StateSpaceModel(A=[[-ke]], B=[[q]], C=[[1]]), {"ke": 0.2, "q": 0.025}, u, 0.25).y[:, 0]
+    y = y0 * (1 + 0.15 * np.random.default_rng(2001).standard_normal(t.size))
+    np.savetxt(tmp_path / "pk.csv", np.column_stack([t, u, y]), delimiter=",", header="t,rate,conc", comments="")
+    main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), "--columns", "time=t",
+          "input=rate", "output=conc", "--units", "time=h", "--time-unit", "h",
+          "--option", 'variance={"proportional": 0.15}'])
+    said = capsys.readouterr().out
+    assert "residual tests on (y − ŷ)/σ, σ from the given variance (an error model" in said
+    assert "verdict: residual white and independent of the " in said
+
+
 def test_times_converted_to_seconds_are_said(tmp_path, capsys):
     """A file in hours read without --time-unit: the record, and so every rate, is per second. Said, with the flag
     that keeps hours (a new user's trial: rates 3600 times smaller, with nothing said)."""

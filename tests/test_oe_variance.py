@@ -216,8 +216,8 @@ def test_weights_from_the_prediction_are_unbiased_where_the_measured_ones_are_no
     ({"proportional": -0.05}, r"proportional must be a finite number ≥ 0"),
     ({"additive": "1"}, r"additive must be a finite number ≥ 0"),
     ({"proportional": 0.0}, r"proportional = additive = 0 has no noise"),
-    ({"proportional": 0.05}, r"value for sample 0, output 0 is 0, so a proportional error model alone gives it "
-                             r"no noise; add an additive part"),
+    ({"proportional": 0.05, "weights": "measured"}, r"value for sample 0, output 0 is 0, so a proportional error "
+                                                    r"model alone gives it no noise; add an additive part"),
     ("0.01", r"variance must be a number or an array of numbers"),
     (True, r"variance must be a number or an array of numbers"),
 ])

@@ -439,19 +439,20 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             for b in range(1, bands):  # the log criterion on a growing band of the lowest frequencies
                 phi, k = self._stage("log", phi, centre, unit, deadline, max(3, math.ceil(b * s / bands)), anchor)
                 nfev += k
-            for kind in ("log", "rel"):
+            for kind in ("log", "rel", "abs"):
                 phi, k = self._stage(kind, phi, centre, unit, deadline)
                 nfev += k
-            # the judged criterion from the better, by it, of stage 1's end and the pass's start: lines whose
-            # noise is as large as the response (beyond a mode, a flat multisine's) make the log and relative
-            # criteria noise there, and stage 1 walked from the truth itself to a misfit 4e4 times the truth's
-            # (a one-mass model, 1 % output noise, lines up to 10 times the mode; 2 of 60 records)
+            # a pass never ends worse, by the judged criterion, than it began: lines whose noise is as large as
+            # the response (beyond a mode, a flat multisine's) make the log and relative criteria noise there,
+            # and stage 1 walked from the truth itself to a misfit 4e4 times the truth's (a one-mass model, 1 %
+            # output noise, lines up to 10 times the mode; 2 of 60 records). Then stage 2 runs from the start too
             judged = self._residual("abs", centre, unit, deadline, s)
-            if float(np.sum(judged(anchor)[0] ** 2)) < float(np.sum(judged(phi)[0] ** 2)):
-                phi = anchor
             nfev += 2
-            phi, k = self._stage("abs", phi, centre, unit, deadline)
-            nfev += k
+            if float(np.sum(judged(anchor)[0] ** 2)) < float(np.sum(judged(phi)[0] ** 2)):
+                again, k = self._stage("abs", anchor, centre, unit, deadline)
+                nfev += k + 1
+                if float(np.sum(judged(again)[0] ** 2)) < float(np.sum(judged(phi)[0] ** 2)):
+                    phi = again
         except _Budget:
             return self._theta(phi, centre, unit), nfev, True
         return self._theta(phi, centre, unit), nfev, False
@@ -685,9 +686,15 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         edge = self._edge(theta, centre, unit)
         if not edge.any():
             return ""
-        names = ", ".join(n for n, e in zip(self.model.parameter_names, edge, strict=True) if e)
-        return (f"; {names} stopped at 1e6 times the start, the solver's limit: a limit the passes ran into rather "
-                f"than a minimum; a start nearer the typical values (x0= or scale=) may fit better")
+        phi = self._phi(theta, centre, unit)
+        sides = []
+        for factor, side in (("1e-6", phi < 0), ("1e6", phi > 0)):
+            names = ", ".join(n for n, e, d in zip(self.model.parameter_names, edge, side, strict=True) if e and d)
+            if names:
+                sides.append(f"{names} stopped at {factor} times the start")
+        return (f"; {' and '.join(sides)}, the solver's limit: a limit the passes ran into rather than a minimum "
+                f"(a parameter the data hardly feel, or a start far from the typical values: x0= or scale= may fit "
+                f"better)")
 
     def _saturated(self, theta: np.ndarray) -> np.ndarray:
         """The positive parameters the response does not feel at θ (choice 9): their column of the Jacobian

@@ -221,13 +221,16 @@ def error_model_variance(model: dict[str, Any], y: np.ndarray) -> np.ndarray:
     σ² = (a·y)² + b², the combined error model of pharmacokinetics (either part may be left out).
 
     :class:`OutputError` uses it on the measured values for its first fit, and then, unless the model says
-    ``"weights": "measured"``, on the model's prediction (:meth:`OutputError.run`).
+    ``"weights": "measured"``, on the model's prediction (:meth:`OutputError.run`); for that first fit a
+    proportional model alone takes a value below :data:`_PREDICTION_FLOOR` of its output's largest as that
+    fraction (a concentration measured as 0 before the dose).
 
     Raises
     ------
     OptionError
         On other keys, values that are not finite numbers ≥ 0, both parts 0, or a proportional-only model
-        where a measured value is 0 (its variance would be 0: add an additive part).
+        with ``"weights": "measured"`` where a measured value is 0 (its variance would be 0: add an additive
+        part).
 
     Examples
     --------
@@ -236,7 +239,13 @@ def error_model_variance(model: dict[str, Any], y: np.ndarray) -> np.ndarray:
     >>> error_model_variance({"proportional": 0.1, "additive": 0.5}, np.array([[10.0], [0.0]])).ravel().tolist()
     [1.25, 0.25]
     """
-    parts, _ = error_model_parts(model)
+    parts, weights = error_model_parts(model)
+    if weights == "prediction" and parts["additive"] == 0:
+        # these σ² only weigh the first fit, before the prediction's: a value measured as 0 (a concentration
+        # before the dose) counts as the prediction floor, as a predicted 0 does
+        with np.errstate(all="ignore"):
+            top = np.nanmax(np.abs(y), axis=0) if np.any(np.isfinite(y)) else np.zeros(y.shape[1:])
+        y = np.maximum(np.abs(y), _PREDICTION_FLOOR * np.nan_to_num(top))
     var = (parts["proportional"] * y) ** 2 + parts["additive"] ** 2
     if parts["additive"] == 0 and np.any(var == 0):
         k, j = (int(i) for i in np.argwhere(var == 0)[0])
@@ -555,6 +564,12 @@ class OutputError(Estimator, FisherInformation):
         A, B, C, D = self._matrices(theta)
         return [simulate_output(A, B, C, D, r.t, r.u, x0)
                 for r, x0 in zip(self.records, self.initial_states(theta), strict=True)]
+
+    def noise_variance(self, theta: Any) -> list[np.ndarray] | None:
+        """σ² of every measured value at θ, one (N, p) array per record, from the ``variance`` option (an error
+        model's from the prediction at θ unless it says ``"weights": "measured"``); ``None`` without one."""
+        self._anchor(self.model.theta_vector(theta))
+        return None if self._variance is None else [np.array(v) for v in self._variance]
 
     def misfit(self, theta: np.ndarray) -> float:
         """The relative output misfit to the measured samples; ``inf`` where the model overflows.
