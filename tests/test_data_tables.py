@@ -214,6 +214,24 @@ def test_a_unit_in_a_frequency_tables_names_is_checked(tmp_path):
                                                                "phase": "deg"})
 
 
+def test_a_unit_inside_a_columns_name_before_a_channel_suffix_is_checked(tmp_path):
+    """A new user's trial: ``phase_deg_m`` and ``phase_deg_l`` (motor and load) read as radians, accepted (misfit
+    0.92), where ``phase_deg`` was refused. The one word after the first that names a unit of the column's
+    dimension is the name's statement; ``m`` (a length) is not a phase's."""
+    path = write_csv(tmp_path / "frf.csv", ["f_Hz,mag_dB_m,phase_deg_m,t_ms_meas", "1,-20,-90,0", "2,-26,-95,1"])
+    columns = {"frequency": "f_Hz", "magnitude": "mag_dB_m", "phase": "phase_deg_m"}
+    ok = {"frequency": "Hz", "magnitude": "dB", "phase": "deg"}
+    FrequencyData.from_table(path, columns=columns, units=ok)
+    with pytest.raises(si.DataError, match="named 'phase_deg_m', which states deg, but the phase unit declared is rad"):
+        FrequencyData.from_table(path, columns=columns, units={**ok, "phase": "rad"})
+    with pytest.raises(si.DataError, match="named 'mag_dB_m', which states dB, but the magnitude unit declared is "
+                                           "linear"):
+        FrequencyData.from_table(path, columns=columns, units={**ok, "magnitude": "linear"})
+    with pytest.raises(si.DataError, match="named 't_ms_meas', which states ms, but the time unit declared is s"):
+        IOData.from_table(path, columns={"time": "t_ms_meas", "input": "f_Hz", "output": "mag_dB_m"},
+                          units={"time": "s"})
+
+
 def test_a_units_comment_without_declared_units_is_an_error(tmp_path):
     path = write_csv(tmp_path / "plain.csv", ["# units: Hz", "f,re,im", "1.0,0.5,-0.5", "2.0,0.2,-0.4"])
     with pytest.raises(si.DataError) as info:
@@ -516,3 +534,16 @@ def test_a_cell_that_is_not_a_number_in_a_dict_or_frame_is_named_with_its_row():
         IOData(np.array([1, "x", 3], dtype=object), np.ones(3), 1.0)
     with pytest.raises(si.DataError, match=r"holds None at \[2\]: a missing value\?"):
         IOData(np.array([1.0, 2.0, None], dtype=object), np.ones(3), 1.0)
+
+
+def test_mega_is_not_milli_but_capitals_are_read_as_written():
+    """A new user's trial: --units time=Ms and time=MS were both read as milliseconds. Ms (mega) is refused with
+    the reason; MS in capitals (a logger's TIME_MS) is ms; RAD/S in capitals is rad/s, not rad and s."""
+    from symid.data.units import canonical_unit, unit_tokens
+
+    with pytest.raises(si.DataError, match=r"unknown unit 'Ms' \(M is mega: milliseconds are ms\)"):
+        canonical_unit("Ms", "time", "units of 'time'")
+    assert canonical_unit("MS", "time", "units of 'time'") == "ms"
+    assert canonical_unit("ms", "time", "units of 'time'") == "ms"
+    assert unit_tokens("Ms", strict=True) == [] and unit_tokens("MSEC", strict=True) == [("time", "ms")]
+    assert unit_tokens("RAD/S", strict=True) == [("frequency", "rad/s")]

@@ -241,13 +241,25 @@ def _check_name_units(where: str, declared: Mapping[str, str], columns: Mapping[
     for name, role in columns.items():
         base = _base_name(name)
         m = _NAME_UNIT.search(base)
-        if not m or role not in declared:
+        if role not in declared:
             continue
-        text = next(g for g in m.groups() if g is not None)
-        if re.search(r"[_\s]rad[_\s]s(?:ec)?$", base, flags=re.IGNORECASE):  # freq_rad_s: rad/s, not s
-            text = "rad/s"
-        found = unit_tokens(text, strict=True) if _ONE_UNIT.fullmatch(text) else []
         dimension = _UNIT_DIMENSION[role]
+        if m:
+            text = next(g for g in m.groups() if g is not None)
+            if re.search(r"[_\s]rad[_\s]s(?:ec)?$", base, flags=re.IGNORECASE):  # freq_rad_s: rad/s, not s
+                text = "rad/s"
+            found = unit_tokens(text, strict=True) if _ONE_UNIT.fullmatch(text) else []
+        else:
+            found = []
+        if not (len(found) == 1 and found[0][0] == dimension):
+            # a unit inside the name, before a channel's suffix (phase_deg_m, mag_dB_load): the one word after
+            # the first that names a unit of the role's dimension
+            words = re.split(r"[_\s]+", re.sub(r"rad[_\s]s(?:ec)?\b", "rad/s", base, flags=re.IGNORECASE))[1:]
+            inner = {u[1]: (dim, u[1]) for w in words if _ONE_UNIT.fullmatch(w)
+                     for u in unit_tokens(w, strict=True) for dim in [u[0]] if dim == dimension}
+            if len(inner) == 1:
+                found = list(inner.values())
+                text = found[0][1]
         if len(found) == 1 and found[0][0] == dimension and found[0][1] != declared[role]:
             raise DataError(f"{where}: the {role} column is named {name!r}, which states {found[0][1]}, but the "
                             f"{dimension} unit declared is {declared[role]}; check which is right (if {text!r} "

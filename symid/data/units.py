@@ -14,7 +14,8 @@ phase          ``deg``, ``rad``                                    radians
 time, dt       ``s``, ``ms``, ``us``, ``min``, ``h``, ``d``        the record's ``time_unit``
 =============  ==================================================  ==========================
 
-Spellings are matched without regard to case, and a few aliases are accepted
+Spellings are matched without regard to case (but ``Ms``, mega, is not ``ms``; all capitals,
+``MS``, are), and a few aliases are accepted
 (``degrees``, ``µs``, ``sec``, ``hour``, ...); anything else is a
 :class:`~symid.errors.DataError` listing the units above.
 """
@@ -22,6 +23,7 @@ Spellings are matched without regard to case, and a few aliases are accepted
 from __future__ import annotations
 
 import math
+import re
 
 from symid.errors import DataError
 
@@ -49,6 +51,16 @@ _ALIASES = {
 }
 
 
+def _alias(text: str) -> str | None:
+    """The canonical unit a spelling names, without regard to case but for the case of a prefix: ``Ms`` (mega)
+    is not ``ms`` (milli), though ``MS`` (all capitals, as a logger's ``TIME_MS`` writes it) is."""
+    key = re.sub(r"\s+", "", text).lower() if "/" in text else text.strip().lower()
+    name = _ALIASES.get(key)
+    if name == "ms" and text.strip()[:1] == "M" and not text.strip().isupper():
+        return None
+    return name
+
+
 def canonical_unit(text: str, dimension: str, what: str) -> str:
     """The canonical name of a unit of ``dimension`` (``"hz"`` → ``"Hz"``), or a :class:`DataError`.
 
@@ -64,10 +76,11 @@ def canonical_unit(text: str, dimension: str, what: str) -> str:
     """
     if not isinstance(text, str):
         raise DataError(f"{what}: a unit is a name such as {', '.join(DIMENSIONS[dimension])}; got {text!r}")
-    name = _ALIASES.get(text.strip().lower()) if len(text) <= 40 else None
+    name = _alias(text) if len(text) <= 40 else None
     if name is None or name not in DIMENSIONS[dimension]:
         shown = repr(text) if len(text) <= 40 else f"{text[:40]!r}..."
-        raise DataError(f"{what}: unknown unit {shown}; symid reads {', '.join(DIMENSIONS[dimension])}")
+        mega = " (M is mega: milliseconds are ms)" if text.strip()[:1] == "M" and name is None else ""
+        raise DataError(f"{what}: unknown unit {shown}{mega}; symid reads {', '.join(DIMENSIONS[dimension])}")
     return name
 
 
@@ -104,12 +117,10 @@ def unit_tokens(text: str, *, strict: bool = False) -> list[tuple[str, str]]:
     >>> unit_tokens("s"), unit_tokens("s", strict=True)
     ([], [('time', 's')])
     """
-    import re
-
     out = []
-    for token in re.findall(r"rad\s*/\s*s(?:ec)?\b|[A-Za-zµμ°]+", text):
+    for token in re.findall(r"rad\s*/\s*s(?:ec)?\b|[A-Za-zµμ°]+", text, flags=re.IGNORECASE):
         raw = re.sub(r"\s+", "", token).lower()
-        name = _ALIASES.get(raw)
+        name = _alias(re.sub(r"\s+", "", token))
         if name is None or (not strict and raw in _AMBIGUOUS):
             continue
         dimension = next(d for d, units in DIMENSIONS.items() if name in units)

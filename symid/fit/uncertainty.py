@@ -65,9 +65,8 @@ import numpy as np
 
 from symid.errors import DataError
 
-__all__ = ["BOUND_PULL_LIMIT", "NEAR_SINGULAR", "ROUNDING_SHIFT", "SHIFT_LIMIT", "FisherInformation", "Uncertainty",
-           "broadcast_noise",
-           "fisher_uncertainty"]
+__all__ = ["BOUND_PULL_LIMIT", "NEAR_SINGULAR", "POSITIVITY_ZERO", "ROUNDING_SHIFT", "SHIFT_LIMIT", "FisherInformation",
+           "Uncertainty", "broadcast_noise", "fisher_uncertainty"]
 
 NEAR_SINGULAR = 1e-8
 """Smallest/largest eigenvalue of the correlation-scaled Fisher information below which it is near-singular."""
@@ -87,6 +86,10 @@ BOUND_PULL_LIMIT = 3.0
 """Largest distance, in its own standard errors, by which a bound may hold a parameter back from the least-squares
 estimate for the other parameters' intervals to be given (:func:`_with_shift`): beyond it the data reject the bound
 (with the truth on the bound, the least-squares estimate lies beyond it by less than this in 99.9 % of records)."""
+
+POSITIVITY_ZERO = 1e-3
+"""A parameter declared positive within this fraction of its own standard error of 0 sits on the bound 0 that
+keeps it positive, for the intervals (:func:`_with_shift`): the data cannot tell it from 0."""
 
 _Z975 = 1.959963984540054  # the 0.975 quantile of the standard normal
 
@@ -251,7 +254,23 @@ class FisherInformation(abc.ABC):
             return unc
         lower, upper = getattr(self, "lower", None), getattr(self, "upper", None)
         bounds = None if lower is None or upper is None else (np.asarray(lower, float), np.asarray(upper, float))
-        return _with_shift(unc, r, J, self._bound_sides(theta), bounds)
+        sides = self._bound_sides(theta)
+        at_zero = self._at_positivity_bound(theta, unc)
+        if at_zero.any():  # the 0 that keeps them positive holds them as a bound does
+            sides = np.where(at_zero, -1, np.zeros(theta.size, int) if sides is None else sides)
+            lo, hi = (np.full(theta.size, -np.inf), np.full(theta.size, np.inf)) if bounds is None else bounds
+            bounds = (np.where(at_zero, 0.0, lo), hi)
+        return _with_shift(unc, r, J, sides, bounds, at_zero)
+
+    def _at_positivity_bound(self, theta: np.ndarray, unc: Uncertainty) -> np.ndarray:
+        """The parameters declared positive that sit at 0 as far as the data can tell: within
+        :data:`POSITIVITY_ZERO` of their own standard error (a new user's motor: the frictions ended at 1e-10
+        where their standard errors are 1e-3, and the shift of that held zero withheld every interval)."""
+        positive = np.asarray(getattr(getattr(self, "model", None), "positive", np.zeros(theta.size, bool)), bool)
+        if positive.shape != theta.shape:
+            return np.zeros(theta.size, bool)
+        se = np.sqrt(np.abs(np.diag(np.asarray(unc.covariance, dtype=float))))
+        return positive & np.isfinite(se) & (se > 0) & (np.abs(theta) <= POSITIVITY_ZERO * se)
 
     def _bound_sides(self, theta: np.ndarray) -> np.ndarray | None:
         """Per parameter: −1 on its lower bound, +1 on its upper, 0 inside (None for a method without bounds).
@@ -267,15 +286,22 @@ class FisherInformation(abc.ABC):
 
 
 def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarray | None = None,
-                bounds: tuple[np.ndarray, np.ndarray] | None = None) -> Uncertainty:
+                bounds: tuple[np.ndarray, np.ndarray] | None = None, at_zero: np.ndarray | None = None
+                ) -> Uncertainty:
     """Add the distance from θ̂ to the least-squares estimate (one Gauss–Newton step on ‖r + J δ‖²); beyond
     ``SHIFT_LIMIT`` standard errors the intervals become NaN and the note says why (that the step leaves the
     bounds where θ̂ sits on one, ``sides``: −1 on a lower bound, +1 on an upper, 0 inside). Where the step
     leaves bounds by less than ``BOUND_PULL_LIMIT`` of each such parameter's own standard error and θ̂ is the
     least-squares estimate with those parameters held on their bounds, only their intervals are NaN (one
     slightly active bound does not withhold every interval). Within ``SHIFT_LIMIT``, the interval of a
-    parameter on a bound is cut at it (``bounds``: (lower, upper)), and the note says so."""
+    parameter on a bound is cut at it (``bounds``: (lower, upper)), and the note says so. ``at_zero`` marks the
+    lower bounds that are the 0 of a parameter declared positive (named so)."""
     import dataclasses
+
+    def side(k: int) -> str:
+        if at_zero is not None and at_zero[k]:
+            return "at 0, the bound of a parameter declared positive"
+        return "lower" if sides[k] < 0 else "upper"
 
     l = unc.covariance.shape[0]
     if not np.all(np.isfinite(unc.covariance)) or not np.all(np.isfinite(J)):
@@ -304,7 +330,7 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
             lo, hi = intervals[k]
             intervals[k] = np.clip(intervals[k], bounds[0][k], bounds[1][k])
             if (lo, hi) != tuple(intervals[k]):
-                cut.append(f"{unc.parameter_names[k]} ({'lower' if sides[k] < 0 else 'upper'}; the data alone "
+                cut.append(f"{unc.parameter_names[k]} ({side(k)}; the data alone "
                            f"would reach {lo if sides[k] < 0 else hi:.6g})")
         if not cut:
             return dataclasses.replace(unc, shift=shift)
@@ -319,7 +345,7 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
     if held is not None and held <= SHIFT_LIMIT:
         # each bound holds its parameter back by less than BOUND_PULL_LIMIT of its own standard errors (the data do not
         # reject the bound), and with them held θ̂ is the least-squares estimate: the others' intervals hold
-        names = ", ".join(f"{unc.parameter_names[k]} ({'lower' if sides[k] < 0 else 'upper'})" for k in pushed)
+        names = ", ".join(f"{unc.parameter_names[k]} ({side(k)})" for k in pushed)
         intervals = np.array(unc.intervals, dtype=float, copy=True)
         intervals[pushed] = np.nan
         note = (f"{unc.note + '. ' if unc.note else ''}θ̂ sits on its bounds where the data pull it slightly "
@@ -329,7 +355,7 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
                 f"(they allow the held parameters to move, so they are wider, not narrower, than with them fixed)")
         return dataclasses.replace(unc, shift=shift, note=note, intervals=intervals)
     if pushed:
-        names = ", ".join(f"{unc.parameter_names[k]} ({'lower' if sides[k] < 0 else 'upper'})" for k in pushed)
+        names = ", ".join(f"{unc.parameter_names[k]} ({side(k)})" for k in pushed)
         note = (f"{unc.note + '. ' if unc.note else ''}θ̂ sits on its bounds where the data pull it beyond them: "
                 f"{names}; the least-squares estimate of these data lies {shift:.3g} standard errors away, outside "
                 f"the bounds, so intervals around θ̂ would not hold and none are given (NaN); widen the bounds if "

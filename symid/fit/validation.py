@@ -151,6 +151,16 @@ class Validation:
             verdict.append("residual NOT white (model or noise structure missing)")
         if not np.all(self.independent):
             verdict.append("residual correlated with past inputs (dynamics not captured)")
+        if verdict:  # a failure near the level can be chance: say how often a true model fails one of these tests
+            pv = np.concatenate([np.ravel(self.whiteness_p), np.ravel(self.independence_p)])
+            pv = pv[np.isfinite(pv)]
+            alpha = 1 - self.confidence
+            failed = pv[pv < alpha]
+            if failed.size and float(failed.min()) >= alpha / 10:
+                chance = 1 - self.confidence ** pv.size
+                verdict.append(f"marginal (smallest p-value {float(failed.min()):.2g}, within a factor 10 of the "
+                               f"level): a true model fails one of these {pv.size} tests in {100 * chance:.0f} % of "
+                               f"records, so try another record before concluding")
         lines.append("verdict: " + ("; ".join(verdict) if verdict else "residual white and independent of the "
                                     "inputs at this level"))
         lines.extend(f"note: {t}" for t in self.notes)
