@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import re
 import sys
 import threading
 import time
@@ -400,8 +399,6 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                      f"{time_unit}")
     if spec.known:
         _say(args, "known: " + ", ".join(f"{k} = {v:.6g}" for k, v in spec.known.items()))
-    for line in _unit_mismatches(args, spec):
-        _show_text_warning(args, line)
     truth = _truth(spec, args)
     model = spec.free_model()
     x0 = spec.start if spec.start is not None else spec.bounds_centre()
@@ -451,37 +448,6 @@ def _cmd_identify(args: argparse.Namespace) -> int:
 
 NO_FIT = 4
 """Exit status of ``symid identify`` when it ran and wrote its result but no start fitted the data."""
-
-
-def _unit_mismatches(args: argparse.Namespace, spec) -> list[str]:
-    """Where a CSV file states a unit for an input or output column (``# units: dose [ug/h]``) other than the
-    model file's ``input_units``/``output_units``: symid converts neither, so a factor between them goes into
-    the estimates (a new user's trial: µg/h against mg/h, a gain 1000 times off, said nowhere)."""
-    files = [f for f in _data_files(args) if not str(f).lower().endswith(".mat")]
-    if not files or args.columns is None:
-        return []
-    from symid.data.table import stated_column_units
-
-    stated: dict[str, str] = {}
-    for f in files:
-        try:
-            stated.update(stated_column_units(f, "\t" if args.delimiter == "tab" else args.delimiter))
-        except Exception:  # the data were read already; a comment the reader took cannot fail here, and a check
-            pass           # never costs the user the fit
-    columns = _pairs(args.columns, "--columns", "identify", repeatable=("input", "output"))
-
-    def same(a: str, b: str) -> bool:
-        norm = [re.sub(r"\s+", "", x).lower().replace("µ", "u").replace("μ", "u") for x in (a, b)]
-        return norm[0] == norm[1]
-
-    out = []
-    for role, declared in (("input", spec.input_units), ("output", spec.output_units)):
-        for i, name in enumerate(columns.get(role, [])):
-            if i < len(declared) and name in stated and not same(stated[name], declared[i]):
-                out.append(f"the file states {stated[name]} for {role} {name!r}; the model file's {role} unit is "
-                           f"{declared[i]}: symid converts neither, so a factor between them goes into the "
-                           f"estimates; convert the data or the model")
-    return out
 
 
 def _show_text_warning(args: argparse.Namespace, text: str) -> None:
@@ -575,11 +541,14 @@ def _write_identify(out, entry, model, data, res, truth, args, validation=None) 
         if truth is not None:
             curves["truth"] = (model, model.theta_vector(truth))
         _, p_out, m_in = data.H.shape  # one figure per entry of H: bode.png, or bode_<output>_<input>.png
+        given = dict(_pairs(args.units, "--units", "identify")) if getattr(args, "units", None) else {}
+        hz = str(given.get("frequency", "")).strip().lower() in ("hz", "khz")  # the axis as the data were given
         for i in range(p_out):
             for j in range(m_in):
                 name = "bode.png" if p_out * m_in == 1 else f"bode_{i}_{j}.png"
                 written.append(bode_plot(data, curves, out / name, output=i, input=j, reference="truth",
-                                         title=f"{entry.name}: data and estimate", h_unit=entry.h_unit(i, j)))
+                                         title=f"{entry.name}: data and estimate", h_unit=entry.h_unit(i, j),
+                                         hz=hz))
     best = res.best_start
     if best.history and best.history[0].families:  # SCR: thesis Figure 3-2 for the reported start
         written.append(start_convergence_plot(

@@ -303,6 +303,13 @@ def substitute_known(model: Any, known: Mapping[str, float]) -> Any:
     known = _known_values(dict(known), model, "known")
     if not known:
         return model
+    out = _substituted(model, known)
+    out.io_units = dict(getattr(model, "io_units", {}))
+    return out
+
+
+def _substituted(model: Any, known: Mapping[str, float]) -> Any:
+    """:func:`substitute_known`'s new model (``known`` checked and not empty)."""
     values = {p: sp.Float(known[p.name]) for p in model.parameters if p.name in known}
     free = [p for p in model.parameters if p.name not in known]
     sym = {k: v.xreplace(values) for k, v in model.symbolic.items()}
@@ -424,6 +431,8 @@ def from_module(module: ModuleType, *, name: str, where: str, path: str | None =
         raise ModelError(f"{where}: give both input_units and output_units (the unit of H is their ratio), "
                          "e.g. input_units, output_units = \"N\", \"m\"")
     texts = {k: _text(declared.get(k, ""), k, where) for k in ("title", "source", "notes")}
+    if units_in:  # what the data files' stated units are compared with (si.identify)
+        model.io_units = {"input": tuple(units_in), "output": tuple(units_out)}
     common = dict(name=name, model=model, known=known, start=start, scale=scale, bounds=bounds,
                   input_units=units_in, output_units=units_out, path=path, **texts)
     zoo_names = [k for k in ("truth", "make_data") if k in names]

@@ -54,7 +54,7 @@ _CURVE_STYLES = [dict(lw=5.0, alpha=0.35, ls="-"), dict(lw=2.2, ls="-"), dict(lw
 
 def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | Path, *,
               output: int = 0, input: int = 0, n_grid: int = 400, title: str | None = None,
-              h_unit: str | None = None, reference: str | None = None) -> Path:
+              h_unit: str | None = None, reference: str | None = None, hz: bool = False) -> Path:
     """Bode magnitude and phase of measured data against model estimates, saved as PNG.
 
     Parameters
@@ -76,10 +76,18 @@ def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | P
         axis reads "|H| (dB re 1 m/N)". Without it the axis says the unit is not given.
     reference : str, optional
         The label of a curve to draw as a wide pale band under the others (e.g. the truth).
+    hz : bool
+        Frequency axis in Hz (as the data were given) instead of rad/s.
 
     Returns
     -------
     pathlib.Path
+
+    Notes
+    -----
+    Each measured phase is drawn at the turn (a multiple of 360°) nearest to the reference curve's (the
+    ``reference`` estimate, else the first), whose phase is unwrapped along the fine grid: unwrapping the
+    measured points themselves put a good fit 360° off, and noisy lines at ±900° (a new user's motor).
     """
     plt = _pyplot()
     w = np.asarray(data.w)
@@ -88,7 +96,9 @@ def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | P
     pad = 0.3 * max(hi - lo, 0.2)
     grid = np.logspace(lo - pad, hi + pad, n_grid)
     fig, (ax_m, ax_p) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6.2))
+    x = 1 / (2 * np.pi) if hz else 1.0
     k = 0
+    ref_phase = None
     for label, (model, theta) in sorted(estimates.items(), key=lambda item: item[0] != reference):
         Hm = model.frequency_response(theta, grid)[:, output, input]
         if label == reference:
@@ -96,14 +106,18 @@ def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | P
         else:
             k += 1
             style = _CURVE_STYLES[1 + (k - 1) % (len(_CURVE_STYLES) - 1)]
-        line, = ax_m.semilogx(grid, 20 * np.log10(np.abs(Hm)), label=_escape(label), **style)
-        ax_p.semilogx(grid, np.degrees(np.unwrap(np.angle(Hm))), color=line.get_color(), **style)
-    ax_m.semilogx(w, 20 * np.log10(np.abs(H)), "ko", ms=5, mfc="none", label="data", zorder=5)
-    ax_p.semilogx(w, np.degrees(np.unwrap(np.angle(H))), "ko", ms=5, mfc="none", zorder=5)
+        phase = np.unwrap(np.angle(Hm))
+        if ref_phase is None and np.all(np.isfinite(phase)):
+            ref_phase = phase
+        line, = ax_m.semilogx(grid * x, 20 * np.log10(np.abs(Hm)), label=_escape(label), **style)
+        ax_p.semilogx(grid * x, np.degrees(phase), color=line.get_color(), **style)
+    measured = _measured_phase(w, H, grid, ref_phase)
+    ax_m.semilogx(w * x, 20 * np.log10(np.abs(H)), "ko", ms=5, mfc="none", label="data", zorder=5)
+    ax_p.semilogx(w * x, np.degrees(measured), "ko", ms=5, mfc="none", zorder=5)
     unit = f"dB re 1 {_escape(h_unit)}" if h_unit else "dB; unit of H not given"
     ax_m.set_ylabel(f"magnitude |H| ({unit})")
     ax_p.set_ylabel("phase ∠H (degrees)")
-    ax_p.set_xlabel("angular frequency ω (rad/s)")
+    ax_p.set_xlabel("frequency f (Hz)" if hz else "angular frequency ω (rad/s)")
     for ax in (ax_m, ax_p):
         ax.grid(True, which="both", alpha=0.3)
     _log_axis(ax_p)
@@ -112,6 +126,25 @@ def bode_plot(data: Any, estimates: Mapping[str, tuple[Any, Any]], path: str | P
     ax_m.set_title(_escape(title or "Bode plot") + suffix, fontsize=11)
     fig.tight_layout()
     return _save(fig, path, dpi=110)
+
+
+def _measured_phase(w: np.ndarray, H: np.ndarray, grid: np.ndarray, ref_phase: np.ndarray | None) -> np.ndarray:
+    """The measured phases (rad), each at the turn nearest the reference curve's unwrapped phase on ``grid`` (the
+    measured points unwrapped among themselves without one).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.plots import _measured_phase
+    >>> grid = np.array([1.0, 10.0])
+    >>> H = np.exp(1j * np.array([0.9 * np.pi, -0.9 * np.pi]))   # 162° and −162°: both near −180° and 180°
+    >>> np.degrees(_measured_phase(np.array([1.0, 10.0]), H, grid, np.array([-np.pi, -np.pi]))).round(1).tolist()
+    [-198.0, -162.0]
+    """
+    if ref_phase is None:
+        return np.unwrap(np.angle(H))
+    near = np.interp(np.log(w), np.log(grid), ref_phase)
+    return near + np.angle(H * np.exp(-1j * near))
 
 
 def convergence_plot(groups: Mapping[str, Sequence[float]], path: str | Path, *, title: str | None = None,

@@ -506,7 +506,7 @@ def test_an_input_unit_the_file_states_against_the_model_files_is_said(tmp_path,
         (tmp_path / "pk.csv").write_text(f"# units: t [h], dose [{unit}], conc [mg/L]\nt,dose,conc\n{rows}\n")
         main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), *args])
         err = capsys.readouterr().err
-        assert ("warning: the file states ug/h for input 'dose'; the model file's input unit is mg/h" in err) == warned
+        assert ("the file states ug/h for input 'dose'; the model file's input unit is mg/h" in err) == warned
 
 
 def test_identify_prints_the_estimates_modes(capsys):

@@ -355,3 +355,24 @@ def test_a_fit_to_rounding_keeps_its_intervals():
     assert np.all(np.isfinite(unc.intervals))
     np.testing.assert_allclose(unc.intervals.mean(axis=1), res.theta_vector, rtol=1e-12)
     assert np.all(unc.standard_errors <= 1e-12 * np.abs(res.theta_vector))
+
+
+def test_the_weakest_direction_is_shown_in_relative_changes():
+    """A new user's motor with its torque constant free: the response fixes only ratios, and the common scaling of
+    every parameter is the null direction. In absolute units it read "-0.73·ks -0.69·Kt -0.00·ds" (the small
+    inertias and dampers at 0); in relative changes each of J, b and Kt here has an equal part, 1/√3."""
+    J, b, Kt = si.parameters("J b Kt", positive=True)
+    model = si.SecondOrderModel(M=[[J]], V=[[b]], K=[[0]], B=[[Kt]], C=[[1]], output="velocity")
+    truth = {"J": 2e-4, "b": 1e-4, "Kt": 0.05}
+    frf = si.simulate_frf(model, truth, np.logspace(-1, 2, 30), noise=0.01, seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", si.IdentifiabilityWarning)
+        res = si.identify(model, frf, method="ipopt", x0=truth, identifiability_check=False)
+    unc = res.uncertainty
+    assert unc.near_singular
+    rel = np.array([unc.weakest_relative[n] for n in ("J", "b", "Kt")])
+    np.testing.assert_allclose(np.abs(rel), 1 / np.sqrt(3), rtol=1e-3)
+    assert np.all(np.sign(rel) == np.sign(rel[0]))
+    assert abs(unc.weakest["Kt"]) > 0.99  # in absolute units the largest parameter takes the direction
+    line = next(x for x in unc.summary().splitlines() if "NEAR-SINGULAR" in x)
+    assert all(f"·δ{n}/{n}" in line for n in ("J", "b", "Kt")) and "(relative changes)" in line

@@ -391,7 +391,11 @@ def stated_column_units(path: Any, delimiter: str = ",") -> dict[str, str]:
     >>> stated_column_units(path)
     {'t': 'h', 'dose': 'mg/h', 'conc': 'mg/L'}
     """
-    src = _Csv(path, delimiter)
+    return _column_units(_Csv(path, delimiter))
+
+
+def _column_units(src: _Csv) -> dict[str, str]:
+    """:func:`stated_column_units` of a file already read."""
     out: dict[str, str] = {}
     for _, comment in src.comments:
         if not re.search(r"\bunits?\b", comment, flags=re.IGNORECASE):
@@ -718,12 +722,20 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
     y = np.hstack([cols.channels(n, missing_ok=not uniform) for n in outputs])
     with _naming(src.where):
         if not uniform:
-            return TimeSeries(t, u, y, time_unit=target)
-        if t is None:
-            step = checks.check_positive_scalar(dt, "dt") * factor
+            record: TimeSeries | IOData = TimeSeries(t, u, y, time_unit=target)
         else:
-            step = _uniform_step(t, src.where)
-        return IOData(u, y, step, time_unit=target)
+            if t is None:
+                step = checks.check_positive_scalar(dt, "dt") * factor
+            else:
+                step = _uniform_step(t, src.where)
+            record = IOData(u, y, step, time_unit=target)
+    if isinstance(src, _Csv):
+        stated = _column_units(src)
+        if any(n in stated for n in (*inputs, *outputs)):
+            units = {"input": tuple((n, stated.get(n)) for n in inputs),  # a CSV column is one channel
+                     "output": tuple((n, stated.get(n)) for n in outputs)}
+            object.__setattr__(record, "stated_units", units)  # on the object read: metadata, not a field
+    return record
 
 
 def _check_time_order(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) -> None:

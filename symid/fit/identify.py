@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 import time
 import warnings
 from typing import Any
 
 import numpy as np
 
-from symid.errors import IdentifiabilityWarning, OptionError
+from symid.errors import DataWarning, IdentifiabilityWarning, OptionError
 from symid.fit.options import check_bool, scale_by_name
 from symid.fit.registry import check_model, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
@@ -18,7 +19,7 @@ from symid.fit.uncertainty import FisherInformation
 from symid.interrupt import Interrupted
 from symid.progress import progress_bar
 
-__all__ = ["identify"]
+__all__ = ["identify", "unit_mismatches"]
 
 
 _SEVERAL_INTERVALS = (
@@ -72,6 +73,50 @@ def _nearest(others: list[dict[str, float]] | None, theta: np.ndarray, unc: Any)
     how = f" ({dist:.3g} standard errors away in {name}, the farthest)" if np.isfinite(dist) else ""
     more = f"; {len(others) - 1} more in options['solutions_at_estimate']" if len(others) > 1 else ""
     return f"; at this estimate the other solution is {values}{how}{more}"
+
+
+def _same_unit(a: str, b: str) -> bool:
+    """Two spellings of a unit alike but for spaces and case of µ (``mg / h`` is ``mg/h``)."""
+    norm = [re.sub(r"\s+", "", x).replace("µ", "u").replace("μ", "u") for x in (a, b)]
+    return norm[0] == norm[1] or (norm[0].lower() == norm[1].lower() and norm[0].lower() in _CASELESS)
+
+
+_CASELESS = frozenset({"deg", "rad", "degree", "degrees", "radian", "radians"})
+
+
+def unit_mismatches(model: Any, data: Any) -> list[str]:
+    """What a data file's stated input and output units (``data.stated_units``) say against the model's declared
+    ones (``model.io_units``, from a model file): one sentence per channel whose units differ; [] when either
+    side states none.
+
+    symid converts neither, so a factor between them goes into the estimates without a word: a new user's
+    encoder angles in degrees fitted a model in radians with ``success=True`` and every inertia off by π/180.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> k, g = si.parameters("k g", positive=True)
+    >>> model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    >>> model.io_units = {"input": ("A",), "output": ("rad",)}
+    >>> io = si.IOData([[1.0], [0.0], [0.0]], [[0.0], [1.0], [0.5]], 0.1)
+    >>> object.__setattr__(io, "stated_units", {"input": (("i", "A"),), "output": (("theta", "deg"),)})
+    >>> unit_mismatches(model, io)[0][:68]
+    "the file states deg for output 'theta'; the model file's output unit"
+    """
+    declared = getattr(model, "io_units", None) or {}
+    records = data if isinstance(data, (list, tuple)) else [data]
+    out: list[str] = []
+    for record in records:
+        stated = getattr(record, "stated_units", None) or {}
+        for role in ("input", "output"):
+            for (column, have), want in zip(stated.get(role, ()), declared.get(role, ()), strict=False):
+                if have and want and not _same_unit(have, want):
+                    text = (f"the file states {have} for {role} {column!r}; the model file's {role} unit is {want}: "
+                            f"symid converts neither, so a factor between them goes into the estimates; convert "
+                            f"the data or the model")
+                    if text not in out:
+                        out.append(text)
+    return out
 
 
 def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None, starts: int = 1,
@@ -216,6 +261,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     check_model(model)
     options = scale_by_name(options, model.parameter_names)  # a dict by name, as x0 may be
     estimator = prepare(model, data, method, options, noise_floor=noise_floor)
+    for text in unit_mismatches(model, data):
+        warnings.warn(text, DataWarning, stacklevel=2)
     if noise_std is not None and not isinstance(estimator, FisherInformation):
         raise OptionError(f"noise_std is for the uncertainty of the estimate, which method {estimator.method!r} "
                           "on this data kind does not give")

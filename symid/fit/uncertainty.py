@@ -123,6 +123,11 @@ class Uncertainty:
         non-identifiable from these data.
     weakest : dict of str to float
         The (unit) direction of θ the data determine least, by parameter name.
+    weakest_relative : dict of str to float or None
+        The same direction in relative changes δθᵢ/θ̂ᵢ (a unit vector; 0 for a parameter at 0): what
+        ``summary()`` shows, since in absolute units parameters of small magnitude (an inertia of 2e-4 beside a
+        stiffness of 3) read as 0 in it whatever their part (a new user's motor: a common scaling of all seven
+        parameters was shown as "ks and Kt").
     residual_ratio : float or None
         With given noise: rms of the residual in units of the given noise (≈ 1 when it is right).
     note : str
@@ -151,6 +156,7 @@ class Uncertainty:
     residual_ratio: float | None = None
     note: str = ""
     shift: float | None = None
+    weakest_relative: dict[str, float] | None = None
 
     @property
     def correlation(self) -> np.ndarray:
@@ -178,9 +184,14 @@ class Uncertainty:
             if self.shift is not None and self.shift <= SHIFT_LIMIT:
                 text += f" (θ̂ lies {self.shift:.2g} standard errors from the least-squares estimate)"
         if self.near_singular:
-            top = sorted(self.weakest.items(), key=lambda kv: -abs(kv[1]))[:3]
+            rel = self.weakest_relative is not None and any(self.weakest_relative.values())
+            vec = self.weakest_relative if rel else self.weakest
+            big = max((abs(v) for v in vec.values()), default=0.0)
+            top = sorted(((k, v) for k, v in vec.items() if abs(v) >= 0.2 * big), key=lambda kv: -abs(kv[1]))
+            shown = " ".join(f"{v:+.2f}·{'δ' + k + '/' + k if rel else k}" for k, v in top[:8])
+            more = f" and {len(top) - 8} more" if len(top) > 8 else ""
             text += ("\n  NEAR-SINGULAR Fisher information: the data hardly determine the direction "
-                     + " ".join(f"{v:+.2f}·{k}" for k, v in top) + " (practically non-identifiable)")
+                     + shown + more + (" (relative changes)" if rel else "") + " (practically non-identifiable)")
         return text
 
     def to_dict(self) -> dict[str, Any]:
@@ -190,6 +201,7 @@ class Uncertainty:
                 "noise_std": _plain(self.noise_std), "noise_units": self.noise_units,
                 "noise_source": self.noise_source, "dof": self.dof, "condition": _plain(self.condition),
                 "near_singular": self.near_singular, "weakest": dict(self.weakest),
+                "weakest_relative": None if self.weakest_relative is None else dict(self.weakest_relative),
                 "residual_ratio": self.residual_ratio, "note": self.note,
                 "shift": None if self.shift is None else float(self.shift)}
 
@@ -550,6 +562,10 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     w = vec[:, 0][:l] / safe[:l]
     w = w / (np.linalg.norm(w) or 1.0)
     weakest = dict(zip(names, np.round(w, 6).tolist(), strict=True))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        wr = np.where(np.abs(theta) > 0, w / np.where(np.abs(theta) > 0, theta, 1.0), 0.0)
+    wr = wr / (np.linalg.norm(wr) or 1.0) if np.all(np.isfinite(wr)) else np.zeros(l)
+    weakest_relative = dict(zip(names, np.round(wr, 6).tolist(), strict=True))
     # sandwich (JᵀJ)⁻¹ JᵀVJ (JᵀJ)⁻¹, columns scaled like F (the same null space)
     Js = Jn / safe[None, :]
     G = Js.T @ Js
@@ -569,7 +585,8 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
         if not np.any(~null):
             result = singular(cond)
             return Uncertainty(names, result.covariance, result.standard_errors, result.intervals, level, dof,
-                               cond, True, weakest, units, result.noise_source, ratio, note)
+                               cond, True, weakest, units, result.noise_source, ratio, note,
+                               weakest_relative=weakest_relative)
         Gpinv = (gvec[:, ~null] / gev[~null]) @ gvec[:, ~null].T
         cov_all = Gpinv @ (Js.T @ (Js * vn[:, None])) @ Gpinv / np.outer(safe, safe)
         free = np.linalg.norm(gvec[:, null], axis=1) > _NULL_PART
@@ -582,4 +599,4 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     se = np.sqrt(np.clip(np.diag(cov), 0, None))
     ci = np.column_stack([theta - quantile * se, theta + quantile * se])
     return Uncertainty(names, cov, se, ci, level, dof, cond, near, weakest, units,
-                       "residuals" if given_std is None else "given", ratio, note)
+                       "residuals" if given_std is None else "given", ratio, note, weakest_relative=weakest_relative)

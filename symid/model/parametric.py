@@ -75,6 +75,10 @@ class ParametricModel:
         self._symbolic: dict[str, sp.Matrix] = dict(matrices)
         self._maps: dict[str, AffineMap] = {n: affine_map(m, self._parameters, n) for n, m in matrices}
         self.name = name
+        #: The units of the inputs and outputs, ``{"input": (...), "output": (...)}``, as a model file declares them
+        #: (``input_units``, ``output_units``; set by :func:`symid.load_model`), else ``{}``. symid converts
+        #: nothing by them: :func:`symid.identify` compares them with the units a data file states.
+        self.io_units: dict[str, tuple[str, ...]] = {}
 
     # -- parameters ---------------------------------------------------------------
     @property
