@@ -170,12 +170,12 @@ def _data_source(args: argparse.Namespace) -> str | list[str] | None:
     return None if not files else files[0] if len(files) == 1 else files
 
 
-def _read_data(args: argparse.Namespace, command: str):
-    """The data of --data: a symid file as it is, or a table with --columns and --units; several files (a repeated
-    --data) are the records of one time-series fit, each read alike."""
+def _read_data(args: argparse.Namespace, command: str, files: list[str] | None = None, flag: str = "--data"):
+    """The data of --data (or of ``files``, read alike): a symid file as it is, or a table with --columns and
+    --units; several files (a repeated --data) are the records of one time-series fit, each read alike."""
     from symid.data import read_data
 
-    files = _data_files(args)
+    files = _data_files(args) if files is None else files
     if args.columns is None:
         extra = [f for f, v in (("--units", args.units), ("--dt", args.dt), ("--kind", args.kind)) if v is not None]
         if extra:
@@ -192,9 +192,9 @@ def _read_data(args: argparse.Namespace, command: str):
     series = [hasattr(r, "t") and hasattr(r, "u") for r in records]
     if not all(series):
         k = series.index(False)
-        raise _UsageError(f"symid {command}: error: --data is given {len(files)} times, but {files[k]!r} holds "
-                          f"{type(records[k]).__name__}, not a time series: only time-series records are fitted "
-                          "together (one --data for any other data)")
+        raise _UsageError(f"symid {command}: error: {flag} is given {len(files)} times, but {files[k]!r} holds "
+                          f"{type(records[k]).__name__}, not a time series: only time-series records are taken "
+                          f"together (one {flag} for any other data)")
     return records
 
 
@@ -382,6 +382,14 @@ def _cmd_identify(args: argparse.Namespace) -> int:
 
     out = _output_dir(args.out, "identify")
     entry, data, source = _entry_and_data(args, "identify")
+    vdata = data
+    if getattr(args, "validate", None):  # other records, read as --data was, validate the estimate (read first)
+        from symid.fit.registry import data_kind
+
+        if data_kind(data).name != "time series":
+            raise _UsageError(f"symid identify: error: --validate checks an estimate on other time-series "
+                              f"records; the data fitted are {data_kind(data).name}")
+        vdata = _read_data(args, "identify", list(args.validate), "--validate")
     spec = _spec(entry, args, "identify")
     _say(args, f"model: {spec.name}   data: {source}")
     time_unit = _record_time_unit(data)
@@ -429,7 +437,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     modes = _modes_line(model, final.theta_vector, time_unit)
     if modes:
         _say(args, modes)
-    validation = _time_series_validation(model, data, final, args)
+    if vdata is not data:
+        _say(args, f"validation on {', '.join(args.validate)} (not the records fitted)")
+    validation = _time_series_validation(model, vdata, final, args)
     for name, (value, lo, hi) in outside.items():
         _say(args, f"warning: {name} = {value:.6g} lies outside its bounds [{lo:g}, {hi:g}]")
     if not fitted:
@@ -688,6 +698,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=1, metavar="N",
                    help="number of starts (default: 1)")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
+    p.add_argument("--validate", metavar="FILE", action="append",
+                   help="time series: validate the estimate on these records (read with the same --columns and "
+                        "--units; repeat for several) instead of on the records fitted")
     g = p.add_argument_group("what you know about the parameters (extends or replaces the model file's)")
     g.add_argument("--x0", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="the first start, for some or all free parameters: the others keep the model file's "

@@ -477,6 +477,37 @@ def test_the_validation_of_identify_uses_the_fits_error_model(tmp_path, capsys):
     assert "verdict: residual white and independent of the " in said
 
 
+def test_identify_validates_on_other_records_with_validate(tmp_path, capsys):
+    """A new user's trial: the command line could validate only on the records fitted. --validate FILE reads other
+    records as --data was read and validates the estimate there: the true structure passes on a second record
+    (the infusion model, 15 % proportional noise, its error model), a wrong one (elimination fixed at half the
+    truth) fails; a frequency response is refused by name."""
+    (tmp_path / "pk.py").write_text(
+        "import symid as si\n"
+        "ke, q = si.parameters('ke q', positive=True)\n"
+        "model = si.StateSpaceModel(A=[[-ke]], B=[[q]], C=[[1]])\n"
+        "start = {'ke': 0.3, 'q': 0.05}\n")
+    ke, q = si.parameters("ke q", positive=True)
+    t = np.arange(0, 48.125, 0.25)
+    u = np.where(t < 2, 500.0, 0.0) + np.where((t >= 12) & (t < 13), 500.0, 0.0)
+    y0 = si.simulate_io(si.StateSpaceModel(A=[[-ke]], B=[[q]], C=[[1]]), {"ke": 0.2, "q": 0.025}, u, 0.25).y[:, 0]
+    for name, seed in (("a.csv", 2001), ("b.csv", 2002)):
+        y = y0 * (1 + 0.15 * np.random.default_rng(seed).standard_normal(t.size))
+        np.savetxt(tmp_path / name, np.column_stack([t, u, y]), delimiter=",", header="t,rate,conc", comments="")
+    args = ["--data", str(tmp_path / "a.csv"), "--validate", str(tmp_path / "b.csv"), "--columns", "time=t",
+            "input=rate", "output=conc", "--units", "time=h", "--time-unit", "h",
+            "--option", 'variance={"proportional": 0.15}']
+    main(["identify", str(tmp_path / "pk.py"), *args])
+    said = capsys.readouterr().out
+    assert f"validation on {tmp_path / 'b.csv'} (not the records fitted)" in said
+    assert "verdict: residual white and independent of the " in said
+    main(["identify", str(tmp_path / "pk.py"), *args, "--known", "ke=0.1"])
+    said = capsys.readouterr().out
+    assert "verdict: residual NOT white" in said or "residual correlated with past inputs" in said
+    code = main(["identify", "mass_damper_2dof", "--validate", str(tmp_path / "b.csv")])
+    assert code == 2 and "--validate checks an estimate on other time-series records" in capsys.readouterr().err
+
+
 def test_times_converted_to_seconds_are_said(tmp_path, capsys):
     """A file in hours read without --time-unit: the record, and so every rate, is per second. Said, with the flag
     that keeps hours (a new user's trial: rates 3600 times smaller, with nothing said)."""
