@@ -225,7 +225,22 @@ def chain_start_table(doc: dict) -> str:
     return table(doc["summary"], SimpleNamespace(noise=noise)) + "\n"
 
 
+def frf_estimated_variance_table(doc: dict) -> str:
+    """``benchmarks/frf_estimated_variance.py``: coverage of the 95 % intervals per problem and periods."""
+    def span(v: list[float]) -> str:
+        return f"{100 * min(v):.0f}–{100 * max(v):.0f} %"
+
+    lines = ["| problem | periods | ν | successes | spread / median SE | coverage, σ̂² as exact | "
+             "coverage, × ν/(ν − 4) |", "|---|---|---|---|---|---|---|"]
+    for r in doc["rows"]:
+        lines.append(f"| {r['problem']} | {r['periods']} | {r['dof']:g} | {r['successes']}/{r['records']} | "
+                     f"{min(r['spread_over_se']):.2f}–{max(r['spread_over_se']):.2f} | "
+                     f"{span(r['coverage_as_exact'])} | {span(r['coverage_inflated'])} |")
+    return "\n".join(lines) + "\n"
+
+
 TABLES: dict[str, Callable[[dict], str]] = {
+    "benchmarks/results/frf_estimated_variance.json": frf_estimated_variance_table,
     "benchmarks/results/chain_start.json": chain_start_table,
     "benchmarks/results/population.json": population_table,
     "benchmarks/results/n4sid_oversampling.json": n4sid_oversampling_table,

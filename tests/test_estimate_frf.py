@@ -314,3 +314,32 @@ def test_the_estimate_says_its_variances_degrees_of_freedom():
     assert si.estimate_frf(io, nperseg=nperseg).variance_dof == pytest.approx(2 * (n_eff - 1), rel=1e-12)
     assert si.estimate_frf(io, nperseg=nperseg, estimator="h2").variance_dof == pytest.approx(2 * (n_eff - 1),
                                                                                               rel=1e-12)
+
+
+def test_hold_zoh_removes_the_holds_response_from_a_held_input():
+    """A new user's motor driven through a DAC: the response of the sampled input to the sampled output differs
+    from H(jω) by the hold (a half-sample delay and a sinc), 18 % at the median line there, and the FRF route
+    fitted it with success=False. hold="zoh" divides it out. Here a one-mass model (5 rad/s mode), a held
+    multisine up to 29 rad/s at 25 samples per period of the mode, exact steady state: the median error against
+    H(jω) falls from 36 % to 0.1 % (2.1 % at the top line, the aliases of the response above the Nyquist frequency,
+    (ω/(ω_s − ω))³ ≈ 3 % to first order there; measured when this test was written), and the least-squares fit of
+    the continuous model is within 0.5 % of the truth."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    truth = [2.0, 0.4, 50.0]
+    N, dt = 256, 0.05
+    lines = np.arange(1, 60)
+    U = np.zeros(N // 2 + 1, complex)
+    U[lines] = np.exp(2j * np.pi * np.random.default_rng(0).random(lines.size))
+    io = si.simulate_io(model, truth, np.tile(np.fft.irfft(U, N), 9), dt)  # held between samples
+    errors = {}
+    for hold in (None, "zoh"):
+        frf = si.estimate_frf(io, period=N, transient_periods=6, hold=hold)
+        H = model.frequency_response(truth, frf.w)[:, 0, 0]
+        errors[hold] = np.abs(frf.H[:, 0, 0] - H) / np.abs(H)
+    assert np.median(errors[None]) > 0.3
+    assert np.median(errors["zoh"]) < 2e-3 and errors["zoh"].max() < 0.03
+    res = si.identify(model, frf, method="lm", x0=truth, identifiability_check=False)
+    np.testing.assert_allclose(res.theta_vector, truth, rtol=5e-3)
+    with pytest.raises(si.DataError, match="hold must be None"):
+        si.estimate_frf(io, period=N, hold="foh")
