@@ -21,8 +21,26 @@ __all__ = ["build_parser", "main"]
 _MAX_STARTS = 100_000
 
 
+class _StoreOnce(argparse._StoreAction):
+    """The default action of a single-valued flag: given twice with different values, an error (the last one
+    silently won before: a new user's `--method lm ... --method ipopt` ran ipopt)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):  # type: ignore[override]
+        seen = namespace.__dict__.setdefault("_flags_given", {})
+        if self.dest in seen and seen[self.dest] != values:
+            parser.error(f"{option_string} is given twice ({seen[self.dest]!r} and {values!r}): give it once")
+        seen[self.dest] = values
+        super().__call__(parser, namespace, values, option_string)
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse with a one-line error (``symid identify: error: ...``) and exit status 2."""
+    """argparse with a one-line error (``symid identify: error: ...``) and exit status 2; a single-valued flag
+    given twice with different values is an error (:class:`_StoreOnce`)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")

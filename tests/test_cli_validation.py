@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 import symid as si
 from symid.cli import main
@@ -122,3 +123,16 @@ def test_values_a_model_file_gives_are_said_to_be_in_the_models_time_unit(tmp_pa
     main([*args, "--time-unit", "min"])
     assert ("symid: warning: the known values of the model file and the command line are taken as they are, in the "
             "model's time unit min: symid converts none of them") in capsys.readouterr().err
+
+
+def test_a_single_valued_flag_given_twice_with_different_values_is_an_error(capsys):
+    """A new user's trial: `--method lm ... --method ipopt` ran ipopt without a word (the last one won); the README
+    said any flag given twice is merged. A single-valued flag given twice with different values is now an error
+    naming both; the same value twice is harmless."""
+    for argv, said in ((["--method", "lm", "--method", "ipopt"], "--method is given twice ('lm' and 'ipopt'): give "
+                                                                 "it once"),
+                       (["--max-iter", "5", "--max-iter", "7"], "--max-iter is given twice (5 and 7)")):
+        with pytest.raises(SystemExit) as info:  # argparse's usage error: exit status 2
+            main(["identify", "mass_damper_2dof", *argv])
+        assert info.value.code == 2 and said in capsys.readouterr().err
+    assert main(["identify", "mass_damper_2dof", "--method", "ipopt", "--method", "ipopt", "--max-iter", "1"]) in (0, 4)

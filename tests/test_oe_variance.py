@@ -225,3 +225,13 @@ def test_a_bad_error_model_is_named(record, model, match):
     io, _ = record  # its first concentration is 0 (before the infusion acts)
     with pytest.raises(OptionError, match=match):
         prepare(ONE, io, "oe", {"variance": model})
+
+
+def test_a_zero_under_a_proportional_model_names_its_record(record):
+    """A new user's trial: with two --data files, the error of a measured 0 under a proportional error model
+    (weights from the measured values) did not say which record held it."""
+    io, _ = record
+    shifted = si.IOData(io.u, np.where(io.y == 0, 0.01, io.y), io.dt)  # no zero in the first record
+    with pytest.raises(OptionError, match=r"record 1 \(of 2, in the order given\): variance: the measured value for "
+                                          r"sample 0, output 0 is 0"):
+        prepare(ONE, [shifted, io], "oe", {"variance": {"proportional": 0.05, "weights": "measured"}})

@@ -91,6 +91,16 @@ class FrfFisher(FisherInformation):
         compared. False for a noise-weighted fit (its weights say the noise) or where either is undefined."""
         if self.line_weights is not None:
             return False
+        key = np.asarray(theta, dtype=float).tobytes()
+        memo = getattr(self, "_additive_memo", None)
+        if memo is not None and memo[0] == key:  # uncertainty asks twice at one θ (noise_units, noise_shape)
+            return memo[1]
+        answer = self._additive_noise(theta)
+        self._additive_memo = (key, answer)
+        return answer
+
+    def _additive_noise(self, theta: Any) -> bool:
+        """:meth:`additive_noise`, computed."""
         H = np.asarray(self.data.H)
         try:
             Hm = np.asarray(self.model.frequency_response(theta, self.data.w))

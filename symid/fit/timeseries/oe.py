@@ -410,6 +410,7 @@ class OutputError(Estimator, FisherInformation):
         self._error_model, self._weights_from = error_model_parts(variance) if isinstance(variance, dict) \
             else (None, None)
         self._anchor_key: bytes | None = None  # the θ whose prediction set the weights (weights from the prediction)
+        self._anchor_sims: list[np.ndarray] | None = None  # that prediction, for the misfit at the same θ
         self._base_variance = None if variance is None else self._sample_variance(variance)
         self._set_variance(self._base_variance)
         if variance is not None:
@@ -465,6 +466,7 @@ class OutputError(Estimator, FisherInformation):
                 sims = self.simulate(theta) if np.all(np.isfinite(theta)) else None
         except (ModelError, np.linalg.LinAlgError, ValueError):
             sims = None
+        self._anchor_sims = sims
         if sims is None or not all(np.all(np.isfinite(s[o])) for s, o in zip(sims, self._observed, strict=True)):
             self._set_variance(self._base_variance)
             return
@@ -506,8 +508,15 @@ class OutputError(Estimator, FisherInformation):
         (N, p), or a list of such, one per record, or an error model (:func:`error_model_variance`); every
         value finite and > 0."""
         if isinstance(variance, dict):
-            variance = [error_model_variance(variance, np.where(o, r.y, np.nan))
-                        for r, o in zip(self.records, self._observed, strict=True)]
+            arrays = []
+            for e, (r, o) in enumerate(zip(self.records, self._observed, strict=True)):
+                try:
+                    arrays.append(error_model_variance(variance, np.where(o, r.y, np.nan)))
+                except OptionError as exc:  # which record, when there are several
+                    if len(self.records) == 1:
+                        raise
+                    raise OptionError(f"record {e} (of {len(self.records)}, in the order given): {exc}") from None
+            variance = arrays
             if len(variance) == 1:
                 variance = variance[0]
         items = variance if isinstance(variance, (list, tuple)) and len(self.records) > 1 else None
@@ -577,11 +586,14 @@ class OutputError(Estimator, FisherInformation):
         With an error model whose weights come from the prediction, σ² is that of θ's own prediction (the
         weights the fit from θ would end with: :meth:`run`)."""
         self._anchor(theta)
-        try:
-            with np.errstate(over="ignore", invalid="ignore"):  # an exponential that overflows: inf, said below
-                sims = self.simulate(theta)
-        except (np.linalg.LinAlgError, ValueError):
-            return float("inf")
+        sims = self._anchor_sims if self._anchor_sims is not None and self._anchor_key == np.asarray(
+            theta, dtype=float).reshape(-1)[: self.model.n_parameters].tobytes() else None
+        if sims is None:  # (the prediction that set the weights is this one: not simulated again)
+            try:
+                with np.errstate(over="ignore", invalid="ignore"):  # an exponential that overflows: inf, said below
+                    sims = self.simulate(theta)
+            except (np.linalg.LinAlgError, ValueError):
+                return float("inf")
         with np.errstate(over="ignore", invalid="ignore"):  # a diverged θ: inf, said by the cost, not by numpy
             total = sum(float(np.sum(w * (r.y - s) ** 2)) for r, s, w in zip(self.records, sims, self._w, strict=True))
         return total if np.isfinite(total) else float("inf")
