@@ -141,3 +141,27 @@ def test_rational_formulas_prove_the_chain_parameters_witnesses_cannot_move(fami
     th = si.parameters("th")
     square = exhaustive_summary(si.StateSpaceModel(A=[[-1]], B=[[th]], C=[[th]]))  # only th² is determined
     assert rational_formulas(square, ["th"]) == {}
+
+
+def test_the_solutions_that_witnesses_show_are_told_apart_and_pointed_to():
+    """A 3-mass chain driven at the grounded end and measured at the free one: certified witnesses settle "local"
+    before the Gröbner step ends, so `.solutions` is empty. The report still says how θ* and the certified
+    witness differ, and identify's warning points to `.witnesses`, not to the empty `.solutions` (a new user's
+    trial followed the warning to an empty tuple)."""
+    from symid.structural.analyse import several_solutions
+
+    m = si.parameters("m1 m2 m3", positive=True)
+    c = si.parameters("c1 c2 c3", positive=True)
+    k = si.parameters("k1 k2 k3", positive=True)
+
+    def ground(e):
+        return [[e[0] + e[1], -e[1], 0], [-e[1], e[1] + e[2], -e[2]], [0, -e[2], e[2]]]
+
+    model = si.SecondOrderModel(M=[[m[0], 0, 0], [0, m[1], 0], [0, 0, m[2]]], V=ground(c), K=ground(k),
+                                B=[[1], [0], [0]], C=[[0, 0, 1]])
+    rep = si.identifiability(model)
+    assert rep.verdict == "local" and not rep.solutions and any(rep.witnesses_certified)
+    text = rep.summary()
+    assert "telling the solutions apart (at θ*):" in text and "another solution differs in m1" in text
+    said = several_solutions(model, timeout=30.0)  # the budget of the report above
+    assert said is not None and "si.identifiability(model).witnesses lists those found" in said

@@ -660,12 +660,13 @@ def _several_solutions(model, timeout: float | None) -> str | None:
     differ = [n for n in rep.parameters
               if len({float(f"{float(sol[n]):.6g}") for sol in sols if n in sol}) > 1]
     how = f"{count}" if count is not None else f"at least {bound}"
+    listed = "solutions lists them" if rep.solutions else "witnesses lists those found"
     return (f"the model is locally but not globally identifiable: at a random parameter point, {how} admissible "
             f"parameter values give the same response" + (f" ({', '.join(differ)} differ between them)" if differ
                                                          else "")
             + "; the estimate is one of them, which one depends on the start, and no data of this kind tell them "
-            "apart (si.identifiability(model).solutions lists them): fix what is known, or compare starts "
-            "(starts=, .alternatives())")
+            f"apart (si.identifiability(model).{listed}): fix what is known, or compare starts (starts=, "
+            ".alternatives())")
 
 
 def warn_if_not_identifiable(model, known: Mapping[str, float] | None = None, *, stacklevel: int = 2

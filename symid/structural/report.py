@@ -294,9 +294,15 @@ class IdentifiabilityReport:
     def _telling_apart(self) -> list[str]:
         """For a model that is locally, not globally identifiable: how the admissible solutions at θ* differ (which
         parameters; a swap said as one) and what keeps one of them."""
-        if self.verdict != "local" or len(self.solutions) < 2:
+        if self.verdict != "local":
             return []
-        first, *others = self.solutions
+        if len(self.solutions) >= 2:
+            first, *others = self.solutions
+        elif self.witnesses and self.theta_star:  # the global step stopped early: θ* and the certified witnesses
+            first = {p: float(Fraction(v)) for p, v in self.theta_star.items()}
+            others = [w for w, ok in zip(self.witnesses, self.witnesses_certified, strict=False) if ok]
+        else:
+            return []
         lines = ["telling the solutions apart (at θ*):"]
         for other in others[:3]:
             diff = [p for p in self.parameters if p in first and p in other
