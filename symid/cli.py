@@ -533,7 +533,7 @@ def _time_series_validation(model, data, res, args):
     variance = res.options.get("variance")  # the fit's error model standardises the residual tests too
     try:
         v = validate(model, res.theta, data, initial_state=initial,
-                     variance=variance if isinstance(variance, dict) else None)
+                     variance=variance if isinstance(variance, dict) else None, hold=res.options.get("hold", "zoh"))
     except (DataError, ModelError) as exc:
         _say(args, f"note: no validation: {exc}")
         return None

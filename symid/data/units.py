@@ -79,7 +79,8 @@ def canonical_unit(text: str, dimension: str, what: str) -> str:
     name = _alias(text) if len(text) <= 40 else None
     if name is None or name not in DIMENSIONS[dimension]:
         shown = repr(text) if len(text) <= 40 else f"{text[:40]!r}..."
-        mega = " (M is mega: milliseconds are ms)" if text.strip()[:1] == "M" and name is None else ""
+        mega = (" (M is mega: milliseconds are ms)" if name is None and text.strip()[:1] == "M"
+                and _ALIASES.get(text.strip().lower()) == "ms" else "")
         raise DataError(f"{what}: unknown unit {shown}{mega}; symid reads {', '.join(DIMENSIONS[dimension])}")
     return name
 

@@ -407,7 +407,7 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
     hold : {"zoh", "foh"}
         How the input moves between samples in the simulation: held (``"zoh"``, default, as
         :class:`~symid.data.IOData` defines a record) or linear (``"foh"``, for a sampled
-        band-limited input). An estimated initial state is the zero-order hold's least squares.
+        band-limited input), as ``si.identify``'s option of the same name for time series.
     variance : dict, float or array_like, optional
         The noise variance of the measured values, as ``si.identify``'s option of the same
         name for time series: an error model ``{"proportional": a, "additive": b}``
@@ -456,17 +456,11 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         raise DataError(f"hold must be 'zoh' (the input held between samples) or 'foh' (linear between them); "
                         f"got {hold!r}")
     M = int(max_lag)
-    sim = OutputError(model, data, initial_state=initial_state, variance=variance)
+    sim = OutputError(model, data, initial_state=initial_state, variance=variance, hold=hold)
     th = model.theta_vector(theta)
     try:
         ys = sim.simulate(th)
         x0s = sim.initial_states(th)
-        if hold == "foh":  # the same initial states, the input linear between samples
-            from symid.fit.timeseries.response import simulate_output
-
-            A, B, C, D = (np.asarray(x, dtype=float) for x in model.state_space(th))
-            ys = [simulate_output(A, B, C, D, r.t, r.u, x0, hold="foh") for r, x0 in zip(sim.records, x0s,
-                                                                                         strict=True)]
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise DataError(f"the model cannot be simulated at θ = {model.theta_dict(th)}: {exc}") from None
     recs, observed = sim.records, sim.observed

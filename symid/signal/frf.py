@@ -429,6 +429,10 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         |H| falls fast: one mass in position, a held multisine up to half the Nyquist
         frequency, the median error against H(jω) 36 % → 0.1 % (2.1 % at the top line;
         ``tests/test_estimate_frf.py``).
+
+    Returns
+    -------
+    FrequencyData
         ω (rad/s), H (s, p, m) and ``variance`` (s, p, m): ``E|Ĥ − H|²`` per entry
         (``None`` for periodic excitation with a single period), with ``variance_dof`` the
         real degrees of freedom of that estimate: 2(P − 1) from P periods, 2(n_eff − m)

@@ -294,8 +294,9 @@ def estimated_variance_inflation(dof: float) -> float:
     conservative. Measured (``benchmarks/frf_estimated_variance.py``, 100 records each, a periodic
     multisine, 1 % output noise): on a 3-mass chain (6 parameters) the 95 % intervals held the truth in
     73–83 % of the records per parameter at 4 periods taking σ̂² as exact and 94–99 % with this factor
-    (84–94 % and 88–99 % at 8 periods); on one mass, 85–87 % and 97–99 % at 4 periods (the estimates'
-    spread 0.72–0.74 of the standard error: conservative).
+    (84–94 % and 88–99 % at 8 periods); on two masses (6 parameters) 78–91 % and 95–99 % at 4 periods. On one
+    lightly damped mass (``tests/test_frf_weighting.py``) the estimates' spread was 0.67–0.77 of the reported
+    standard error at 4 periods: conservative there.
 
     Examples
     --------

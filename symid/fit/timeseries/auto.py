@@ -76,7 +76,7 @@ class AutoOutputError(OutputError):
 
     Parameters
     ----------
-    model, data, initial_state, positivity, bounds, variance, solver, hessian, max_iter, tol, callback, verbose
+    model, data, initial_state, positivity, bounds, variance, hold, solver, hessian, max_iter, tol, callback, verbose
         As for :class:`~symid.fit.timeseries.oe.OutputError` (each pass is one output-error run;
         ``solver="trf"`` by default: 30 of 32 starts of the time-series population met the
         success rule against 28 with IPOPT's passes, in a median 2.1 s against 7.0 s).
@@ -126,11 +126,11 @@ class AutoOutputError(OutputError):
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = 120.0, callback: Any = None, verbose: bool = False,
                  restarts: int = 10, spread: float = 10.0, seed: int = 0, black_box_start: bool = True,
-                 solver: str = "trf", bounds: Any = None, variance: Any = None):
+                 solver: str = "trf", bounds: Any = None, variance: Any = None, hold: str = "zoh"):
         budget = check_time_limit("time_limit", time_limit)
         super().__init__(model, data, initial_state=initial_state, scale=scale, positivity=positivity,
                          hessian=hessian, max_iter=max_iter, tol=tol, time_limit=budget, callback=callback,
-                         verbose=verbose, solver=solver, bounds=bounds, variance=variance)
+                         verbose=verbose, solver=solver, bounds=bounds, variance=variance, hold=hold)
         self._budget = budget
         self._restarts = check_int("restarts", restarts, low=0, high=10**6)
         self._spread = check_float("spread", spread, low=1.0)

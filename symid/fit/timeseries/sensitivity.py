@@ -16,7 +16,9 @@ and the derivative of the exponential along dF = ∂F/∂θₖ is its Fréchet d
     Sₖ⁺ = Ad Sₖ + (∂Ad/∂θₖ) x + (∂Bd/∂θₖ) u,     Sₖ(t₀) = ∂x(t₀)/∂θₖ,
 
 and ∂ŷ/∂θₖ = C Sₖ + (∂C/∂θₖ) x + (∂D/∂θₖ) u. An estimated initial state is one more
-column per state, with Sₖ(t₀) a unit vector and no forcing.
+column per state, with Sₖ(t₀) a unit vector and no forcing. With the input linear between
+samples (first-order hold), x⁺ = Ad x + G1 u + G2 (u⁺ − u) from one larger block
+exponential, differentiated the same way.
 
 For a second-order model in first-order form (x = [q; q']), A = [[0, I], [−M⁻¹K, −M⁻¹V]]
 and B = [0; M⁻¹B] are rational in θ: ∂(M⁻¹X)/∂θₖ = M⁻¹(∂X/∂θₖ − (∂M/∂θₖ) M⁻¹X).
@@ -105,8 +107,31 @@ def _zoh_derivatives(A: np.ndarray, B: np.ndarray, dA: np.ndarray, dB: np.ndarra
     return Phi[:n, :n], Phi[:n, n:], dAd, dBd
 
 
+def _foh_derivatives(A: np.ndarray, B: np.ndarray, dA: np.ndarray, dB: np.ndarray, h: float
+                     ) -> tuple[np.ndarray, ...]:
+    """(Ad, G1, G2, dAd, dG1, dG2) of the first-order hold over h (the input linear between samples:
+    x⁺ = Ad x + G1 u + G2 (u⁺ − u), :func:`symid.signal.simulate.foh_discretize`), the derivatives by the
+    Fréchet derivative of the same block exponential ``expm([[A, B, 0], [0, 0, I/h], [0, 0, 0]] h)``."""
+    n, m = B.shape
+    F = np.zeros((n + 2 * m, n + 2 * m))
+    F[:n, :n], F[:n, n:n + m], F[n:n + m, n + m:] = A * h, B * h, np.eye(m)
+    l = dA.shape[0]
+    dAd, dG1, dG2 = np.zeros((l, n, n)), np.zeros((l, n, m)), np.zeros((l, n, m))
+    Phi = None
+    for k in range(l):
+        if not (np.any(dA[k]) or np.any(dB[k])):
+            continue
+        dF = np.zeros_like(F)
+        dF[:n, :n], dF[:n, n:n + m] = dA[k] * h, dB[k] * h
+        Phi, L = expm_frechet(F, dF, compute_expm=True, check_finite=False)
+        dAd[k], dG1[k], dG2[k] = L[:n, :n], L[:n, n:n + m], L[:n, n + m:]
+    if Phi is None:
+        Phi = expm(F)
+    return Phi[:n, :n], Phi[:n, n:n + m], Phi[:n, n + m:], dAd, dG1, dG2
+
+
 def output_sensitivity(mats: tuple[np.ndarray, ...], dmats: tuple[np.ndarray, ...], t: np.ndarray, u: np.ndarray,
-                       x0: np.ndarray, dx0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                       x0: np.ndarray, dx0: np.ndarray, hold: str = "zoh") -> tuple[np.ndarray, np.ndarray]:
     """ŷ (N, p) and ∂ŷ/∂v (N, p, k) on one record from x(t₀) = x0.
 
     Parameters
@@ -115,7 +140,8 @@ def output_sensitivity(mats: tuple[np.ndarray, ...], dmats: tuple[np.ndarray, ..
         (A, B, C, D) and their derivatives (dA, dB, dC, dD), each (l, rows, cols)
         (:func:`state_space_derivatives`).
     t, u : ndarray
-        Sample times (N,) and inputs (N, m), the input held between samples.
+        Sample times (N,) and inputs (N, m), the input held between samples (``hold="zoh"``) or linear
+        between them (``"foh"``).
     x0 : ndarray
         Initial state (n,).
     dx0 : ndarray
@@ -150,14 +176,24 @@ def output_sensitivity(mats: tuple[np.ndarray, ...], dmats: tuple[np.ndarray, ..
     k = dx0.shape[1]
     N = u.shape[0]
     reps, group = interval_groups(t)
-    zoh = [_zoh_derivatives(A, B, dA, dB, h) for h in reps]
-    # the input's part of each step for every sample at once: Bd u (N−1, n) and ∂Bd/∂θ u (N−1, n·l)
+    # the input's part of each step for every sample at once: Bd u (N−1, n) and ∂Bd/∂θ u (N−1, n·l); with the
+    # input linear between samples, G1 u + G2 Δu and their derivatives
     Bu, dBu = np.zeros((N - 1, n)), np.zeros((N - 1, n * l))
-    for g, (_, Bd, _, dBd) in enumerate(zoh):
-        at = np.flatnonzero(group == g)
-        Bu[at] = u[at] @ Bd.T
-        dBu[at] = np.einsum("knm,tm->tnk", dBd, u[at]).reshape(at.size, n * l)
-    steps = [(Ad, dAd.transpose(1, 0, 2).reshape(n * l, n)) for Ad, _, dAd, _ in zoh]  # rows (state, θₖ)
+    steps = []
+    if hold == "foh":
+        du = np.diff(u, axis=0)
+        for g, (Ad, G1, G2, dAd, dG1, dG2) in enumerate(_foh_derivatives(A, B, dA, dB, h) for h in reps):
+            at = np.flatnonzero(group == g)
+            Bu[at] = u[at] @ G1.T + du[at] @ G2.T
+            dBu[at] = (np.einsum("knm,tm->tnk", dG1, u[at]) + np.einsum("knm,tm->tnk", dG2, du[at])
+                       ).reshape(at.size, n * l)
+            steps.append((Ad, dAd.transpose(1, 0, 2).reshape(n * l, n)))  # rows (state, θₖ)
+    else:
+        for g, (Ad, Bd, dAd, dBd) in enumerate(_zoh_derivatives(A, B, dA, dB, h) for h in reps):
+            at = np.flatnonzero(group == g)
+            Bu[at] = u[at] @ Bd.T
+            dBu[at] = np.einsum("knm,tm->tnk", dBd, u[at]).reshape(at.size, n * l)
+            steps.append((Ad, dAd.transpose(1, 0, 2).reshape(n * l, n)))
     # Z = [x | S] (n, 1 + k): one product with Ad moves the state and every sensitivity
     Zs = np.empty((N, n, 1 + k))
     Z = np.empty((n, 1 + k))
