@@ -510,6 +510,10 @@ def _modes_line(model, theta, time_unit: str | None) -> str:
         return ""
     unit = time_unit or "s"
     items = []
+    zero = np.abs(poles) <= 1e-12 * max(float(np.max(np.abs(poles))), 1e-300) if poles.size else poles
+    if np.count_nonzero(zero) > 1:  # integrators (a rigid-body mode, positions no output sees): one item
+        items.append(f"{np.count_nonzero(zero)} poles at 0")
+        poles = poles[~zero]
     for p in sorted(poles, key=abs):
         if p.imag > 0:
             wn = abs(p)

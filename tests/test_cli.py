@@ -569,3 +569,17 @@ def test_a_mimo_frequency_response_gets_a_bode_figure_per_entry(tmp_path, capsys
     for name in ("bode_0_0.png", "bode_1_0.png"):
         assert (tmp_path / "out" / name).stat().st_size > 1000
     assert not (tmp_path / "out" / "bode.png").exists()
+
+
+def test_the_modes_line_groups_poles_at_zero():
+    """A new user's room (K = 0, temperatures as velocities) listed "real pole 0 /s" once per node; the integrators
+    are one item, and the other poles are the matrix's own (reference: the eigenvalues of A, computed here)."""
+    from symid.cli import _modes_line
+
+    Ca, Cw, Haw, Hwo = si.parameters("Ca Cw Haw Hwo", positive=True)
+    model = si.SecondOrderModel(M=[[Ca, 0], [0, Cw]], V=[[Haw, -Haw], [-Haw, Haw + Hwo]], K=[[0, 0], [0, 0]],
+                                B=[[1], [0]], C=[[1, 0]], output="velocity")
+    theta = [5e5, 8e6, 300.0, 80.0]
+    line = _modes_line(model, theta, "s")
+    poles = sorted(np.linalg.eigvals(np.asarray(model.state_space(theta)[0], float)).real, key=abs)[2:]
+    assert line == ("modes of the estimate: 2 poles at 0; " + "; ".join(f"real pole {p:.4g} /s" for p in poles))

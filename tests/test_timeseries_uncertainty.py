@@ -90,3 +90,22 @@ def test_monte_carlo_coverage_of_95_percent_intervals():
     rate = hits / n
     print("coverage", dict(zip(TRUTH, rate.round(3).tolist(), strict=True)))
     assert np.all((rate >= 0.90) & (rate <= 0.98)), rate
+
+
+def test_an_initial_position_the_output_cannot_see_is_not_a_near_singular_direction():
+    """A new user's room (heat capacities as masses, conductances as dampers, K = 0, temperatures as velocities,
+    the initial state estimated): the initial positions reach neither the output nor the dynamics, their columns
+    of the Jacobian are zero, and every well-determined fit was flagged "NEAR-SINGULAR … practically
+    non-identifiable" (condition 1e20 or inf). They are left out now: two nodes here, not flagged, and the
+    intervals hold the truth (references: the values simulated)."""
+    Ca, Cw, Haw, Hwo = si.parameters("Ca Cw Haw Hwo", positive=True)
+    model = si.SecondOrderModel(M=[[Ca, 0], [0, Cw]], V=[[Haw, -Haw], [-Haw, Haw + Hwo]], K=[[0, 0], [0, 0]],
+                                B=[[1], [0]], C=[[1, 0]], output="velocity")
+    truth = {"Ca": 5e5, "Cw": 8e6, "Haw": 300.0, "Hwo": 80.0}
+    u = np.where((np.arange(2000) // 97) % 2 == 0, 2000.0, 0.0)  # a heater switched on and off, 1-minute samples
+    io = si.simulate_io(model, truth, u, 60.0, x0=[0.0, 0.0, 18.0, 17.5], noise_std=0.05, seed=3)
+    res = si.identify(model, io, method="oe", x0=truth, initial_state="estimate", identifiability_check=False)
+    unc = res.uncertainty
+    assert res.success and not unc.near_singular, unc.summary()
+    th = np.array([truth[n] for n in model.parameter_names])
+    assert np.all((unc.intervals[:, 0] <= th) & (th <= unc.intervals[:, 1]))

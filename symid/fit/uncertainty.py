@@ -29,7 +29,8 @@ which is F⁻¹ when the misfit weighs every entry by its noise (V ∝ I); other
   (≈ 1 when the given noise is right).
 
 Nuisance unknowns (estimated initial states) are in J and marginalised: the θ block of
-the covariance is reported. The covariance is that of the least-squares estimate of the
+the covariance is reported (one the residual does not depend on at all, an initial
+position of a model measured in velocity, is left out). The covariance is that of the least-squares estimate of the
 method's misfit, evaluated at θ̂: exact to first order for the methods that minimise that
 misfit (``ipopt``, ``oe``); for the others (``scr``, ``ls``, ``als``, ``gb``, an
 equation-error objective) it holds as far as their estimate agrees with that minimiser,
@@ -511,6 +512,10 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     keep = s > 0
     r, J, channels, s = r[keep], J[keep], channels[keep], s[keep]
     Gm = None if sensitivity is None else np.asarray(sensitivity, dtype=float)[:, keep]
+    if J.shape[1] > l:  # a nuisance unknown the residual does not depend on at all (an estimated initial position
+        # of a model measured in velocity) is no direction the data fail to determine: left out, not flagged
+        felt = np.any(J[:, l:] != 0, axis=0)
+        J = np.hstack([J[:, :l], J[:, l:][:, felt]])
     N, k = J.shape
     p = int(channels.max()) + 1 if channels.size else 1
     level = np.zeros(p)
