@@ -65,3 +65,19 @@ def test_a_comparison_on_noisy_data_says_why_nothing_is_near_the_truth():
     assert "NOTE: no start is within the tolerance of the truth, but 4 fit the data" in cmp.table()
     loose = si.compare(model, frf, methods=["auto"], starts=2, truth=[1.0, 0.2, 4.0], param_tol=0.05)
     assert loose["auto"].n_success == 2 and "NOTE" not in loose.table()
+
+
+def test_a_method_that_cannot_take_the_data_is_refused_before_any_runs(monkeypatch):
+    """A new user's trial: si.compare(..., methods=("oe", "srivc", "svf")) ran oe's starts, then srivc refused the
+    model and the finished row was lost. Every method is now built first: the refusal comes before any start."""
+    from symid.errors import ModelError
+    from symid.fit.timeseries.oe import OutputError
+
+    k, g, c = si.parameters("k g c", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[c]])  # the gain g·c is not affine in θ: srivc refuses
+    io = si.simulate_io(model, {"k": 0.5, "g": 2.0, "c": 1.5}, np.random.default_rng(0).standard_normal(200), 0.1)
+    runs = []
+    monkeypatch.setattr(OutputError, "run", lambda self, x0: runs.append(x0))
+    with pytest.raises(ModelError, match="srivc"):
+        si.compare(model, io, methods=("oe", "srivc"), starts=2)
+    assert runs == []

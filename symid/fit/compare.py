@@ -337,13 +337,22 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         return Comparison(stats=tuple(stats), n_starts=len(x0s), seed=seed, criterion=criterion,
                           truth=None if truth is None else model.theta_dict(truth))
 
+    # every method is built (its options and the data checked) before any runs: a method that cannot take these
+    # data is refused at once, not after the earlier methods' starts (a new user's comparison lost its finished
+    # output-error row to srivc's refusal of the model)
+    built: dict[str, tuple[Any, Any, float]] = {}
+    for method in methods:
+        t0 = time.perf_counter()
+        estimator, polisher = _build(model, data, method, dict(options.get(method.removesuffix("+polish"), {})),
+                                     noise_floor)
+        built[method] = (estimator, polisher, time.perf_counter() - t0)
     for method in methods:
         outcomes: list[StartOutcome] = []
         meta: dict[str, Any] = {}
         try:
             method_options = dict(options.get(method.removesuffix("+polish"), {}))
             _run_method(model, data, method, method_options, x0s, progress, log, outcomes, meta, noise_floor,
-                        executor)
+                        executor, built.pop(method))
         except KeyboardInterrupt:
             if outcomes:
                 stats.append(tabulate(method, meta, outcomes, interrupted=True))
@@ -410,7 +419,8 @@ def _build(model: Any, data: Any, method: str, options: dict[str, Any], noise_fl
 
 def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s: list[np.ndarray],
                 progress: bool | None, log: RunLog | None, outcomes: list[StartOutcome], meta: dict[str, Any],
-                noise_floor: float | None, executor: Executor | None = None) -> None:
+                noise_floor: float | None, executor: Executor | None = None,
+                built: tuple[Any, Any, float] | None = None) -> None:
     """Run one method from every start, appending to ``outcomes`` (in start order).
 
     ``meta`` receives ``ran_as``, ``options``, ``setup_time`` and ``cost_kind`` as soon as
@@ -429,9 +439,12 @@ def _run_method(model: Any, data: Any, method: str, options: dict[str, Any], x0s
                     cost_kind=str(head["cost_kind"]))
         outcomes.extend(StartOutcome.from_dict(rec) for rec in cached)
         return
-    t0 = time.perf_counter()
-    estimator, polisher = _build(model, data, method, options, noise_floor)  # every row builds its own
-    setup = time.perf_counter() - t0
+    if built is not None:  # (built by compare, which checks every method before running any)
+        estimator, polisher, setup = built
+    else:
+        t0 = time.perf_counter()
+        estimator, polisher = _build(model, data, method, options, noise_floor)  # every row builds its own
+        setup = time.perf_counter() - t0
     opts = dict(estimator.options)
     ran_as = estimator.method
     if polisher is not None:
