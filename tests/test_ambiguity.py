@@ -73,6 +73,8 @@ def test_equal_misfits_count_whether_or_not_they_pass_the_fit_test():
     # none fits: the sentence says so instead of "fit the data as well" (a new user read that on misfit 0.9988)
     assert "end at the best estimate's misfit (4.54e-05, which does not fit the data) with different" in res.ambiguity()
     assert "fit the data as well" not in res.ambiguity()
+    # nor as if the structure were in question (a new user's room, misfit 7e-2, was sent to identifiability)
+    assert "identifiability" not in res.ambiguity() and "NEXT in the summary says what to try" in res.ambiguity()
 
 
 def test_passes_of_one_start_count_as_alternatives():

@@ -392,3 +392,20 @@ def test_hold_foh_fits_a_sampled_band_limited_input():
         si.identify(model, io, method="oe", hold="linear")
     with pytest.raises(si.OptionError, match="simulated by solver='trf' only"):
         si.identify(model, io, method="oe", hold="foh", solver="ipopt")
+
+
+def test_a_record_that_does_not_start_at_rest_says_to_estimate_the_initial_state():
+    """A new user's room at 18 °C fitted by a model that starts at 0: the fit failed and the advice was "more starts,
+    other methods, check the units", never the initial state. Now NEXT names it, with the first measured value
+    and the model's; estimating the initial state then fits (reference: the values simulated)."""
+    k, g = si.parameters("k g", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    u = np.where((np.arange(400) // 40) % 2 == 0, 1.0, 0.0)
+    io = si.simulate_io(model, {"k": 0.05, "g": 0.02}, u, 1.0, x0=[18.0], noise_std=0.02, seed=1)
+    res = si.identify(model, io, x0={"k": 0.05, "g": 0.02}, identifiability_check=False)
+    assert not res.success and res.options["initial_offset"]["measured"] == pytest.approx(18.0, abs=0.1)
+    assert 'NEXT: the record does not start where the model does (output 0 is 18' in res.summary()
+    assert "initial_state=\"estimate\"" in res.summary()
+    fixed = si.identify(model, io, x0={"k": 0.05, "g": 0.02}, initial_state="estimate", identifiability_check=False)
+    assert fixed.success and "initial_offset" not in fixed.options
+    np.testing.assert_allclose(fixed.theta_vector, [0.05, 0.02], rtol=0.05)

@@ -329,6 +329,11 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         # the initial states estimated with θ (the least-squares ones at θ̂), one per record
         extra["initial_states"] = [np.asarray(x, dtype=float).tolist()
                                    for x in estimator.initial_states(result.theta_vector)]
+    if not result.success and hasattr(estimator, "initial_offset") and np.all(np.isfinite(result.theta_vector)):
+        # a record that does not start where the model does: the likeliest reason a time-series fit fails
+        offset = estimator.initial_offset(result.theta_vector)
+        if offset is not None:
+            extra["initial_offset"] = offset
     if identifiability_check and not not_local and result.success:
         from symid.structural.analyse import several_solutions
 

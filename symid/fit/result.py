@@ -374,12 +374,13 @@ class IdentificationResult:
         ref = np.asarray(self.best_start.theta, dtype=float)
         rel = np.max([_relative_difference(np.asarray(s.theta, dtype=float), ref) for s in alts], axis=0)
         k = int(np.argmax(rel))
-        if self.success:
-            how = "fit the data as well"
-        else:  # equally good is not good: the sentence must not read as if anything fitted
-            how = f"end at the best estimate's misfit ({self.best_start.cost:.3g}, which does not fit the data)"
-        return (f"{len(alts)} other estimate(s) from other starts or restarts {how} with different "
-                f"parameters (up to {100 * rel[k]:.3g} % in {self.parameter_names[k]}): the data do not single out "
+        head = f"{len(alts)} other estimate(s) from other starts or restarts"
+        differ = f"with different parameters (up to {100 * rel[k]:.3g} % in {self.parameter_names[k]})"
+        if not self.success:  # equally good is not good: neither a fit nor a question of identifiability yet
+            return (f"{head} end at the best estimate's misfit ({self.best_start.cost:.3g}, which does not fit the "
+                    f"data) {differ}: whether the data single out one estimate is a question once an estimate fits "
+                    "(NEXT in the summary says what to try); .alternatives() lists them")
+        return (f"{head} fit the data as well {differ}: the data do not single out "
                 "one estimate. The model may have several exact solutions (symid.identifiability gives the global "
                 "verdict) or the data may not pin these parameters down; compare them in .alternatives(), or fix "
                 "known parameters")
@@ -401,6 +402,12 @@ class IdentificationResult:
         if not self.success:
             if self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
+            elif (offset := self.options.get("initial_offset")) is not None:
+                where = f"record {offset['record']}, " if offset["record"] else ""
+                lines.append(f"NEXT: the record does not start where the model does ({where}output "
+                             f"{offset['output']} is {offset['measured']:.6g} at its first sample, the model's "
+                             f"{offset['model']:.6g}): estimate the initial state (initial_state=\"estimate\"; "
+                             f"--option initial_state=estimate) or remove the offset from the data")
             elif self.on_bounds:
                 sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
                 lines.append(f"NEXT: the estimate sits on its bounds ({sides}) and does not fit: the data want values "

@@ -590,6 +590,34 @@ class OutputError(Estimator, FisherInformation):
         return [simulate_output(A, B, C, D, r.t, r.u, x0, hold=self._hold)
                 for r, x0 in zip(self.records, self.initial_states(theta), strict=True)]
 
+    def initial_offset(self, theta: Any) -> dict[str, Any] | None:
+        """Where a record's first measured output lies far from the model's initial output at θ (beyond a fifth of
+        that output's range over the record, and 1e-9 of its largest value): the record does not start where
+        the model does (at rest: a room at 18 °C fitted by a model starting at 0). ``None`` when every record
+        starts near the model, or the initial state is estimated."""
+        if self._estimate_x0 or self._x0_mode == "estimate":
+            return None
+        theta = self.model.theta_vector(theta)
+        try:
+            with np.errstate(all="ignore"):
+                sims = self.simulate(theta)
+        except (ModelError, np.linalg.LinAlgError, ValueError):
+            return None
+        for e, (r, s, o) in enumerate(zip(self.records, sims, self._observed, strict=True)):
+            first = np.flatnonzero(np.all(o, axis=1))
+            if not first.size or not np.all(np.isfinite(s[first[0]])):
+                continue
+            k = int(first[0])
+            y = np.where(o, r.y, np.nan)
+            spread = np.nanmax(y, axis=0) - np.nanmin(y, axis=0)
+            gap = np.abs(r.y[k] - s[k])
+            far = (gap > 0.2 * spread) & (gap > 1e-9 * np.nanmax(np.abs(y), axis=0))
+            if np.any(far):
+                j = int(np.argmax(np.where(far, gap / np.where(spread > 0, spread, 1.0), -np.inf)))
+                return {"record": e, "output": j, "sample": k, "measured": float(r.y[k, j]),
+                        "model": float(s[k, j])}
+        return None
+
     def noise_variance(self, theta: Any) -> list[np.ndarray] | None:
         """σ² of every measured value at θ, one (N, p) array per record, from the ``variance`` option (an error
         model's from the prediction at θ unless it says ``"weights": "measured"``); ``None`` without one."""
