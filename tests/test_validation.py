@@ -204,3 +204,18 @@ def test_a_failure_near_the_level_is_said_to_be_possibly_chance():
         assert ("marginal" in verdict) == marginal, verdict
         if marginal:
             assert "a true model fails one of these 2 tests in 2 % of records" in verdict
+
+
+def test_the_summary_names_the_channels_by_the_tables_columns(tmp_path):
+    """A new user's trial: the command line named the channels, Python's si.validate(...).summary() said 0 and 1.
+    A record read from a table keeps its columns (io.stated_units), and the summary uses them."""
+    model = mck()
+    io = white_input_record(model, n=300)
+    rows = "\n".join(f"{0.1 * k:.1f},{u!r},{y!r}" for k, (u, y) in enumerate(zip(io.u[:, 0].tolist(),
+                                                                                  io.y[:, 0].tolist(), strict=True)))
+    (tmp_path / "rec.csv").write_text(f"t,force,position\n{rows}\n")
+    rec = si.IOData.from_table(str(tmp_path / "rec.csv"), columns={"time": "t", "input": "force",
+                                                                    "output": "position"}, units={"time": "s"})
+    assert rec.stated_units == {"input": (("force", None),), "output": (("position", None),)}
+    text = si.validate(model, TRUTH, rec).summary()
+    assert "position" in text.splitlines()[2] and "force" in text

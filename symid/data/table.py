@@ -729,12 +729,11 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
             else:
                 step = _uniform_step(t, src.where)
             record = IOData(u, y, step, time_unit=target)
-    if isinstance(src, _Csv):
+    if isinstance(src, _Csv):  # the columns read and the units the file states for them (a CSV column: a channel)
         stated = _column_units(src)
-        if any(n in stated for n in (*inputs, *outputs)):
-            units = {"input": tuple((n, stated.get(n)) for n in inputs),  # a CSV column is one channel
-                     "output": tuple((n, stated.get(n)) for n in outputs)}
-            object.__setattr__(record, "stated_units", units)  # on the object read: metadata, not a field
+        units = {role: tuple((n, stated.get(n)) for n in names) for role, names in (("input", inputs),
+                                                                                     ("output", outputs))}
+        object.__setattr__(record, "stated_units", units)  # on the object read: metadata, not a field
     return record
 
 

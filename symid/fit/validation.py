@@ -106,6 +106,9 @@ class Validation:
     confidence: float = 0.99
     notes: tuple[str, ...] = ()
     time_unit: str = "s"
+    channel_names: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """The input and output columns of a table the records were read from (``{"input": (...), "output": (...)}``,
+    from ``stated_units``): the labels of :meth:`summary` and :meth:`plot` when no names are given."""
 
     @property
     def white(self) -> np.ndarray:
@@ -118,10 +121,17 @@ class Validation:
         with np.errstate(invalid="ignore"):
             return np.where(np.isfinite(self.independence_p), self.independence_p >= 1 - self.confidence, True)
 
+    def _column_names(self, role: str, n: int) -> tuple[str, ...] | None:
+        """The table's column names of ``role`` when there are ``n`` of them, else None."""
+        names = self.channel_names.get(role, ())
+        return tuple(names) if len(names) == n and n else None
+
     def summary(self, *, output_names: Any = None, input_names: Any = None) -> str:
         """A readable table: fit and tests per output (and input), labelled by number or by the names given."""
         p = self.fit_percent.size
         m = self.cross_correlation.shape[1] if self.cross_correlation.ndim == 3 else 0
+        output_names = output_names if output_names is not None else self._column_names("output", p)
+        input_names = input_names if input_names is not None else self._column_names("input", m)
         onames = [str(j) for j in range(p)] if output_names is None else _names(output_names, p, "output")
         inames = [str(i) for i in range(m)] if input_names is None else _names(input_names, m, "input")
         wo = max(7, *(len(x) for x in onames))
@@ -208,9 +218,9 @@ class Validation:
         """
         p = self.fit_percent.size
         m = self.cross_correlation.shape[1] if self.cross_correlation.ndim == 3 else 0
-        onames = _names(output_names, p, "output")
+        onames = _names(output_names if output_names is not None else self._column_names("output", p), p, "output")
         ounits = _names(output_units, p, None)
-        inames = _names(input_names, m, "input")
+        inames = _names(input_names if input_names is not None else self._column_names("input", m), m, "input")
         stem = Path(path)
         if stem.suffix.lower() == ".png":
             stem = stem.with_suffix("")
@@ -283,6 +293,13 @@ class Validation:
 
 def _p_text(p: float) -> str:
     return "p < 1e-16" if p < 1e-16 else f"p = {p:.2g}"
+
+
+def _record_columns(data: Any) -> dict[str, tuple[str, ...]]:
+    """The column names the (first) record was read with from a table (``stated_units``), else {}."""
+    first = data[0] if isinstance(data, (list, tuple)) and data else data
+    stated = getattr(first, "stated_units", None) or {}
+    return {role: tuple(name for name, _ in stated.get(role, ())) for role in ("input", "output") if role in stated}
 
 
 def _names(values: Any, n: int, default: str | None) -> list[str]:
@@ -524,4 +541,5 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
                       auto_band=float(z / np.sqrt(N)), whiteness_q=q, whiteness_p=q_p,
                       cross_lags=np.arange(-M, M + 1), cross_correlation=rho_eu, cross_band=cross_band,
                       independence_s=s_stat, independence_p=s_p, confidence=float(confidence),
-                      notes=tuple(notes), time_unit=getattr(recs[0], "time_unit", "s"))
+                      notes=tuple(notes), time_unit=getattr(recs[0], "time_unit", "s"),
+                      channel_names=_record_columns(data))
