@@ -6,8 +6,6 @@ import argparse
 import math
 import os
 import sys
-import threading
-import time
 import traceback
 import warnings
 from collections.abc import Sequence
@@ -334,32 +332,6 @@ def _say(args: argparse.Namespace, text: str) -> None:
     print(text, file=sys.stderr if getattr(args, "json", False) else sys.stdout)
 
 
-class _Heartbeat:
-    """A line on standard error every ``every`` seconds once a run has taken ``after``: a long estimate is seen to
-    be alive whatever the method (the per-iteration detail is the methods' ``verbose=``)."""
-
-    def __init__(self, what: str, *, after: float = 10.0, every: float = 20.0):
-        self.what, self.after, self.every = what, after, every
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._beat, daemon=True)
-
-    def _beat(self) -> None:
-        t0 = time.monotonic()
-        wait = self.after
-        while not self._stop.wait(wait):
-            print(f"symid: still estimating ({self.what}): {time.monotonic() - t0:.0f} s so far", file=sys.stderr,
-                  flush=True)
-            wait = self.every
-
-    def __enter__(self) -> _Heartbeat:
-        self._thread.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self._stop.set()
-        self._thread.join()
-
-
 def _run_identify(identify, model, data, args, x0, opts: dict, from_file: set[str]):
     """identify() with the flags' options; an option the method does not take is named by its flag.
 
@@ -368,14 +340,16 @@ def _run_identify(identify, model, data, args, x0, opts: dict, from_file: set[st
     """
     from symid.errors import OptionError
     from symid.fit.registry import data_kind
+    from symid.progress import Heartbeat
 
     if args.method is None:  # the data kind's default (auto for a frequency response or time series)
         args.method = data_kind(data).default_method
     while True:
         try:
-            with _Heartbeat(f"{args.method}, {args.starts} start{'s' if args.starts > 1 else ''}"):
+            starts = f"{args.starts} start{'s' if args.starts > 1 else ''}"
+            with Heartbeat(f"{args.method}, {starts}", after=10.0, every=20.0):
                 return identify(model, data, method=args.method, x0=x0, starts=args.starts, seed=args.seed,
-                                polish=args.polish, progress=True if args.starts > 1 else None, **opts), opts
+                                polish=args.polish, progress=args.starts > 1, **opts), opts  # (own heartbeat)
         except OptionError as exc:
             text = str(exc)
             dropped = sorted(n for n in from_file & set(opts) if f"'{n}'" in text or f" {n} " in text

@@ -9,7 +9,7 @@ from typing import TypeVar
 
 from tqdm import tqdm
 
-__all__ = ["HEARTBEAT_S", "progress_bar"]
+__all__ = ["HEARTBEAT_S", "Heartbeat", "progress_bar"]
 
 T = TypeVar("T")
 
@@ -48,6 +48,39 @@ def progress_bar(items: Iterable[T], *, desc: str, enabled: bool | None = None, 
         yield from items
         return
     yield from tqdm(items, desc=desc, total=total, file=sys.stderr, leave=False, dynamic_ncols=True)
+
+
+class Heartbeat:
+    """A line on standard error every ``every`` seconds once a run has taken ``after``: ``with Heartbeat("lm, 1
+    start"):`` around work that shows no bar (one start) says it is alive, "symid: still estimating (lm, 1
+    start): 60 s so far"; ``enabled=False`` says nothing. A new user's single start ran 77 s without a word."""
+
+    def __init__(self, what: str, *, after: float | None = None, every: float | None = None, enabled: bool = True):
+        import threading
+
+        self.what, self.enabled = what, enabled
+        self.after = HEARTBEAT_S if after is None else after
+        self.every = HEARTBEAT_S if every is None else every
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._beat, daemon=True)
+
+    def _beat(self) -> None:
+        t0 = time.monotonic()
+        wait = self.after
+        while not self._stop.wait(wait):
+            print(f"symid: still estimating ({self.what}): {time.monotonic() - t0:.0f} s so far", file=sys.stderr,
+                  flush=True)
+            wait = self.every
+
+    def __enter__(self) -> Heartbeat:
+        if self.enabled:
+            self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join()
 
 
 def _heartbeat(items: Iterable[T], desc: str, total: int) -> Iterator[T]:

@@ -17,7 +17,7 @@ from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
 from symid.fit.uncertainty import FisherInformation
 from symid.interrupt import Interrupted
-from symid.progress import progress_bar
+from symid.progress import Heartbeat, progress_bar
 
 __all__ = ["identify", "unit_mismatches"]
 
@@ -291,8 +291,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         options_used["identifiability_check_s"] = check_s
     outcomes: list[StartOutcome] = []
     try:
-        for x in progress_bar(x0s, desc=f"{estimator.method} starts", enabled=progress):
-            outcomes.append(estimator.run(x))
+        # one start shows no bar: by default a line every 30 s says a long one is alive
+        with Heartbeat(f"{estimator.method}, 1 start", enabled=progress is None and len(x0s) == 1):
+            for x in progress_bar(x0s, desc=f"{estimator.method} starts", enabled=progress):
+                outcomes.append(estimator.run(x))
     except KeyboardInterrupt:
         if not outcomes:
             raise
