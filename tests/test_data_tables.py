@@ -547,3 +547,17 @@ def test_mega_is_not_milli_but_capitals_are_read_as_written():
     assert canonical_unit("ms", "time", "units of 'time'") == "ms"
     assert unit_tokens("Ms", strict=True) == [] and unit_tokens("MSEC", strict=True) == [("time", "ms")]
     assert unit_tokens("RAD/S", strict=True) == [("frequency", "rad/s")]
+
+
+def test_a_gap_in_an_equally_spaced_record_names_its_lines_and_size(tmp_path):
+    """A new user's 3-day record with 10 minutes missing was told "sample 1000 is at 60599.9988, 7.66 sample times
+    away from an even grid of step 60.1392" (seconds, of a file in hours; no line). The gap is named: the file's
+    lines, the times in its unit, how many samples are missing."""
+    t = [k / 60 for k in range(200) if not 100 <= k < 110]  # one minute in hours; 10 samples missing
+    rows = "\n".join(f"{v:.6f},1.0,0.5" for v in t)
+    path = write_csv(tmp_path / "gap.csv", ["t_h,P,Ta", rows])
+    with pytest.raises(si.DataError, match=r"lines 101 and 102, column 't_h': the times jump from 1.65 to 1.833333 "
+                                           r"h, 11 steps of 0.0166\d* h: about 10 samples are missing"):
+        IOData.from_table(path, columns={"time": "t_h", "input": "P", "output": "Ta"}, units={"time": "h"})
+    assert TimeSeries.from_table(path, columns={"time": "t_h", "input": "P", "output": "Ta"},
+                                 units={"time": "h"}).n_samples == 190

@@ -727,6 +727,7 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
             if t is None:
                 step = checks.check_positive_scalar(dt, "dt") * factor
             else:
+                _check_gaps(raw, src, roles["time"], declared["time"])
                 step = _uniform_step(t, src.where)
             record = IOData(u, y, step, time_unit=target)
     if isinstance(src, _Csv):  # the columns read and the units the file states for them (a CSV column: a channel)
@@ -753,6 +754,33 @@ def _check_time_order(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) 
                         "samples or drop one")
     raise DataError(f"{place}: the time {t[k + 1]:.9g} {unit} comes after {t[k]:.9g} {unit}: sample times must "
                     "increase; sort the rows by time")
+
+
+def _check_gaps(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) -> None:
+    """For an equally spaced record: refuse a jump between two rows of more than 1.5 typical steps where nearly
+    every other step (90 %) is the typical one (samples missing from an even grid), naming the file's lines, the
+    times in the file's unit and how many samples are missing (a new user's record with 10 minutes missing was
+    told its sample 1000 lay 7.66 sample times off an even grid, in seconds of a file in hours)."""
+    if t.size < 3:
+        return
+    d = np.diff(t)
+    typical = float(np.median(d))
+    k = int(np.argmax(d))
+    even = np.abs(d - typical) <= 1e-3 * typical  # a grid with holes: nearly every step is the typical one
+    if not (typical > 0 and d[k] > 1.5 * typical and np.mean(even) >= 0.9):
+        return
+    if isinstance(src, _Csv):
+        place = f"{src.where}, lines {src.rows[k][0]} and {src.rows[k + 1][0]}, column {name!r}"
+    else:
+        place = f"{src.where}, rows {k} and {k + 1}, column {name!r}"
+    gaps = int(np.count_nonzero(d > 1.5 * typical))
+    more = f" ({gaps} such gaps in all)" if gaps > 1 else ""
+    raise DataError(f"{place}: the times jump from {t[k]:.9g} to {t[k + 1]:.9g} {unit}, {d[k] / typical:.3g} steps "
+                    f"of {typical:.6g} {unit}: about {round(d[k] / typical) - 1} samples are missing{more}. An "
+                    "equally spaced record has none: read the table as a TimeSeries (TimeSeries.from_table, or "
+                    "kind='TimeSeries'; --kind TimeSeries), which takes the times as they are and the input as held "
+                    "from one row to the next across the gap (an input that changed inside it is then wrong there: "
+                    "split the record at the gap instead)")
 
 
 def _uniform_step(t: np.ndarray, where: str) -> float:
