@@ -410,6 +410,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         opts["scale"] = [spec.scale[n] for n in model.parameter_names]
         if not args.scale:
             from_file.add("scale")
+    if spec.initial_state and "initial_state" not in opts:  # the file's, unless --option gives one
+        opts["initial_state"] = spec.initial_state
+        from_file.add("initial_state")
     if spec.bounds:  # a method that takes bounds= keeps its estimate inside; for the others they are checked after
         opts["bounds"] = {n: tuple(b) for n, b in spec.bounds.items()}
         from_file.add("bounds")

@@ -16,6 +16,7 @@ about its parameters::
     bounds = {"k1": (10.0, 1000.0), "k2": (10.0, 1000.0)}                # plausible ranges
     title = "Two masses on springs, force on mass 2, position of mass 1"
     input_units, output_units = "N", "m"             # for plot labels: H in m/N
+    initial_state = "estimate"                       # time series: records that do not start at rest
 
 Only ``model`` is required (any name works when the file defines exactly one model;
 with several, the one to use must be called ``model``). The other names are optional
@@ -63,7 +64,8 @@ EXAMPLE = ('    k, c = si.parameters("k c", positive=True)              # after 
 """The two-line model file quoted by every error about a model file's contents."""
 
 _MODEL_TYPES = (StateSpaceModel, SecondOrderModel)
-_OPTIONAL = ("known", "start", "scale", "bounds", "title", "source", "notes", "input_units", "output_units")
+_OPTIONAL = ("known", "start", "scale", "bounds", "title", "source", "notes", "input_units", "output_units",
+             "initial_state")
 
 
 def _model_error(where: str, what: str) -> ModelError:
@@ -102,6 +104,12 @@ class ModelFile:
     input_units, output_units : tuple of str
         Physical unit of each input and output (labels only: the Bode plot's |H| is in
         output unit per input unit). Empty when not given.
+    initial_state : {"estimate", "zero"} or None
+        How time-series fits take the initial state (``si.identify``'s option of that name):
+        ``"estimate"`` for records that do not start at rest (a room at 18 °C), which a
+        second-order model cannot say itself (a state-space model can: ``x0="estimate"``).
+        ``symid identify`` passes it on (a method that takes no initial state is told so).
+        ``None`` when not given.
     path : str or None
         The file it was read from (``None`` for a model built in Python).
 
@@ -131,6 +139,7 @@ class ModelFile:
     bounds: dict[str, tuple[float, float]] = field(default_factory=dict)
     input_units: tuple[str, ...] = ()
     output_units: tuple[str, ...] = ()
+    initial_state: str | None = None
     path: str | None = None
 
     def free_model(self, known: Mapping[str, float] | None = None) -> Any:
@@ -246,6 +255,8 @@ class ModelFile:
             lines.append("bounds: " + ", ".join(f"{lo:.6g} ≤ {k} ≤ {hi:.6g}" for k, (lo, hi) in self.bounds.items()))
         if self.input_units:
             lines.append(f"units: inputs {', '.join(self.input_units)}; outputs {', '.join(self.output_units)}")
+        if self.initial_state:
+            lines.append(f"initial state: {self.initial_state}")
         return lines
 
     def summary(self) -> str:
@@ -268,7 +279,8 @@ class ModelFile:
                           "n_inputs": self.model.n_inputs, "n_outputs": self.model.n_outputs},
                 "known": dict(self.known), "start": None if self.start is None else dict(self.start),
                 "scale": dict(self.scale), "bounds": {k: list(v) for k, v in self.bounds.items()},
-                "input_units": list(self.input_units), "output_units": list(self.output_units)}
+                "input_units": list(self.input_units), "output_units": list(self.output_units),
+                "initial_state": self.initial_state}
 
 
 def substitute_known(model: Any, known: Mapping[str, float]) -> Any:
@@ -431,10 +443,14 @@ def from_module(module: ModuleType, *, name: str, where: str, path: str | None =
         raise ModelError(f"{where}: give both input_units and output_units (the unit of H is their ratio), "
                          "e.g. input_units, output_units = \"N\", \"m\"")
     texts = {k: _text(declared.get(k, ""), k, where) for k in ("title", "source", "notes")}
+    initial = declared.get("initial_state")
+    if initial is not None and (not isinstance(initial, str) or initial not in ("estimate", "zero")):
+        raise ModelError(f"{where}: initial_state is 'estimate' (records that do not start at rest) or 'zero'; got "
+                         f"{initial!r}")
     if units_in:  # what the data files' stated units are compared with (si.identify)
         model.io_units = {"input": tuple(units_in), "output": tuple(units_out)}
     common = dict(name=name, model=model, known=known, start=start, scale=scale, bounds=bounds,
-                  input_units=units_in, output_units=units_out, path=path, **texts)
+                  input_units=units_in, output_units=units_out, initial_state=initial, path=path, **texts)
     zoo_names = [k for k in ("truth", "make_data") if k in names]
     if not zoo_names:
         return ModelFile(**common)

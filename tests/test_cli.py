@@ -583,3 +583,36 @@ def test_the_modes_line_groups_poles_at_zero():
     line = _modes_line(model, theta, "s")
     poles = sorted(np.linalg.eigvals(np.asarray(model.state_space(theta)[0], float)).real, key=abs)[2:]
     assert line == ("modes of the estimate: 2 poles at 0; " + "; ".join(f"real pole {p:.4g} /s" for p in poles))
+
+
+def test_a_model_file_can_say_the_records_do_not_start_at_rest(tmp_path, capsys):
+    """A new user's trial: a second-order model file could not declare the estimated initial state, so every call
+    needed --option initial_state=estimate. `initial_state = "estimate"` in the file now does it (time series);
+    a frequency response's method, which takes none, is told so and runs; a bad value is named."""
+    (tmp_path / "room.py").write_text(
+        "import symid as si\n"
+        "Ca, Cw, Haw, Hwo = si.parameters('Ca Cw Haw Hwo', positive=True)\n"
+        "model = si.SecondOrderModel(M=[[Ca, 0], [0, Cw]], V=[[Haw, -Haw], [-Haw, Haw + Hwo]], K=[[0, 0], [0, 0]],\n"
+        "                            B=[[1], [0]], C=[[1, 0]], output='velocity')\n"
+        "start = {'Ca': 4e5, 'Cw': 9e6, 'Haw': 250.0, 'Hwo': 100.0}\n"
+        "initial_state = 'estimate'\n")
+    spec = si.load_model(str(tmp_path / "room.py"))
+    assert spec.initial_state == "estimate" and "initial state: estimate" in spec.summary()
+    truth = {"Ca": 5e5, "Cw": 8e6, "Haw": 300.0, "Hwo": 80.0}
+    u = np.where((np.arange(2000) // 97) % 2 == 0, 2000.0, 0.0)
+    io = si.simulate_io(spec.model, truth, u, 60.0, x0=[0.0, 0.0, 18.0, 17.5], noise_std=0.05, seed=3)
+    rows = "\n".join(f"{60.0 * k},{a!r},{b!r}" for k, (a, b) in enumerate(zip(io.u[:, 0].tolist(),
+                                                                              io.y[:, 0].tolist(), strict=True)))
+    (tmp_path / "rec.csv").write_text(f"t,P,Ta\n{rows}\n")
+    code = main(["identify", str(tmp_path / "room.py"), "--data", str(tmp_path / "rec.csv"), "--columns", "time=t",
+                 "input=P", "output=Ta", "--units", "time=s", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and doc["result"]["options"]["initial_state"] == "estimate"
+    np.testing.assert_allclose([doc["result"]["theta"][n] for n in truth], list(truth.values()), rtol=0.05)
+    frf = si.simulate_frf(spec.model, truth, np.logspace(-5, -2, 30))
+    frf.to_csv(tmp_path / "frf.csv")
+    assert main(["identify", str(tmp_path / "room.py"), "--data", str(tmp_path / "frf.csv")]) in (0, 4)
+    assert "does not use the model file's initial_state" in capsys.readouterr().out
+    (tmp_path / "bad.py").write_text((tmp_path / "room.py").read_text().replace("'estimate'", "'guess'"))
+    with pytest.raises(si.ModelError, match=r"initial_state is 'estimate' .* or 'zero'; got 'guess'"):
+        si.load_model(str(tmp_path / "bad.py"))
