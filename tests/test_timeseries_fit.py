@@ -402,7 +402,11 @@ def test_a_record_that_does_not_start_at_rest_says_to_estimate_the_initial_state
     model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
     u = np.where((np.arange(400) // 40) % 2 == 0, 1.0, 0.0)
     io = si.simulate_io(model, {"k": 0.05, "g": 0.02}, u, 1.0, x0=[18.0], noise_std=0.02, seed=1)
-    res = si.identify(model, io, x0={"k": 0.05, "g": 0.02}, identifiability_check=False)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = si.identify(model, io, x0={"k": 0.05, "g": 0.02}, identifiability_check=False)
+    # far from a fit, the restarts' other estimates are not warned about as if the structure were in question
+    assert not [w for w in caught if issubclass(w.category, si.IdentifiabilityWarning)]
     assert not res.success and res.options["initial_offset"]["measured"] == pytest.approx(18.0, abs=0.1)
     assert 'NEXT: the record does not start where the model does (output 0 is 18' in res.summary()
     assert "initial_state=\"estimate\"" in res.summary()
