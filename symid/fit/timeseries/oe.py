@@ -327,8 +327,7 @@ class OutputError(Estimator, FisherInformation):
         taken as held, a misfit 37 times the noise's (success False, c 3.4 % off); linear, the
         noise's, with k/m and c/m within 0.3 % and a common gain 1.3 % low (linear
         interpolation attenuates a band-limited input by about (ω dt)²/12;
-        ``tests/test_timeseries_fit.py``; at 8 samples per period of the mode: c 12.7 % off
-        held, a gain 5 % low linear).
+        ``tests/test_timeseries_fit.py``).
     max_iter : int, optional
         IPOPT iteration limit, or residual evaluations of ``"trf"`` (default 500).
     tol : float, optional
