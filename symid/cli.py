@@ -192,6 +192,9 @@ def _read_data(args: argparse.Namespace, command: str, files: list[str] | None =
     from symid.data import read_data
 
     files = _data_files(args) if files is None else files
+    twice = sorted({f for f in files if files.count(f) > 1})
+    if twice:  # counted twice, a record would narrow the intervals by √2 without a word
+        raise _UsageError(f"symid {command}: error: {flag} gives {twice[0]!r} more than once: each record once")
     if args.columns is None:
         extra = [f for f, v in (("--units", args.units), ("--dt", args.dt), ("--kind", args.kind)) if v is not None]
         if extra:

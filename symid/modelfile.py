@@ -108,8 +108,9 @@ class ModelFile:
         How time-series fits take the initial state (``si.identify``'s option of that name):
         ``"estimate"`` for records that do not start at rest (a room at 18 °C), which a
         second-order model cannot say itself (a state-space model can: ``x0="estimate"``).
-        ``symid identify`` passes it on (a method that takes no initial state is told so).
-        ``None`` when not given.
+        ``symid identify`` passes it on (a method that takes no initial state is told so); in
+        Python give it yourself, ``si.identify(spec.free_model(), io,
+        initial_state=spec.initial_state)``. ``None`` when not given.
     path : str or None
         The file it was read from (``None`` for a model built in Python).
 

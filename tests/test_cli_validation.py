@@ -101,8 +101,9 @@ def test_repeated_flags_are_merged_and_repeated_data_are_several_records(tmp_pat
 def test_repeated_data_of_another_kind_is_refused(tmp_path, capsys):
     """Only time-series records are fitted together: two frequency responses are a usage error naming the file."""
     si.load_model("belt_drive").data().to_csv(tmp_path / "frf.csv")
-    f = str(tmp_path / "frf.csv")
-    assert main(["identify", "belt_drive", "--data", f, "--data", f]) == 2
+    si.load_model("belt_drive").data().to_csv(tmp_path / "frf2.csv")
+    f, g = str(tmp_path / "frf.csv"), str(tmp_path / "frf2.csv")
+    assert main(["identify", "belt_drive", "--data", f, "--data", g]) == 2
     assert f"but {f!r} holds FrequencyData, not a time series" in capsys.readouterr().err
 
 
@@ -136,3 +137,11 @@ def test_a_single_valued_flag_given_twice_with_different_values_is_an_error(caps
             main(["identify", "mass_damper_2dof", *argv])
         assert info.value.code == 2 and said in capsys.readouterr().err
     assert main(["identify", "mass_damper_2dof", "--method", "ipopt", "--method", "ipopt", "--max-iter", "1"]) in (0, 4)
+
+
+def test_a_file_given_twice_is_refused(tmp_path, capsys):
+    """A new user's trial: --data a.csv --data a.csv fitted the record twice, the standard errors √2 too small."""
+    si.load_model("belt_drive").data().to_csv(tmp_path / "frf.csv")
+    f = str(tmp_path / "frf.csv")
+    assert main(["identify", "belt_drive", "--data", f, "--data", f]) == 2
+    assert f"--data gives {f!r} more than once: each record once" in capsys.readouterr().err

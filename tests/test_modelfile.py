@@ -311,3 +311,8 @@ def test_identify_warns_when_a_data_files_units_differ_from_the_model_files(tmp_
         said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)]
         assert any(f"the file states {unit} for output 'w'; the model file's output unit is rad/s" in s
                    for s in said) == warned, said
+        with warnings.catch_warnings(record=True) as seen:  # validation on such a record says it too
+            warnings.simplefilter("always")
+            si.validate(spec.free_model(), {"J": 1e-3, "b": 1e-2}, io)
+        assert any("the file states" in str(w.message) for w in seen
+                   if issubclass(w.category, si.DataWarning)) == warned

@@ -30,13 +30,14 @@ cross-correlation.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from symid.errors import DataError
+from symid.errors import DataError, DataWarning
 
 __all__ = ["Validation", "validate"]
 
@@ -474,6 +475,10 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
                         f"got {hold!r}")
     M = int(max_lag)
     sim = OutputError(model, data, initial_state=initial_state, variance=variance, hold=hold)
+    from symid.fit.identify import unit_mismatches
+
+    for text in unit_mismatches(model, data):  # as identify says it for the records it fits
+        warnings.warn(text, DataWarning, stacklevel=2)
     th = model.theta_vector(theta)
     try:
         ys = sim.simulate(th)

@@ -419,16 +419,19 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         Lines where the input's amplitude (smallest singular value over inputs) is below
         this fraction of its strongest line are left out (not excited; see the module
         notes); 0 keeps every line with a nonzero input. Default 1e-3 (−60 dB).
-    hold : {None, "zoh"}
-        ``None`` (default): Ĥ is the response from the sampled input to the sampled output,
-        which is the continuous-time H(jω) when the input was sampled, not held (see the
-        notes). ``"zoh"``: the input was held between samples (a DAC, a digital
+    hold : {None, "foh", "zoh"}
+        ``None`` (default) or ``"foh"`` (as ``si.identify`` names a sampled input): Ĥ is the
+        response from the sampled input to the sampled output, which is the continuous-time
+        H(jω) when the input was sampled, not held (see the notes); nothing is corrected.
+        ``"zoh"``: the input was held between samples (a DAC, a digital
         controller, :func:`symid.simulate_io`): Ĥ (and its variance) is divided by the
         hold's response e^{−jω dt/2} sinc(ω dt/2), so that a continuous-time model fits it.
         What stays is the aliasing of the response above the Nyquist frequency, small where
         |H| falls fast: one mass in position, a held multisine up to half the Nyquist
         frequency, the median error against H(jω) 36 % → 0.1 % (2.1 % at the top line;
-        ``tests/test_estimate_frf.py``).
+        ``tests/test_estimate_frf.py``). For an output with a direct feedthrough
+        (acceleration) the aliases dominate and the correction can leave Ĥ further from
+        H(jω) than none: fit such a record as samples (``si.identify(model, io)``).
 
     Returns
     -------
@@ -490,10 +493,11 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
     >>> bool(np.allclose(frf.H[:, 0, 0], 0.2 / (1 - 0.8 / z), rtol=1e-3))
     True
     """
-    if hold not in (None, "zoh"):
-        raise DataError(f"hold must be None (the input sampled) or 'zoh' (held between samples); got {hold!r}")
+    if hold not in (None, "foh", "zoh"):
+        raise DataError(f"hold must be None or 'foh' (the input sampled) or 'zoh' (held between samples); got "
+                        f"{hold!r}")
     est = _analyse(data, estimator, period, transient_periods, nperseg, window, detrend, band, min_excitation)
-    if hold is None:
+    if hold != "zoh":
         return FrequencyData(est.w, est.H, est.variance, est.variance_dof)
     factor = _hold_factor(est.w, _records(data)[0].dt)[:, None, None]
     variance = None if est.variance is None else est.variance / np.abs(factor) ** 2

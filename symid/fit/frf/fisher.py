@@ -166,9 +166,9 @@ class FrfFisher(FisherInformation):
         nan = np.full_like(np.asarray(unc.covariance, dtype=float), np.nan)
         said = (f"intervals withheld: the data's variance is an estimate with {dof:g} degrees of freedom (2 or 3 "
                 f"periods), and a fit weighted by it has no finite covariance (4 periods or more are needed); fit "
-                f"with variance=None (equal weights) for intervals, or measure more periods")
+                f"with variance=None (equal weights; --option variance=none) for intervals, or measure more periods")
         return dataclasses.replace(unc, covariance=nan, standard_errors=np.full(nan.shape[0], np.nan),
-                                   intervals=np.full((nan.shape[0], 2), np.nan),
+                                   intervals=np.full((nan.shape[0], 2), np.nan), shift=None,
                                    note=f"{unc.note}; {said}" if unc.note else said)
 
     def estimate_sensitivity(self, theta: Any) -> np.ndarray | None:

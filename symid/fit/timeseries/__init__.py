@@ -47,7 +47,11 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
             noise_floor: float | None = None) -> Estimator:
     """The estimator of ``method`` for time-series data (see the module table)."""
     if method not in METHODS:
-        raise OptionError(f"unknown method {method!r} for time-series data; choose one of {', '.join(METHODS)}")
+        from symid.fit.registry import all_methods
+
+        what = (f"method {method!r} does not take time-series data (it is another data kind's)"
+                if method in all_methods() else f"unknown method {method!r} for time-series data")
+        raise OptionError(f"{what}; choose one of {', '.join(METHODS)}")
     if method == "oe":
         from symid.fit.timeseries.oe import OutputError
 

@@ -335,7 +335,8 @@ class SimplifiedRIVC(JudgedOnSamples):
                  max_iter: int = 20, tol: float = 1e-9, hold: str = "zoh", skip: float | None = None,
                  initial_state: Any = None, time_limit: float | None = None, callback: Any = None,
                  verbose: bool = False):
-        self.samples = OutputError(model, data, initial_state=initial_state)
+        # the samples the estimate is judged on, simulated with the same hold as the filters take the input
+        self.samples = OutputError(model, data, initial_state=initial_state, hold=check_choice("hold", hold, _HOLDS))
         self.model, self.data = model, data
         self.poly = transfer_polynomials(model)
         records = self.samples.records

@@ -151,7 +151,8 @@ class StateVariableFilter(JudgedOnSamples):
     def __init__(self, model: Any, data: Any, *, bandwidth: float | None = None, order: int | None = None,
                  hold: str = "zoh", iv_iterations: int = 5, initial_state: Any = None,
                  time_limit: float | None = None, callback: Any = None, verbose: bool = False):
-        self.samples = OutputError(model, data, initial_state=initial_state)
+        # the samples the estimate is judged on, simulated with the same hold as the filters take the input
+        self.samples = OutputError(model, data, initial_state=initial_state, hold=check_choice("hold", hold, _HOLDS))
         self.model, self.data = model, data
         self._kind = _check_model(model)
         records = self.samples.records
