@@ -304,13 +304,17 @@ def test_identify_warns_when_a_data_files_units_differ_from_the_model_files(tmp_
         path = tmp_path / "rec.csv"
         path.write_text(f"# units: t [s], tau [N m], w [{unit}]\nt,tau,w\n{rows}\n")
         io = si.IOData.from_table(str(path), columns=cols, units={"time": "s"})
-        assert io.stated_units == {"input": (("tau", "N m"),), "output": (("w", unit),)}
+        assert io.stated_units == {"input": (("tau", "N m"),), "output": (("w", unit),), "file": repr(str(path))}
         with warnings.catch_warnings(record=True) as seen:
             warnings.simplefilter("always")
             si.identify(spec.free_model(), io, x0=spec.start, identifiability_check=False, max_iter=2)
         said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)]
         assert any(f"the file states {unit} for output 'w'; the model file's output unit is rad/s" in s
                    for s in said) == warned, said
+        if warned:  # with several records, the file is named
+            from symid.fit.identify import unit_mismatches
+
+            assert unit_mismatches(spec.free_model(), [io, io])[0].endswith(f"(in {str(path)!r})")
         with warnings.catch_warnings(record=True) as seen:  # validation on such a record says it too
             warnings.simplefilter("always")
             si.validate(spec.free_model(), {"J": 1e-3, "b": 1e-2}, io)

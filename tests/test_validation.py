@@ -216,6 +216,7 @@ def test_the_summary_names_the_channels_by_the_tables_columns(tmp_path):
     (tmp_path / "rec.csv").write_text(f"t,force,position\n{rows}\n")
     rec = si.IOData.from_table(str(tmp_path / "rec.csv"), columns={"time": "t", "input": "force",
                                                                     "output": "position"}, units={"time": "s"})
-    assert rec.stated_units == {"input": (("force", None),), "output": (("position", None),)}
+    assert rec.stated_units == {"input": (("force", None),), "output": (("position", None),),
+                                "file": repr(str(tmp_path / "rec.csv"))}
     text = si.validate(model, TRUTH, rec).summary()
     assert "position" in text.splitlines()[2] and "force" in text

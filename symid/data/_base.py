@@ -41,8 +41,8 @@ class DataContainer:
     _npz_keys: ClassVar[tuple[str, ...]]
     stated_units: ClassVar[dict[str, tuple[tuple[str, str | None], ...]]] = {}
     """The input and output columns a CSV file was read with and the units its ``# units:`` comment states for
-    them, ``{"input": ((column, unit), ...), "output": (...)}``, units as written (``None`` for a column it
-    states none for); ``{}`` for data not read from a CSV file. symid converts nothing by them:
+    them, ``{"input": ((column, unit), ...), "output": (...), "file": "'path'"}``, units as written (``None``
+    for a column it states none for); ``{}`` for data not read from a CSV file. symid converts nothing by them:
     :func:`symid.identify` compares them with a model file's ``input_units`` and ``output_units``, and
     :func:`symid.validate` labels the channels by the columns. Set on the object read (not kept by a copy or a
     file)."""

@@ -732,8 +732,9 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
             record = IOData(u, y, step, time_unit=target)
     if isinstance(src, _Csv):  # the columns read and the units the file states for them (a CSV column: a channel)
         stated = _column_units(src)
-        units = {role: tuple((n, stated.get(n)) for n in names) for role, names in (("input", inputs),
-                                                                                     ("output", outputs))}
+        units: dict = {role: tuple((n, stated.get(n)) for n in names) for role, names in (("input", inputs),
+                                                                                           ("output", outputs))}
+        units["file"] = src.where  # which file says so, for messages about several
         object.__setattr__(record, "stated_units", units)  # on the object read: metadata, not a field
     return record
 

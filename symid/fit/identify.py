@@ -112,9 +112,10 @@ def unit_mismatches(model: Any, data: Any) -> list[str]:
         for role in ("input", "output"):
             for (column, have), want in zip(stated.get(role, ()), declared.get(role, ()), strict=False):
                 if have and want and not _same_unit(have, want):
+                    where = f" (in {stated['file']})" if len(records) > 1 and stated.get("file") else ""
                     text = (f"the file states {have} for {role} {column!r}; the model file's {role} unit is {want}: "
                             f"symid converts neither, so a factor between them goes into the estimates; convert "
-                            f"the data or the model")
+                            f"the data or the model{where}")
                     if text not in out:
                         out.append(text)
     return out
