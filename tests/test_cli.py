@@ -454,10 +454,9 @@ def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
     np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["q"]], [0.3, 0.05], rtol=1e-6)
 
 
-def test_the_validation_of_identify_uses_the_fits_error_model(tmp_path, capsys):
-    """A one-compartment infusion record with 15 % proportional noise (193 samples): `symid identify` with the
-    error model validates with it too, the residual tests on (y − ŷ)/σ (without it the true model's residual
-    tests as coloured: si.validate's test in tests/test_validation.py)."""
+def _infusion_files(tmp_path, records: dict[str, int]) -> None:
+    """pk.py (one compartment, elimination ke, q = 1/V) and, per file name and noise seed, 48 h of two 500 mg/h
+    infusions sampled every 15 min with 15 % proportional noise on the concentration (ke = 0.2, q = 0.025)."""
     (tmp_path / "pk.py").write_text(
         "import symid as si\n"
         "ke, q = si.parameters('ke q', positive=True)\n"
@@ -467,8 +466,16 @@ def test_the_validation_of_identify_uses_the_fits_error_model(tmp_path, capsys):
     t = np.arange(0, 48.125, 0.25)
     u = np.where(t < 2, 500.0, 0.0) + np.where((t >= 12) & (t < 13), 500.0, 0.0)
     y0 = si.simulate_io(si.StateSpaceModel(A=[[-ke]], B=[[q]], C=[[1]]), {"ke": 0.2, "q": 0.025}, u, 0.25).y[:, 0]
-    y = y0 * (1 + 0.15 * np.random.default_rng(2001).standard_normal(t.size))
-    np.savetxt(tmp_path / "pk.csv", np.column_stack([t, u, y]), delimiter=",", header="t,rate,conc", comments="")
+    for name, seed in records.items():
+        y = y0 * (1 + 0.15 * np.random.default_rng(seed).standard_normal(t.size))
+        np.savetxt(tmp_path / name, np.column_stack([t, u, y]), delimiter=",", header="t,rate,conc", comments="")
+
+
+def test_the_validation_of_identify_uses_the_fits_error_model(tmp_path, capsys):
+    """A one-compartment infusion record with 15 % proportional noise (193 samples): `symid identify` with the
+    error model validates with it too, the residual tests on (y − ŷ)/σ (without it the true model's residual
+    tests as coloured: si.validate's test in tests/test_validation.py)."""
+    _infusion_files(tmp_path, {"pk.csv": 2001})
     main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), "--columns", "time=t",
           "input=rate", "output=conc", "--units", "time=h", "--time-unit", "h",
           "--option", 'variance={"proportional": 0.15}'])
@@ -482,18 +489,7 @@ def test_identify_validates_on_other_records_with_validate(tmp_path, capsys):
     records as --data was read and validates the estimate there: the true structure passes on a second record
     (the infusion model, 15 % proportional noise, its error model), a wrong one (elimination fixed at half the
     truth) fails; a frequency response is refused by name."""
-    (tmp_path / "pk.py").write_text(
-        "import symid as si\n"
-        "ke, q = si.parameters('ke q', positive=True)\n"
-        "model = si.StateSpaceModel(A=[[-ke]], B=[[q]], C=[[1]])\n"
-        "start = {'ke': 0.3, 'q': 0.05}\n")
-    ke, q = si.parameters("ke q", positive=True)
-    t = np.arange(0, 48.125, 0.25)
-    u = np.where(t < 2, 500.0, 0.0) + np.where((t >= 12) & (t < 13), 500.0, 0.0)
-    y0 = si.simulate_io(si.StateSpaceModel(A=[[-ke]], B=[[q]], C=[[1]]), {"ke": 0.2, "q": 0.025}, u, 0.25).y[:, 0]
-    for name, seed in (("a.csv", 2001), ("b.csv", 2002)):
-        y = y0 * (1 + 0.15 * np.random.default_rng(seed).standard_normal(t.size))
-        np.savetxt(tmp_path / name, np.column_stack([t, u, y]), delimiter=",", header="t,rate,conc", comments="")
+    _infusion_files(tmp_path, {"a.csv": 2001, "b.csv": 2002})
     args = ["--data", str(tmp_path / "a.csv"), "--validate", str(tmp_path / "b.csv"), "--columns", "time=t",
             "input=rate", "output=conc", "--units", "time=h", "--time-unit", "h",
             "--option", 'variance={"proportional": 0.15}']

@@ -362,13 +362,9 @@ def test_bounds_that_exclude_the_other_solution_make_the_estimate_unique_within_
     assert "NOT UNIQUE" not in res.uncertainty.note
 
 
-def test_hold_foh_fits_a_sampled_band_limited_input():
-    """A sum of 40 sines up to 12 rad/s (sampled, not held) through a 10 rad/s oscillator, position with 2 % noise,
-    its steady state exact, 25 samples a second: output error taking the input as held leaves a misfit 37 times the
-    noise's (success False, c 3.4 % off); with hold="foh" the misfit is the noise's and the shape of the response is
-    right: k/m and c/m within 0.3 % of the truth. What remains is a common gain (m, c, k 1.3 % low): linear
-    interpolation between samples attenuates a band-limited input, by 1 − (ω dt)²/12 to first order (1.9 % at
-    the top sine). Measured when this test was written; a bad hold and IPOPT with foh are named."""
+def _sampled_sines_record():
+    """A sum of 40 sines up to 12 rad/s (sampled, not held) through a 10 rad/s oscillator (m, c, k = 1, 0.4, 100),
+    position with 2 % noise, its steady state exact from the frequency response, 25 samples a second."""
     m, c, k = si.parameters("m c k", positive=True)
     model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
     truth = np.array([1.0, 0.4, 100.0])
@@ -378,8 +374,17 @@ def test_hold_foh_fits_a_sampled_band_limited_input():
     H = model.frequency_response(truth, freqs)[:, 0, 0]
     u = np.sin(np.outer(t, freqs) + phases).sum(axis=1)
     y = (np.abs(H) * np.sin(np.outer(t, freqs) + phases + np.angle(H))).sum(axis=1)
-    y = y + 0.02 * np.std(y) * rng.standard_normal(y.shape)
-    io = si.IOData(u, y, 0.04)
+    return model, truth, si.IOData(u, y + 0.02 * np.std(y) * rng.standard_normal(y.shape), 0.04)
+
+
+def test_hold_foh_fits_a_sampled_band_limited_input():
+    """A sum of 40 sines up to 12 rad/s (sampled, not held) through a 10 rad/s oscillator, position with 2 % noise,
+    its steady state exact, 25 samples a second: output error taking the input as held leaves a misfit 37 times the
+    noise's (success False, c 3.4 % off); with hold="foh" the misfit is the noise's and the shape of the response is
+    right: k/m and c/m within 0.3 % of the truth. What remains is a common gain (m, c, k 1.3 % low): linear
+    interpolation between samples attenuates a band-limited input, by 1 − (ω dt)²/12 to first order (1.9 % at
+    the top sine). Measured when this test was written; a bad hold and IPOPT with foh are named."""
+    model, truth, io = _sampled_sines_record()
     fits = {hold: si.identify(model, io, method="oe", x0=truth, initial_state="estimate", hold=hold,
                               identifiability_check=False) for hold in ("zoh", "foh")}
     noise = 0.02**2  # the relative misfit 2 % noise leaves
@@ -420,16 +425,7 @@ def test_svf_and_srivc_judge_their_estimate_with_their_own_hold(method):
     """A new user's trial: svf and srivc with hold="foh" filtered the input as linear between samples but scored
     their estimate on a simulation that held it (cost 3.7e-2 where the linear one is 5.9e-4: success False). The
     cost is now the output-error misfit with the same hold."""
-    m, c, k = si.parameters("m c k", positive=True)
-    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
-    truth = np.array([1.0, 0.4, 100.0])
-    rng = np.random.default_rng(0)
-    freqs, phases = rng.uniform(1, 12, 40), rng.uniform(0, 2 * np.pi, 40)
-    t = np.arange(3000) * 0.04
-    H = model.frequency_response(truth, freqs)[:, 0, 0]
-    u = np.sin(np.outer(t, freqs) + phases).sum(axis=1)
-    y = (np.abs(H) * np.sin(np.outer(t, freqs) + phases + np.angle(H))).sum(axis=1)
-    io = si.IOData(u, y + 0.02 * np.std(y) * rng.standard_normal(y.shape), 0.04)
+    model, _, io = _sampled_sines_record()
     res = si.identify(model, io, method=method, hold="foh", initial_state="estimate", identifiability_check=False)
     judge = prepare(model, io, "oe", {"hold": "foh", "initial_state": "estimate"})
     held = prepare(model, io, "oe", {"initial_state": "estimate"})
