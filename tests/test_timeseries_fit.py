@@ -96,6 +96,21 @@ def test_estimated_initial_states_over_several_forced_experiments():
     assert res.to_dict()["options"]["initial_states"] == res.options["initial_states"]
 
 
+def test_initial_state_of_a_failed_fit_is_labelled():
+    """A fit that does not fit reports its least-squares initial state as such (a new user's failed room-model fit
+    showed -2302 °C without comment): a first-order model cannot fit a second-order record."""
+    a, b, g = si.parameters("a b g", positive=True)
+    truth_model = si.StateSpaceModel(A=[[0, 1], [-a, -b]], B=[[0], [g]], C=[[1, 0]])
+    rec = si.simulate_io(truth_model, {"a": 4.0, "b": 0.3, "g": 2.0}, np.random.default_rng(0).standard_normal(200),
+                         dt=0.1, x0=[1.0, 0.0])
+    first = si.StateSpaceModel(A=[[-a]], B=[[g]], C=[[1]], x0="estimate")
+    res = si.identify(first, rec, method="oe", x0={"a": 1.0, "g": 1.0}, identifiability_check=False)
+    assert not res.success and len(res.options["initial_states"]) == 1
+    text = res.summary()
+    assert "initial state x(t₀) at an estimate that does not fit the data" in text
+    assert "estimated with θ (least squares at the estimate)" not in text
+
+
 def test_oe_on_iodata_with_input_and_zero_initial_state():
     k, c = si.parameters("k c", positive=True)
     model = si.StateSpaceModel(A=[[-k]], B=[[c]], C=[[1]])
