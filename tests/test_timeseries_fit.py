@@ -446,3 +446,26 @@ def test_svf_and_srivc_judge_their_estimate_with_their_own_hold(method):
     held = prepare(model, io, "oe", {"initial_state": "estimate"})
     np.testing.assert_allclose(res.cost, judge.misfit(res.theta_vector), rtol=1e-9)
     assert judge.misfit(res.theta_vector) != pytest.approx(held.misfit(res.theta_vector), rel=1e-3)
+
+
+def test_a_given_noise_std_judges_the_fit():
+    """Noise of 15 % of the output's rms leaves a relative misfit of about 0.0225, beyond the 1e-2 that a fit judged by
+    its whiteness alone may have: with the noise level given (``noise_std``) that misfit is the floor, so the least-
+    squares estimate is a success and a wrong structure is not (a new user's tank levels as deviation variables)."""
+    a, b, g = si.parameters("a b g", positive=True)
+    model = si.StateSpaceModel(A=[[0, 1], [-a, -b]], B=[[0], [g]], C=[[1, 0]])
+    truth = {"a": 4.0, "b": 0.8, "g": 2.0}
+    u = np.random.default_rng(3).standard_normal(1500)
+    clean = si.simulate_io(model, truth, u, dt=0.1)
+    sigma = 0.15 * float(np.sqrt(np.mean(clean.y**2)))
+    noisy = si.IOData(clean.u, clean.y + sigma * np.random.default_rng(4).standard_normal(clean.y.shape), dt=0.1)
+    start = {"a": 3.0, "b": 1.0, "g": 1.5}
+    plain = si.identify(model, noisy, method="oe", x0=start, identifiability_check=False)
+    assert plain.cost > 1e-2 and not plain.success and "over 10 % rms" in plain.summary()
+    given = si.identify(model, noisy, method="oe", x0=start, identifiability_check=False, noise_std=sigma)
+    assert given.success and "noise floor" in given.summary()
+    np.testing.assert_allclose(given.theta_vector, plain.theta_vector, rtol=1e-8)  # the same estimate, judged
+    first = si.StateSpaceModel(A=[[-a]], B=[[g]], C=[[1]])  # a first-order model of a resonance
+    wrong = si.identify(first, noisy, method="oe", x0={"a": 1.0, "g": 1.0}, identifiability_check=False,
+                        noise_std=sigma)
+    assert not wrong.success

@@ -201,11 +201,13 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     noise_floor : float, optional
         The relative misfit noise alone leaves at the true parameters (ε² for relative
         noise of level ε); used to judge ``success`` (:mod:`symid.fit.success`). Default:
-        estimated from the residual where the data kind allows it.
+        the misfit ``noise_std`` leaves when it is given, else estimated from the residual
+        where the data kind allows it.
     noise_std : float or array_like, optional
         Standard deviation of the measurement noise of every measured value, in data
         units (a number, one per frequency or sample, or the data's full shape), for the
-        uncertainty in ``result.uncertainty``; default: estimated from the residuals
+        uncertainty in ``result.uncertainty`` and, unless ``noise_floor`` is given, the noise
+        floor that judges ``success``; default: estimated from the residuals
         (:mod:`symid.fit.uncertainty`).
     **options
         The method's options (see each estimator's docstring and the options table in
@@ -268,6 +270,12 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     if noise_std is not None and not isinstance(estimator, FisherInformation):
         raise OptionError(f"noise_std is for the uncertainty of the estimate, which method {estimator.method!r} "
                           "on this data kind does not give")
+    if noise_std is not None and estimator.noise_floor is None:
+        # the noise the user declared also judges the fit: the misfit it alone leaves at the truth, Σ of the squared
+        # standard deviations of the misfit's weighted residual (a new user's tank levels as deviations, 0.2 cm noise
+        # on a ±1.5 cm signal: a white residual at misfit 1.9e-2 was refused as "over 10 % rms")
+        std, _ = estimator.given_noise(noise_std)
+        estimator.noise_floor = float(np.sum(np.asarray(std, dtype=float) ** 2))
     polisher = estimator.polisher() if polish else None
     if polish and polisher is None:
         raise OptionError(f"method {estimator.method!r} has no polish step (polish=True applies to SCR)")
