@@ -346,3 +346,22 @@ def test_hold_zoh_removes_the_holds_response_from_a_held_input():
                                   si.estimate_frf(io, period=N, transient_periods=6).H)
     with pytest.raises(si.DataError, match="hold must be None or 'foh'"):
         si.estimate_frf(io, period=N, hold="linear")
+
+
+def test_inputs_that_are_one_signal_warn():
+    """An input and its derivative as two inputs (a new user's road displacement and velocity) are one signal: the
+    response to each cannot be told apart and the estimate says so; correlated but separable inputs do not warn."""
+    from symid.errors import DataWarning
+
+    rng = np.random.default_rng(7)
+    N = 2**13
+    u0 = rng.standard_normal(N)
+    y = scipy.signal.lfilter(B_IIR, A_IIR, u0) + 0.01 * rng.standard_normal(N)
+    with pytest.warns(DataWarning, match="2 inputs are nearly one signal"):
+        si.estimate_frf(si.IOData(np.column_stack([u0, np.gradient(u0, DT)]), y, DT), nperseg=256)
+    # u1 = u0 + 0.5 e (e independent): |γ| = 1/√1.25 = 0.89 between them, a separation of 0.11 > COLLINEAR_INPUTS
+    u1 = u0 + 0.5 * rng.standard_normal(N)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DataWarning)
+        frf = si.estimate_frf(si.IOData(np.column_stack([u0, u1]), y, DT), nperseg=256)
+    assert frf.H.shape[2] == 2

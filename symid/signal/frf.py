@@ -78,7 +78,7 @@ import numpy as np
 import scipy.signal
 
 from symid.data import FrequencyData, IOData
-from symid.errors import DataError
+from symid.errors import DataError, DataWarning
 
 __all__ = ["effective_averages", "estimate_coherence", "estimate_frf"]
 
@@ -96,6 +96,28 @@ class _Estimate:
     coherence: np.ndarray
     variance_dof: float | None = None
     """Real degrees of freedom of the variance estimate (2 per complex one)."""
+    input_separation: float = 1.0
+    """Median over the lines of the smallest eigenvalue of the inputs' normalised spectral matrix (:func:`_separation`):
+    1 for uncorrelated inputs, 0 for inputs that are one signal at every line."""
+
+
+COLLINEAR_INPUTS = 1e-2
+"""Below this median separation of the inputs (for two inputs, 1 − |γ₁₂|: an input coherence above 0.98) the
+estimate warns: each input's column has at least 1/separation times the variance it would have with uncorrelated
+inputs, and with inputs that are one signal (one the derivative or a copy of the other) it is arbitrary."""
+
+
+def _separation(Suu: np.ndarray) -> float:
+    """Median over the lines of λ_min(D^{-1/2} Suu D^{-1/2}), D = diag(Suu): how far the inputs are from being one
+    signal (1 with one input)."""
+    if Suu.shape[1] < 2 or Suu.shape[0] == 0:
+        return 1.0
+    d = np.sqrt(np.real(np.diagonal(Suu, axis1=1, axis2=2)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        C = Suu / (d[:, :, None] * d[:, None, :])
+    C = 0.5 * (C + np.conj(np.swapaxes(C, 1, 2)))
+    lam = np.linalg.eigvalsh(np.where(np.isfinite(C), C, 0.0))[:, 0]
+    return float(np.median(np.clip(lam, 0.0, None)))
 
 
 # -- arguments ----------------------------------------------------------------------------
@@ -283,7 +305,7 @@ def _welch(recs: list[IOData], estimator: str, nperseg: Any, window: Any, detren
             raise DataError(f"the coherence is zero at ω = {w[i]:.6g} rad/s: the H2 estimate and its variance do not "
                             "exist there; use estimator='h1' or narrow the band")
         var = (rel * np.abs(H[:, :, 0]) ** 2 / (n_eff - 1))[:, :, None]
-    return _Estimate(w, H, var, coh, 2.0 * float(dof if estimator == "h1" else n_eff - 1))
+    return _Estimate(w, H, var, coh, 2.0 * float(dof if estimator == "h1" else n_eff - 1), _separation(Suu))
 
 
 # -- periodic ------------------------------------------------------------------------------
@@ -344,7 +366,7 @@ def _periodic(recs: list[IOData], period: Any, transient_periods: Any, band: Any
     Syu = np.einsum("ksa,ksb->sab", Yk, np.conj(Uk))
     syy = np.sum(np.abs(Yk) ** 2, axis=0)
     coh = _multiple_coherence(Suu, Syu, syy) if P * E >= m else np.zeros_like(syy)
-    return _Estimate(w, H, var, coh, None if var is None else 2.0 * (P - 1))
+    return _Estimate(w, H, var, coh, None if var is None else 2.0 * (P - 1), _separation(Suu))
 
 
 def _analyse(data: Any, estimator: Any, period: Any, transient_periods: Any, nperseg: Any, window: Any,
@@ -451,6 +473,15 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         above the Nyquist frequency; H2 with several inputs, or at a line of zero
         coherence.
 
+    Warns
+    -----
+    DataWarning
+        When the inputs are nearly one signal (:data:`COLLINEAR_INPUTS`: for two inputs, a
+        coherence above 0.98 between them at the median line), so that the response to
+        each cannot be told apart: the warning says how much that multiplies each
+        column's variance. An input derived from another (its derivative, a scaled copy)
+        is not a separate input. And when ``band`` reaches above the Nyquist frequency.
+
     Notes
     -----
     Ĥ is the response from the sampled input to the sampled output. Where the input
@@ -497,6 +528,17 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         raise DataError(f"hold must be None or 'foh' (the input sampled) or 'zoh' (held between samples); got "
                         f"{hold!r}")
     est = _analyse(data, estimator, period, transient_periods, nperseg, window, detrend, band, min_excitation)
+    if est.input_separation < COLLINEAR_INPUTS:
+        # a new user's road input and its derivative as two inputs: coherence 0.99993 between them, each column of Ĥ
+        # 190 % to 10⁴ % off with no word said (the output's coherence with the two was 0.9999)
+        sep = est.input_separation
+        warnings.warn(f"the {est.H.shape[2]} inputs are nearly one signal (median over the lines of the smallest "
+                      f"eigenvalue of their normalised spectral matrix {sep:.2g}; for two inputs, a coherence of "
+                      f"{(1 - sep) ** 2:.5f} between them): the response to each cannot be told apart, and each "
+                      f"column of Ĥ has at least {1 / max(sep, 1e-300):.2g} times the variance it would have with "
+                      "uncorrelated inputs (arbitrary where they are one signal). Excite the inputs independently; "
+                      "if one input is derived from another (its derivative, a scaled copy), it is not a separate "
+                      "input: model the pair as one", DataWarning, stacklevel=2)
     if hold != "zoh":
         return FrequencyData(est.w, est.H, est.variance, est.variance_dof)
     factor = _hold_factor(est.w, _records(data)[0].dt)[:, None, None]
