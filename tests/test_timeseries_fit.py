@@ -469,3 +469,30 @@ def test_a_given_noise_std_judges_the_fit():
     wrong = si.identify(first, noisy, method="oe", x0={"a": 1.0, "g": 1.0}, identifiability_check=False,
                         noise_std=sigma)
     assert not wrong.success
+
+
+def test_records_around_an_operating_point_are_named_in_next():
+    """Absolute values around an operating point: a tank level logged at 30 ± 1 cm (a new user's pilot plant) and
+    an accelerometer with a bias. A fit whose gains absorb the level says the output sits at a level; one whose
+    model cannot absorb it (acceleration: no response at DC) says the residual is mostly a constant; each with the
+    remedies of the guide, whose first remedy then fits (reference: the values simulated)."""
+    a, b = si.parameters("a b", positive=True)
+    tank = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]], x0="estimate")
+    du = np.repeat(np.random.default_rng(0).choice([-5.0, 5.0], 40), 25)
+    dev = si.simulate_io(tank, {"a": 0.05, "b": 0.02}, du, dt=1.0, x0=[0.0], noise_std=0.01, seed=1)
+    absolute = si.IOData(50.0 + dev.u, 32.0 + dev.y, dt=1.0)  # 32, not 0.4 · 50: an operating point
+    res = si.identify(tank, absolute, x0={"a": 0.1, "b": 0.01}, identifiability_check=False)
+    assert not res.success and res.options["initial_offset"]["kind"] == "level"
+    assert "output 0 sits at a level (mean 32" in res.summary()
+    fixed = si.identify(tank, si.IOData(dev.u, dev.y, dt=1.0), x0={"a": 0.1, "b": 0.01}, identifiability_check=False)
+    assert fixed.success
+    np.testing.assert_allclose(fixed.theta_vector, [0.05, 0.02], rtol=0.02)
+
+    m, c, k = si.parameters("m c k", positive=True)
+    mass = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]], output="acceleration")
+    io = si.simulate_io(mass, {"m": 2.0, "c": 0.8, "k": 50.0}, np.random.default_rng(2).standard_normal(800), 0.05,
+                        noise=0.01, seed=3)
+    biased = si.IOData(io.u, io.y + 0.5 * float(np.sqrt(np.mean(io.y**2))), dt=0.05)
+    res = si.identify(mass, biased, x0={"m": 2.0, "c": 0.8, "k": 50.0}, identifiability_check=False)
+    assert not res.success and res.options["initial_offset"]["kind"] == "offset"
+    assert "the residual is mostly a constant offset (output 0" in res.summary()

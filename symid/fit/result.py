@@ -8,6 +8,7 @@ never instead of it: a start stopped by its budget whose estimate fits is a succ
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -64,6 +65,30 @@ _IN_TIME = {  # the whiteness advice for residuals ordered in time (measured sam
     "smooth across frequency": "smooth in time",
     "noise that grows with |H|": "noise that is not white (coloured, or growing with the signal)",
 }
+
+
+def _offset_advice(offset: Mapping[str, Any]) -> str:
+    """The NEXT line for a time-series misfit that a free initial state or a constant offset explains
+    (:meth:`symid.fit.timeseries.oe.OutputError.initial_offset`)."""
+    where = f"record {offset['record']}, " if offset["record"] else ""
+    drop = ("" if offset.get("after") is None else
+            f"this estimate's misfit would fall from {offset['misfit']:.3g} to {offset['after']:.3g}")
+    if offset.get("kind", "initial_state") == "initial_state":
+        return (f"the record does not start where the model does ({where}output {offset['output']} is "
+                f"{offset['measured']:.6g} at its first sample, the model's {offset['model']:.6g}"
+                f"{'; with the initial state estimated ' + drop if drop else ''}): estimate the initial state "
+                f"(initial_state=\"estimate\"; --option initial_state=estimate) or remove the offset from the data")
+    if offset.get("kind") == "level":
+        return (f"{where}output {offset['output']} sits at a level (mean {offset['mean']:.6g}, standard deviation "
+                f"{offset['std']:.3g}): if the record lies around an operating point (absolute levels, "
+                f"temperatures, positions), subtract the operating point from the inputs and outputs (deviation "
+                f"variables), or model it: a constant input (a column of ones) whose gain is a parameter, with the "
+                f"initial state estimated (guide: records around an operating point)")
+    return (f"the residual is mostly a constant offset ({where}output {offset['output']}: mean residual "
+            f"{offset['mean']:.6g}; with each output's mean residual removed {drop}): the record lies around an "
+            f"operating point. Subtract the operating point from the inputs and outputs (deviation variables), or "
+            f"model it: a constant input (a column of ones) whose gain is a parameter, with the initial state "
+            f"estimated (guide: records around an operating point)")
 
 
 def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
@@ -403,11 +428,7 @@ class IdentificationResult:
             if self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
             elif (offset := self.options.get("initial_offset")) is not None:
-                where = f"record {offset['record']}, " if offset["record"] else ""
-                lines.append(f"NEXT: the record does not start where the model does ({where}output "
-                             f"{offset['output']} is {offset['measured']:.6g} at its first sample, the model's "
-                             f"{offset['model']:.6g}): estimate the initial state (initial_state=\"estimate\"; "
-                             f"--option initial_state=estimate) or remove the offset from the data")
+                lines.append("NEXT: " + _offset_advice(offset))
             elif self.on_bounds:
                 sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
                 lines.append(f"NEXT: the estimate sits on its bounds ({sides}) and does not fit: the data want values "
