@@ -291,10 +291,23 @@ def test_theta_as_dict_or_sequence():
 
 @pytest.mark.parametrize("theta, phrase", [
     ({"m1": 1}, "missing"), ({**TRUTH_2DOF, "zz": 1}, "unknown"), ([1, 2], "has 2 value"),
-    ({**TRUTH_2DOF, "m1": float("nan")}, "not finite for m1"), ({**TRUTH_2DOF, "m1": "x"}, "real numbers")])
+    ({**TRUTH_2DOF, "m1": float("nan")}, "not finite for m1"), ({**TRUTH_2DOF, "m1": "x"}, "real numbers"),
+    ("estimate", "initial state is estimated with initial_state=")])
 def test_theta_errors(theta, phrase):
     with pytest.raises(si.ModelError, match=phrase):
         two_dof().state_space(theta)
+
+
+def test_a_result_given_as_theta_names_its_estimate():
+    # a new user passed the result of si.identify to si.validate: "theta has 1 value(s)"
+    from symid.fit.result import IdentificationResult, StartOutcome
+
+    names = two_dof().parameter_names
+    vec = two_dof().theta_vector(TRUTH_2DOF)
+    res = IdentificationResult.from_starts("lm", names, [StartOutcome(vec, vec, 0.0, True, True, "ok", 1, 0.1)],
+                                           cost_kind="misfit")
+    with pytest.raises(si.ModelError, match=r"theta is an IdentificationResult.*result\.theta"):
+        two_dof().state_space(res)
 
 
 # -- first-order forms and frequency responses --------------------------------------------------

@@ -162,8 +162,13 @@ class ParametricModel:
             vals = [given[n] for n in names]
         else:
             if isinstance(theta, (str, bytes)):
+                hint = ("; the initial state is estimated with initial_state=\"estimate\" (identify's x0 is the "
+                        "start of the parameters)" if str(theta).strip().lower() == "estimate" else "")
                 raise ModelError(f"theta is the text {theta!r}; give a dict by name or a sequence of {len(names)} "
-                                 f"number(s) ({', '.join(names)})")
+                                 f"number(s) ({', '.join(names)}){hint}")
+            if hasattr(theta, "theta") and hasattr(theta, "parameter_names"):  # a result where its estimate belongs
+                raise ModelError(f"theta is an {type(theta).__name__}, not parameter values: pass its estimate "
+                                 f"(result.theta, or result.polished.theta for the polished one)")
             vals = list(np.asarray(theta, dtype=object).reshape(-1)) if np.ndim(theta) else [theta]
             if len(vals) != len(names):
                 raise ModelError(f"theta has {len(vals)} value(s); the model has {len(names)} parameter(s) "
