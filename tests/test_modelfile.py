@@ -320,3 +320,24 @@ def test_identify_warns_when_a_data_files_units_differ_from_the_model_files(tmp_
             si.validate(spec.free_model(), {"J": 1e-3, "b": 1e-2}, io)
         assert any("the file states" in str(w.message) for w in seen
                    if issubclass(w.category, si.DataWarning)) == warned
+
+
+def test_a_model_files_dicts_serve_the_model_with_some_values_known():
+    """A new user's quarter car: ``si.identify(spec.model.with_known({"ms": 320}), io, x0=spec.start,
+    scale=spec.scale, bounds=spec.bounds)`` was refused three times ("'ms' is not a parameter"); the known names
+    are left out of those dicts (the command line's --known did so already)."""
+    import numpy as np
+
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    truth = {"m": 2.0, "c": 0.8, "k": 50.0}
+    io = si.simulate_io(model, truth, np.random.default_rng(0).standard_normal(400), dt=0.05)
+    start, scale = {"m": 1.5, "c": 1.0, "k": 40.0}, {"m": 1.0, "c": 1.0, "k": 10.0}
+    bounds = {"m": (0.1, 10.0), "c": (0.01, 10.0), "k": (1.0, 1e3)}
+    known = model.with_known({"m": 2.0})
+    assert known.known_values == {"m": 2.0}
+    res = si.identify(known, io, x0=start, scale=scale, bounds=bounds, identifiability_check=False)
+    assert res.success and set(res.theta) == {"c", "k"}
+    np.testing.assert_allclose([res.theta["c"], res.theta["k"]], [0.8, 50.0], rtol=1e-6)
+    cmp = si.compare(known, io, methods=("oe",), starts=1, x0=start, options={"oe": {"scale": scale, "bounds": bounds}})
+    assert cmp.stats[0].n_success == 1

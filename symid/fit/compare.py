@@ -12,7 +12,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from symid.errors import DataError, ModelError, OptionError
-from symid.fit.options import check_choice, check_float, scale_by_name
+from symid.fit.options import check_choice, check_float, scale_by_name, without_known
 from symid.fit.registry import check_model, data_kind, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
@@ -290,7 +290,11 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         if not isinstance(m, str) or m.removesuffix("+polish") not in kind.methods:
             raise OptionError(f"unknown method {m!r} for {kind.name} data; choose among "
                               f"{', '.join(kind.methods)} (each also as '<method>+polish' where it has a polish step)")
-    options = dict(options or {})
+    # a model file's start, scale and bounds name every parameter; with some made known (with_known) they still serve
+    known = model.known_values if hasattr(model, "known_values") else {}
+    x0 = without_known(x0, known)
+    options = {m: ({k: (without_known(v, known) if k in ("scale", "bounds") else v) for k, v in o.items()}
+                   if isinstance(o, dict) else o) for m, o in dict(options or {}).items()}
     unknown = set(options) - {m.removesuffix("+polish") for m in methods}
     if unknown:
         raise ModelError(f"options are keyed by method, e.g. options={{'ipopt': {{'time_limit': 10}}}} (a "

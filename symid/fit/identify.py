@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from symid.errors import DataWarning, IdentifiabilityWarning, OptionError
-from symid.fit.options import check_bool, scale_by_name
+from symid.fit.options import check_bool, scale_by_name, without_known
 from symid.fit.registry import check_model, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
@@ -263,6 +263,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     if progress is not None:
         progress = check_bool("progress", progress)
     check_model(model)
+    # a model file's start, scale and bounds name every parameter; with some made known (with_known) they still serve
+    known = model.known_values if hasattr(model, "known_values") else {}
+    x0 = without_known(x0, known)
+    options = {k: (without_known(v, known) if k in ("scale", "bounds") else v) for k, v in options.items()}
     options = scale_by_name(options, model.parameter_names)  # a dict by name, as x0 may be
     estimator = prepare(model, data, method, options, noise_floor=noise_floor)
     for text in unit_mismatches(model, data):

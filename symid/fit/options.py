@@ -155,6 +155,22 @@ def check_scale(name: str, value: Any, size: int) -> np.ndarray:
     return arr.copy()
 
 
+def without_known(value: Any, known: Mapping[str, float]) -> Any:
+    """A dict by parameter name less the names ``known`` holds (a model's :attr:`known_values`): a model file's start,
+    scale or bounds, written for every parameter, serve the same model with some values known. Anything that is
+    not a dict is returned as it is.
+
+    Examples
+    --------
+    >>> from symid.fit.options import without_known
+    >>> without_known({"m": 300.0, "k": 2e4}, {"m": 320.0})
+    {'k': 20000.0}
+    """
+    if not isinstance(value, Mapping) or not known:
+        return value
+    return {k: v for k, v in value.items() if str(k) not in known}
+
+
 def scale_by_name(options: Mapping[str, Any], parameter_names: Sequence[str]) -> dict[str, Any]:
     """``options`` with a ``scale`` given as a dict by parameter name (as ``x0`` and ``bounds`` may be) turned
     into one value per parameter, in θ order; every parameter must be named, and only those.

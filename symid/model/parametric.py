@@ -182,6 +182,19 @@ class ParametricModel:
             raise ModelError(f"theta is not finite for {', '.join(bad)}")
         return vec
 
+    @property
+    def known_values(self) -> dict[str, float]:
+        """The values :meth:`with_known` fixed, by name (empty for a model whose parameters are all its own).
+
+        Examples
+        --------
+        >>> import symid as si
+        >>> m, c, k = si.parameters("m c k", positive=True)
+        >>> si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]]).with_known({"m": 2.0}).known_values
+        {'m': 2.0}
+        """
+        return dict(getattr(self, "_known_values", {}))
+
     def theta_dict(self, theta: Theta) -> dict[str, float]:
         """θ as a dict by parameter name."""
         return dict(zip(self.parameter_names, self.theta_vector(theta).tolist(), strict=True))
