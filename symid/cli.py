@@ -589,11 +589,11 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         raise _UsageError(f"symid compare: error: --methods {args.methods!r} names no method")
     truth = _truth(spec, args)
     _say(args, f"model: {spec.name}   data: {source}")
-    scr_opts = _method_options(args)
+    model = spec.free_model()
+    options, noise_floor = _compare_options(model, data, methods, spec, args)
     try:
-        cmp = compare(spec.free_model(), data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
-                      x0=spec.start, progress=True,
-                      options={"scr": scr_opts} if scr_opts and {"scr", "scr+polish"} & set(methods) else None)
+        cmp = compare(model, data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
+                      x0=spec.start, progress=True, options=options or None, noise_floor=noise_floor)
     except Interrupted as exc:  # keep the finished starts
         _say(args, exc.partial.table())
         if out is not None:
@@ -606,6 +606,57 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
         _print_json(cmp.to_dict())
     return 0
+
+
+def _compare_options(model, data, methods, spec, args) -> tuple[dict, float | None]:
+    """Per method, the options of the flags and the model file that method takes; and ``noise_floor``.
+
+    A flag's option that no compared method takes is an error naming the flag; one that some take goes to those
+    (said). The model file's scale, bounds and initial state go to the methods that take them, silently, as for
+    ``symid identify``."""
+    from symid.errors import OptionError, SymidError
+    from symid.fit.registry import data_kind
+
+    given = _method_options(args)
+    noise_floor = given.pop("noise_floor", None)
+    if noise_floor is not None and not (isinstance(noise_floor, (int, float)) and noise_floor >= 0):
+        raise _UsageError(f"symid compare: error: --option noise_floor={noise_floor!r}: a number ≥ 0 (the relative "
+                          f"misfit the noise leaves)")
+    if "noise_std" in given:
+        raise _UsageError("symid compare: error: --option noise_std: compare judges fits by --option noise_floor= "
+                          "(the relative misfit the noise leaves, e.g. 1e-4 for 1 % noise)")
+    from_file = {}
+    if spec.scale:
+        from_file["scale"] = [spec.scale[n] for n in model.parameter_names]
+    if spec.bounds:
+        from_file["bounds"] = {n: tuple(b) for n, b in spec.bounds.items()}
+    if spec.initial_state:
+        from_file["initial_state"] = spec.initial_state
+    kind = data_kind(data)
+
+    def takes(method: str, name: str, value) -> bool:
+        try:
+            kind.prepare(model, data, method.removesuffix("+polish"), {name: value})
+        except OptionError:
+            return False
+        except SymidError:  # the method refuses the model or data itself: compare says so, by name
+            return True
+        return True
+
+    flags = {"backend": "--backend", "max_iter": "--max-iter", "tol": "--tol", "time_limit": "--time-limit"}
+    options: dict[str, dict] = {}
+    for name, value in {**from_file, **given}.items():
+        takers = [m for m in methods if takes(m, name, value)]
+        if name in given and not takers:
+            flag = flags.get(name, f"--option {name}")
+            raise _UsageError(f"symid compare: error: {flag}: none of the methods compared ({', '.join(methods)}) "
+                              f"takes {name} with this data")
+        if name in given and len(takers) < len(methods):
+            _say(args, f"note: {flags.get(name, f'--option {name}')} goes to {', '.join(takers)} (the others do not "
+                       f"take it)")
+        for m in takers:
+            options.setdefault(m.removesuffix("+polish"), {})[name] = value
+    return options, noise_floor
 
 
 def _write_compare(out, cmp) -> None:
@@ -751,12 +802,24 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--starts", type=_int_in(1, _MAX_STARTS), default=10, metavar="N",
                    help="number of starts (default: 10)")
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
-    p.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
-    p.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
-                   help="SCR iterations per start (≥ 1)")
     p.add_argument("--x0", nargs="+", action="extend", metavar="NAME=VALUE", help="the first start of every method")
     p.add_argument("--known", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="parameters whose values are known: substituted into the model before estimation")
+    p.add_argument("--scale", nargs="+", action="extend", metavar="NAME=VALUE",
+                   help="typical magnitude of every free parameter (or one number for all), for the methods "
+                        "that take scale=")
+    p.add_argument("--bounds", nargs="+", action="extend", metavar="NAME=LOW:HIGH",
+                   help="plausible ranges, for the methods that take bounds= (the start must lie inside)")
+    g = p.add_argument_group("method options: each goes to the methods that take it (one that no method takes is an "
+                             "error); --option noise_floor=PHI judges every method's fit against that noise floor")
+    g.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
+    g.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
+                   help="iteration limit per start (≥ 1)")
+    g.add_argument("--tol", type=_positive_number, metavar="TOL", help="the methods' stopping tolerance")
+    g.add_argument("--time-limit", type=_positive_seconds, dest="time_limit", metavar="S",
+                   help="wall-time budget of one start in seconds (methods that take time_limit)")
+    g.add_argument("--option", nargs="+", action="extend", metavar="NAME=VALUE",
+                   help="any other option (see the options table), e.g. hold=foh or initial_state=estimate")
     p.add_argument("--out", metavar="DIR", help="write comparison.json and comparison.md here")
     p.add_argument("--json", action="store_true", help="print the comparison as JSON on standard output")
     p.set_defaults(func=_cmd_compare)
