@@ -394,6 +394,23 @@ def stated_column_units(path: Any, delimiter: str = ",") -> dict[str, str]:
     return _column_units(_Csv(path, delimiter))
 
 
+_NAME_UNIT = re.compile(r"^.*\S\s*[\[(]\s*([^\[\]()]*[A-Za-zµμ°%][^\[\]()]*?)\s*[\])]\s*$")
+"""A unit at the end of a column's own name: ``h2 [mm]``, ``T (degC)``."""
+
+
+def _name_unit(name: str) -> str | None:
+    """The unit a column's name ends with in brackets or parentheses (``h2 [mm]`` → ``mm``), or None.
+
+    Examples
+    --------
+    >>> from symid.data.table import _name_unit
+    >>> _name_unit("h2 [mm]"), _name_unit("T (degC)"), _name_unit("u[1]"), _name_unit("h2")
+    ('mm', 'degC', None, None)
+    """
+    m = _NAME_UNIT.match(str(name))
+    return m.group(1) if m else None
+
+
 def _column_units(src: _Csv) -> dict[str, str]:
     """:func:`stated_column_units` of a file already read."""
     out: dict[str, str] = {}
@@ -732,11 +749,16 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
             record = IOData(u, y, step, time_unit=target)
     if isinstance(src, _Csv):  # the columns read and the units the file states for them (a CSV column: a channel)
         stated = _column_units(src)
-        units: dict = {role: tuple((n, stated.get(n)) for n in names) for role, names in (("input", inputs),
-                                                                                           ("output", outputs))}
+        units: dict = {role: tuple((n, stated.get(n) or _name_unit(n)) for n in names)
+                       for role, names in (("input", inputs), ("output", outputs))}
         units["file"] = src.where  # which file says so, for messages about several
         object.__setattr__(record, "stated_units", units)  # on the object read: metadata, not a field
     return record
+
+
+def _missing(n: int) -> str:
+    """'about 1 sample is missing', 'about 3 samples are missing'."""
+    return f"about {n} sample is missing" if n == 1 else f"about {n} samples are missing"
 
 
 def _check_time_order(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) -> None:
@@ -777,7 +799,7 @@ def _check_gaps(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) -> Non
     gaps = int(np.count_nonzero(d > 1.5 * typical))
     more = f" ({gaps} such gaps in all)" if gaps > 1 else ""
     raise DataError(f"{place}: the times jump from {t[k]:.9g} to {t[k + 1]:.9g} {unit}, {d[k] / typical:.3g} steps "
-                    f"of {typical:.6g} {unit}: about {round(d[k] / typical) - 1} samples are missing{more}. An "
+                    f"of {typical:.6g} {unit}: {_missing(round(d[k] / typical) - 1)}{more}. An "
                     "equally spaced record has none: read the table as a TimeSeries (TimeSeries.from_table, or "
                     "kind='TimeSeries'; --kind TimeSeries), which takes the times as they are and the input as held "
                     "from one row to the next across the gap (an input that changed inside it is then wrong there: "
