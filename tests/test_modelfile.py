@@ -357,3 +357,24 @@ def test_a_model_files_dicts_serve_the_model_with_some_values_known():
     np.testing.assert_allclose([res.theta["c"], res.theta["k"]], [0.8, 50.0], rtol=1e-6)
     cmp = si.compare(known, io, methods=("oe",), starts=1, x0=start, options={"oe": {"scale": scale, "bounds": bounds}})
     assert cmp.stats[0].n_success == 1
+
+
+def test_a_unit_per_second_against_a_record_in_milliseconds_warns():
+    """A new user's accelerations in m/s^2 (the model file's output unit) with the record's time axis in ms: no fit
+    after 60 s and a generic message. The unit's time and the record's time unit are compared (a DataWarning)."""
+    import warnings
+
+    import numpy as np
+
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]], output="acceleration")
+    model.io_units = {"input": ("N",), "output": ("m/s^2",)}
+    u = np.random.default_rng(0).standard_normal(100)
+    for unit, warned in (("ms", True), ("s", False)):
+        io = si.IOData(u, np.sin(np.arange(100.0)), 1.0, time_unit=unit)
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            si.identify(model, io, x0={"m": 1.0, "c": 1.0, "k": 1.0}, identifiability_check=False, max_iter=1)
+        said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)]
+        assert any("the model file's output unit m/s^2 is per s, but the record's time unit (the model's time "
+                   "axis) is ms" in t for t in said) == warned, said

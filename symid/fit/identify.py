@@ -118,7 +118,43 @@ def unit_mismatches(model: Any, data: Any) -> list[str]:
                             f"the data or the model{where}")
                     if text not in out:
                         out.append(text)
+        time_unit = getattr(record, "time_unit", None) if hasattr(record, "t") else None
+        for role in ("input", "output"):
+            for want in declared.get(role, ()):
+                per = _per_time(want)
+                if per is not None and time_unit is not None and per != time_unit:
+                    # a new user's accelerations in m/s^2 with the record read in ms: no fit, and a generic message
+                    text = (f"the model file's {role} unit {want} is per {per}, but the record's time unit (the "
+                            f"model's time axis) is {time_unit}: read the record in {per} (time_unit={per!r}; "
+                            f"--time-unit {per}) or state the unit per {time_unit}")
+                    if text not in out:
+                        out.append(text)
     return out
+
+
+_PER_TIME = re.compile(r"/\s*\(?\s*(s|sec|ms|us|µs|min|h|hr|d)\b")
+"""A time unit after a slash in a unit (m/s^2, rad/s, mg/h, cm³/(s·%))."""
+
+
+def _per_time(unit: str) -> str | None:
+    """The canonical time unit a unit is per (``m/s^2`` → ``s``, ``mg/h`` → ``h``), or None.
+
+    Examples
+    --------
+    >>> from symid.fit.identify import _per_time
+    >>> _per_time("m/s^2"), _per_time("mg/h"), _per_time("cm³/(s·%)"), _per_time("N m"), _per_time("rad/s")
+    ('s', 'h', 's', None, 's')
+    """
+    from symid.data.units import canonical_unit
+    from symid.errors import DataError
+
+    m = _PER_TIME.search(str(unit))
+    if m is None:
+        return None
+    try:
+        return canonical_unit(m.group(1).replace("µ", "u"), "time", "unit")
+    except DataError:
+        return None
 
 
 def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None, starts: int = 1,
