@@ -112,6 +112,9 @@ def test_non_affine_entry_is_named(entry, involved):
     ("1/(a + b)", "introduce a new parameter for the whole ratio (for example `r = 1/(a + b)`)"),
     ("k*c", "introduce a new parameter for the nonlinear combination of c, k (for example `ck = c*k`"),
     ("sin(a)", "introduce a new parameter for the nonlinear function of a (for example `f = sin(a)`)"),
+    # with its sign, the ratio is suggested positive (a new user's hint read `r = -ks/ms` for positive symbols)
+    ("-c/m", "introduce a new parameter for the whole ratio (for example `r = c/m`) and write the entry as its "
+             "negative (-r)"),
 ])
 def test_non_affine_hint(entry, hint):
     with pytest.raises(si.NonAffineError) as info:

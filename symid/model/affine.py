@@ -93,11 +93,16 @@ def _hint(expr: sp.Expr, involved: Sequence[sp.Symbol]) -> str:
         inv = sp.Symbol(f"{den}inv")
         if _is_affine(expr.subs(den, 1 / inv), [*(set(involved) - {den}), inv]):  # 1/m, 1 + 2/m
             return f"introduce a new parameter such as `{inv} = 1/{den}` and write the entry in it"
+    # a ratio written with its sign (-k/m in A) is suggested without it: the new parameter can then be declared
+    # positive like the physical ones, and the entry is -r (a new user's hint read r = -ks/ms)
+    neg = expr.could_extract_minus_sign()
+    shown, entry = (sp.sstr(-expr), "as its negative") if neg else (sp.sstr(expr), "in it")
     if den.free_symbols & set(involved):  # c/m, 1/(a + b), k/(m1*m2)
-        return (f"introduce a new parameter for the whole ratio (for example `r = {sp.sstr(expr)}`) "
-                f"and write the entry in it")
+        return (f"introduce a new parameter for the whole ratio (for example `r = {shown}`) "
+                f"and write the entry {entry}" + (" (-r)" if neg else ""))
     if len(involved) == 1:
-        return f"introduce a new parameter for the nonlinear function of {names[0]} (for example `f = {sp.sstr(expr)}`)"
+        return (f"introduce a new parameter for the nonlinear function of {names[0]} (for example `f = {shown}`"
+                + (", the entry -f)" if neg else ")"))
     return (f"introduce a new parameter for the nonlinear combination of {', '.join(names)} "
             f"(for example `{''.join(names)} = {'*'.join(names)}` when the entry holds a product)")
 
