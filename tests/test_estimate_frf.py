@@ -344,7 +344,7 @@ def test_hold_zoh_removes_the_holds_response_from_a_held_input():
     # "foh" names a sampled input as si.identify does: nothing corrected, the same as None
     np.testing.assert_array_equal(si.estimate_frf(io, period=N, transient_periods=6, hold="foh").H,
                                   si.estimate_frf(io, period=N, transient_periods=6).H)
-    with pytest.raises(si.DataError, match="hold must be None or 'foh'"):
+    with pytest.raises(si.DataError, match="hold must be None, 'foh' or 'bandlimited'"):
         si.estimate_frf(io, period=N, hold="linear")
 
 

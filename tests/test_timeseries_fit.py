@@ -414,6 +414,31 @@ def test_hold_foh_fits_a_sampled_band_limited_input():
         si.identify(model, io, method="oe", hold="foh", solver="ipopt")
 
 
+def test_hold_bandlimited_removes_the_gain_bias_of_linear_interpolation():
+    """The same record: linear interpolation leaves a common gain 1.3 % low, about 22 standard errors, and the
+    validation of that estimate finds its residual correlated with the input; the band-limited interpolation
+    (4 points per sample interval, outputs at the samples) leaves every parameter within 0.1 % and 2 standard
+    errors, and a residual white and independent of the input (a new user's quarter car, its road profile sampled
+    at 500 Hz: the truth failed validation with hold="foh", p = 1.6e-61). Measured when this test was written:
+    0.046 %, 0.075 %, 0.046 %; 0.75, 1.5, 0.75 standard errors."""
+    model, truth, io = _sampled_sines_record()
+    fits = {hold: si.identify(model, io, method="oe", x0=truth, initial_state="estimate", hold=hold,
+                              identifiability_check=False) for hold in ("foh", "bandlimited")}
+    lin, band = fits["foh"], fits["bandlimited"]
+    assert band.success and band.options["hold"] == "bandlimited"
+    np.testing.assert_allclose(band.theta_vector, truth, rtol=1e-3)
+    assert np.all(np.abs(band.theta_vector - truth) < 2.0 * band.uncertainty.standard_errors)
+    assert np.all(np.abs(lin.theta_vector - truth) > 10.0 * lin.uncertainty.standard_errors)  # the bias it removes
+    for hold, fit in fits.items():
+        v = si.validate(model, fit.theta, io, hold=hold, initial_state="estimate")
+        assert ("residual white and independent" in v.summary()) == (hold == "bandlimited")
+        assert v.summary().startswith("validation on 1 record(s), 3000 samples")  # the samples, not the points
+    uneven = si.TimeSeries(np.cumsum(np.r_[0.0, np.full(99, 0.04) + 0.001 * np.arange(99) % 0.003]),
+                           io.u[:100], io.y[:100])
+    with pytest.raises(si.DataError, match="hold='bandlimited' interpolates equally spaced samples"):
+        si.identify(model, uneven, method="oe", hold="bandlimited", identifiability_check=False)
+
+
 def test_a_record_that_does_not_start_at_rest_says_to_estimate_the_initial_state():
     """A new user's room at 18 °C fitted by a model that starts at 0: the fit failed and the advice was "more starts,
     other methods, check the units", never the initial state. Now NEXT names it, with the first measured value

@@ -153,7 +153,7 @@ def test_a_sampled_band_limited_input_is_simulated_linear_between_samples_with_h
     held = si.validate(model, truth, io, initial_state="estimate").fit_percent[0]
     linear = si.validate(model, truth, io, initial_state="estimate", hold="foh").fit_percent[0]
     assert linear >= 98.0 - 1.5 and linear >= held + 10, (held, linear)
-    with pytest.raises(DataError, match=r"hold must be 'zoh' .* or 'foh'"):
+    with pytest.raises(DataError, match=r"hold must be 'zoh' .* 'foh' .* or 'bandlimited'"):
         si.validate(model, truth, io, hold="linear")
 
 

@@ -67,7 +67,7 @@ _IN_TIME = {  # the whiteness advice for residuals ordered in time (measured sam
     # a new user's quarter car, its road input measured at 500 Hz and fitted as held: misfit 11 times the noise's,
     # parameters 3-12 % off, and no word of the hold
     "the data's units)": "the data's units, and the input between samples: one measured (sampled, band-limited) "
-                         "rather than held by a DAC needs hold='foh')",
+                         "rather than held by a DAC needs hold='bandlimited')",
 }
 
 
@@ -110,7 +110,7 @@ def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
     >>> next_step("structured residual (lag-1 statistic 5.1 > 3)", frf=False, time=True).startswith(
     ...     "the residual is smooth in time")
     True
-    >>> "hold='foh'" in next_step("structured residual (lag-1 statistic 5.1 > 3)", frf=False, time=True)
+    >>> "hold='bandlimited'" in next_step("structured residual (lag-1 statistic 5.1 > 3)", frf=False, time=True)
     True
     """
     for key, advice in _NEXT_STEPS:

@@ -441,8 +441,9 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         Lines where the input's amplitude (smallest singular value over inputs) is below
         this fraction of its strongest line are left out (not excited; see the module
         notes); 0 keeps every line with a nonzero input. Default 1e-3 (−60 dB).
-    hold : {None, "foh", "zoh"}
-        ``None`` (default) or ``"foh"`` (as ``si.identify`` names a sampled input): Ĥ is the
+    hold : {None, "foh", "bandlimited", "zoh"}
+        ``None`` (default), ``"foh"`` or ``"bandlimited"`` (as ``si.identify`` names a sampled
+        input): Ĥ is the
         response from the sampled input to the sampled output, which is the continuous-time
         H(jω) when the input was sampled, not held (see the notes); nothing is corrected.
         ``"zoh"``: the input was held between samples (a DAC, a digital
@@ -524,9 +525,9 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
     >>> bool(np.allclose(frf.H[:, 0, 0], 0.2 / (1 - 0.8 / z), rtol=1e-3))
     True
     """
-    if hold not in (None, "foh", "zoh"):
-        raise DataError(f"hold must be None or 'foh' (the input sampled) or 'zoh' (held between samples); got "
-                        f"{hold!r}")
+    if hold not in (None, "foh", "bandlimited", "zoh"):
+        raise DataError(f"hold must be None, 'foh' or 'bandlimited' (the input sampled) or 'zoh' (held between "
+                        f"samples); got {hold!r}")
     est = _analyse(data, estimator, period, transient_periods, nperseg, window, detrend, band, min_excitation)
     if est.input_separation < COLLINEAR_INPUTS:
         # a new user's road input and its derivative as two inputs: coherence 0.99993 between them, each column of Ĥ
