@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
 import sys
@@ -867,9 +868,16 @@ def _version() -> str:
 
 
 def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: object = None,
-                  line: str | None = None) -> None:
-    """``symid: warning (IdentifiabilityWarning): …`` on standard error, without the source line of the call."""
-    print(f"symid: warning ({category.__name__}): {message}", file=sys.stderr if file is None else file)
+                  line: str | None = None, *, shown: set | None = None) -> None:
+    """``symid: warning (IdentifiabilityWarning): …`` on standard error, without the source line of the call; a
+    warning ``shown`` already in this command is not repeated (a record's units, said by the fit and again by its
+    validation)."""
+    text = f"symid: warning ({category.__name__}): {message}"
+    if shown is not None:
+        if text in shown:
+            return
+        shown.add(text)
+    print(text, file=sys.stderr if file is None else file)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -887,7 +895,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with warnings.catch_warnings():
             # a warning reads as the command's own words, not as a line of symid's source
-            warnings.showwarning = _show_warning
+            warnings.showwarning = functools.partial(_show_warning, shown=set())
             code = int(args.func(args) or 0)
         sys.stdout.flush()  # inside the try: a closed pipe surfaces here, not at interpreter exit
         return code
