@@ -92,10 +92,36 @@ def test_auto_runs_the_black_box_start_first_unless_the_start_fits(monkeypatch, 
     np.testing.assert_allclose(res.theta_vector, TRUTH, rtol=1e-8)
     # a pass that fits to rounding ends the start: the other special pass is not run
     if start_fits:
-        assert "the stub's fit, not run: pass 0 from the start fitted to rounding" in res.message
+        assert "the stub's fit, not run: the pass from the start fitted to rounding" in res.message
     else:
         assert "pass 0 from the stub's fit" in res.message
     assert "a fit after 1 output-error pass(es)" in res.message
+
+
+@pytest.mark.parametrize("floor", [0.5, 1e-5])
+def test_on_noisy_records_the_start_goes_first_and_the_black_box_start_only_when_it_predicts_better(monkeypatch,
+                                                                                                    floor):
+    # a new user's room model (3 thermal nodes, a record over days): the N4SID black box of its order predicted the
+    # samples to 3.6e-5, the pass from the start to 9.1e-6; the response fit then spent 10.9 s in 8 passes (misfit
+    # 6.5e-2) for a start that could not do better: 13.6 s against 0.3 s
+    from symid.fit.timeseries.bbstart import BlackBoxResponse
+
+    model = _chain()
+    io = _records(model, samples=300, noise=0.01)
+    calls = []
+    monkeypatch.setattr(auto_module, "black_box_response",
+                        lambda m, d: BlackBoxResponse(si.FrequencyData([1.0], np.ones((1, 1, 1))), "", floor, 20))
+    monkeypatch.setattr(auto_module, "black_box_start",
+                        lambda *a, **k: calls.append(1) or BlackBoxStart(TRUTH.copy(), "the stub's fit", 0.0))
+    res = si.identify(model, io, x0=TRUTH * 1.5, restarts=0, identifiability_check=False)
+    assert res.success
+    if floor == 0.5:  # the start's pass (misfit about 1e-4) predicts better than such a black box
+        assert calls == [] and "no black-box start sought: the pass from the start predicts the samples as well " \
+                               "as the N4SID black box of the model's order" in res.message
+        assert "a fit after 1 output-error pass(es)" in res.message
+    else:  # a black box that predicts better than the start's pass: its start is sought, and runs second
+        assert calls == [1] and "pass 1 from the stub's fit" in res.message
+        assert "a fit after 2 output-error pass(es)" in res.message
 
 
 def test_without_the_black_box_start_auto_does_not_call_it(monkeypatch):
