@@ -38,6 +38,27 @@ def _unify_symbols(mats: list[tuple[str, sp.Matrix]]) -> list[tuple[str, sp.Matr
     return [(n, m.xreplace(repl)) for n, m in mats]
 
 
+
+def pretty(expr: Any) -> str:
+    """``expr`` drawn as sympy's pretty printer draws it, each parameter under its own name (sympy writes ``mu`` as
+    μ and ``lambda_1`` as λ₁: not the names the user gave, nor those ``parameter_names`` lists).
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> from symid.model.parametric import pretty
+    >>> print(pretty(sp.Matrix([[sp.Symbol("mu")]])))
+    [mu]
+    """
+    from sympy.printing.pretty.pretty import PrettyPrinter
+    from sympy.printing.pretty.stringpict import prettyForm
+
+    class _Names(PrettyPrinter):
+        def _print_Symbol(self, e: sp.Symbol, bold_name: bool = False) -> prettyForm:
+            return prettyForm(e.name)
+
+    return _Names({"use_unicode": True}).doprint(expr)
+
 class ParametricModel:
     """Base class: named symbolic matrices, their affine maps and the parameter vector θ.
 
@@ -255,7 +276,7 @@ class ParametricModel:
         lines = []
         for n, m in self._symbolic.items():
             lines.append(f"{n} =")
-            lines.append(sp.pretty(m, use_unicode=True))
+            lines.append(pretty(m))
         return "\n".join(lines)
 
     def __repr__(self) -> str:

@@ -10,7 +10,7 @@ import sympy as sp
 
 from symid.errors import ModelError
 from symid.model.lti import StateSpaceMatrices, as_frequencies, frequency_response_ss
-from symid.model.parametric import ParametricModel, Theta
+from symid.model.parametric import ParametricModel, Theta, pretty
 from symid.model.symbols import as_symbolic_matrix
 
 __all__ = ["StateSpaceModel"]
@@ -221,7 +221,7 @@ class StateSpaceModel(ParametricModel):
         if self._x0_estimate:
             return f"{text}\nx0 = estimated per experiment"
         if self._x0_symbolic is not None:
-            return f"{text}\nx0 =\n{sp.pretty(self._x0_symbolic, use_unicode=True)}"
+            return f"{text}\nx0 =\n{pretty(self._x0_symbolic)}"
         return text
 
 
