@@ -385,7 +385,14 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         if data_kind(data).name != "time series":
             raise _UsageError(f"symid identify: error: --validate checks an estimate on other time-series "
                               f"records; the data fitted are {data_kind(data).name}")
-        vdata = _read_data(args, "identify", list(args.validate), "--validate")
+        # another file may name its columns or state its units otherwise (a log in minutes beside one in seconds)
+        vargs = argparse.Namespace(**{**vars(args),
+                                      "columns": args.validate_columns or args.columns,
+                                      "units": args.validate_units or args.units})
+        vdata = _read_data(vargs, "identify", list(args.validate), "--validate")
+    elif args.validate_columns or args.validate_units:
+        raise _UsageError("symid identify: error: --validate-columns and --validate-units describe the files of "
+                          "--validate: give --validate FILE too")
     spec = _spec(entry, args, "identify")
     _say(args, f"model: {spec.name}   data: {source}")
     time_unit = _record_time_unit(data)
@@ -754,7 +761,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=_int_in(0), default=0, metavar="S", help="seed of the random starts (default: 0)")
     p.add_argument("--validate", metavar="FILE", action="append",
                    help="time series: validate the estimate on these records (read with the same --columns and "
-                        "--units; repeat for several) instead of on the records fitted")
+                        "--units unless --validate-columns or --validate-units say otherwise; repeat for several) "
+                        "instead of on the records fitted")
+    p.add_argument("--validate-columns", nargs="+", action="extend", metavar="ROLE=NAME", dest="validate_columns",
+                   help="the columns of the --validate files, when they differ from --columns (all of them)")
+    p.add_argument("--validate-units", nargs="+", action="extend", metavar="ROLE=UNIT", dest="validate_units",
+                   help="the units of the --validate files, when they differ from --units (all of them): the "
+                        "records are converted to the model's time unit (--time-unit) as --data's are")
     g = p.add_argument_group("what you know about the parameters (extends or replaces the model file's)")
     g.add_argument("--x0", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="the first start, for some or all free parameters: the others keep the model file's "

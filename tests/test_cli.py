@@ -653,3 +653,25 @@ def test_a_warning_is_said_once_per_command(tmp_path, capsys):
           "input=tau", "output=w", "--units", "time=s"])
     err = capsys.readouterr().err
     assert err.count("the file states deg/s for output 'w'") == 1, err
+
+
+def test_validate_reads_files_with_their_own_columns_and_units(tmp_path, capsys):
+    """A new user's trial: the validation log had its time in minutes under another name, and --validate read it
+    with the fitting file's --columns and --units only ("no column named 't'"). --validate-columns and
+    --validate-units describe those files; their times are converted to the model's time unit as --data's are."""
+    _infusion_files(tmp_path, {"a.csv": 2001, "b.csv": 2002})
+    b = np.loadtxt(tmp_path / "b.csv", delimiter=",", skiprows=1)
+    b[:, 0] *= 60.0  # hours → minutes
+    np.savetxt(tmp_path / "b_min.csv", b, delimiter=",", header="t_min,rate,conc", comments="")
+    args = ["--data", str(tmp_path / "a.csv"), "--columns", "time=t", "input=rate", "output=conc", "--units",
+            "time=h", "--time-unit", "h", "--option", 'variance={"proportional": 0.15}',
+            "--validate", str(tmp_path / "b_min.csv")]
+    assert main(["identify", str(tmp_path / "pk.py"), *args]) == 2
+    assert "no column named 't'" in capsys.readouterr().err
+    main(["identify", str(tmp_path / "pk.py"), *args, "--validate-columns", "time=t_min", "input=rate",
+          "output=conc", "--validate-units", "time=min"])
+    said = capsys.readouterr().out
+    assert f"validation on {tmp_path / 'b_min.csv'} (not the records fitted)" in said
+    assert "verdict: residual white and independent of the " in said
+    assert main(["identify", str(tmp_path / "pk.py"), *args[:-2], "--validate-units", "time=min"]) == 2
+    assert "give --validate FILE too" in capsys.readouterr().err
