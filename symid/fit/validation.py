@@ -493,7 +493,9 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
     recs, observed = sim.records, sim.observed
     if hold == "bandlimited":  # simulated at points between the samples, which carry no output: back to the samples
         from symid.data.timeseries import TimeSeries
-        from symid.fit.timeseries.records import BAND_LIMITED_UPSAMPLE as step
+        from symid.fit.timeseries import records as _records
+
+        step = _records.BAND_LIMITED_UPSAMPLE
 
         recs = [TimeSeries(r.t[::step], r.u[::step], r.y[::step], r.time_unit) for r in recs]
         observed, ys = [o[::step] for o in observed], [y[::step] for y in ys]
@@ -514,6 +516,8 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         fit = 100.0 * (1.0 - np.sqrt(np.nansum(e_all**2, axis=0)) / denom)
     rms = np.sqrt(np.nanmean(e_all**2, axis=0))
     sigma = sim.noise_variance(th) if variance is not None else None
+    if sigma is not None and hold == "bandlimited":  # on the points, as the simulation: back to the samples
+        sigma = [v[::step] for v in sigma]
     if sigma is None:
         sigma = [np.ones_like(y) for y in ys_obs]
     else:
