@@ -359,6 +359,9 @@ def test_inputs_that_are_one_signal_warn():
     y = scipy.signal.lfilter(B_IIR, A_IIR, u0) + 0.01 * rng.standard_normal(N)
     with pytest.warns(DataWarning, match="2 inputs are nearly one signal"):
         si.estimate_frf(si.IOData(np.column_stack([u0, np.gradient(u0, DT)]), y, DT), nperseg=256)
+    # exactly one signal (a scaled copy): named as such, not "the input is zero at every frequency"
+    with pytest.raises(DataError, match="the inputs are one signal at every line"):
+        si.estimate_frf(si.IOData(np.column_stack([u0, 2.0 * u0]), y, DT), nperseg=256)
     # u1 = u0 + 0.5 e (e independent): |γ| = 1/√1.25 = 0.89 between them, a separation of 0.11 > COLLINEAR_INPUTS
     u1 = u0 + 0.5 * rng.standard_normal(N)
     with warnings.catch_warnings():

@@ -185,14 +185,19 @@ def _check_window(window: Any, nperseg: int) -> None:
 # -- line selection --------------------------------------------------------------------------
 
 def _keep_lines(w: np.ndarray, level: np.ndarray, band: tuple[float, float], min_excitation: float,
-                what: str) -> np.ndarray:
-    """Indices of the lines in ``band`` whose input level (smallest singular value) is high enough."""
+                what: str, largest: np.ndarray | None = None) -> np.ndarray:
+    """Indices of the lines in ``band`` whose input level (smallest singular value) is high enough; ``largest``,
+    the largest singular value, tells inputs that are one signal from inputs that are zero."""
     in_band = (w >= band[0]) & (w <= band[1])
     if not np.any(in_band):
         raise DataError(f"no {what} lies in band [{band[0]:.6g}, {band[1]:.6g}] rad/s (lines from {w[0]:.6g} to "
                         f"{w[-1]:.6g} rad/s, spacing {w[1] - w[0] if w.size > 1 else w[0]:.6g} rad/s)")
     top = float(np.max(level)) if level.size else 0.0
     if not top > 0:
+        if largest is not None and np.max(largest) > 0:
+            raise DataError("the inputs are one signal at every line (one is a copy, a scaled copy or a "
+                            "filtered version of another, e.g. its derivative): the response to each cannot be told "
+                            "apart. Excite them independently, or model them as one input")
         raise DataError("the input is zero at every frequency: there is no excitation to estimate a response from")
     excited = level >= min_excitation * top
     if min_excitation == 0:
@@ -275,7 +280,7 @@ def _welch(recs: list[IOData], estimator: str, nperseg: Any, window: Any, detren
     Suu = 0.5 * (Suu + np.conj(np.swapaxes(Suu, 1, 2)))
     lam = np.linalg.eigvalsh(Suu)
     keep = _keep_lines(w_all, np.sqrt(np.clip(lam[:, 0], 0, None)), _band(band, np.pi / dt), min_excitation,
-                       "Welch bin")
+                       "Welch bin", largest=np.sqrt(np.clip(lam[:, -1], 0, None)))
     w, Suu, Syu, Syy = w_all[keep], Suu[keep], Syu[keep], Syy[keep]
     syy = np.real(np.diagonal(Syy, axis1=1, axis2=2))  # (s, p)
     coh = _multiple_coherence(Suu, Syu, syy)
@@ -349,7 +354,7 @@ def _periodic(recs: list[IOData], period: Any, transient_periods: Any, band: Any
     Ubar, Ybar = U.mean(axis=0), Y.mean(axis=0)  # (s, m, E), (s, p, E)
     sv = np.linalg.svd(Ubar, compute_uv=False)  # (s, min(m, E))
     keep = _keep_lines(w_all, sv[:, -1] if m <= E else np.zeros(len(lines)), _band(band, np.pi / dt),
-                       min_excitation, "line")
+                       min_excitation, "line", largest=sv[:, 0] if m <= E else None)
     w, U, Y, Ubar, Ybar = w_all[keep], U[:, keep], Y[:, keep], Ubar[keep], Ybar[keep]
     Upinv = np.linalg.pinv(Ubar)  # (s, E, m)
     H = Ybar @ Upinv  # (s, p, m)
