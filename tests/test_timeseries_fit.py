@@ -445,6 +445,9 @@ def test_hold_bandlimited_removes_the_gain_bias_of_linear_interpolation():
     assert "residual white and independent" in v.summary()
     uneven = si.TimeSeries(np.cumsum(np.r_[0.0, np.full(99, 0.04) + 0.001 * np.arange(99) % 0.003]),
                            io.u[:100], io.y[:100])
+    for method in ("svf", "srivc"):  # their filters take the input held or linear: named, with the nearest
+        with pytest.raises(si.OptionError, match=f"{method} filters the input as held .* 'foh' is the nearest"):
+            si.identify(model, io, method=method, hold="bandlimited", identifiability_check=False)
     with pytest.raises(si.DataError, match="hold='bandlimited' interpolates equally spaced samples"):
         si.identify(model, uneven, method="oe", hold="bandlimited", identifiability_check=False)
 

@@ -336,6 +336,9 @@ class SimplifiedRIVC(JudgedOnSamples):
                  initial_state: Any = None, time_limit: float | None = None, callback: Any = None,
                  verbose: bool = False):
         # the samples the estimate is judged on, simulated with the same hold as the filters take the input
+        if hold == "bandlimited":  # output error's; the filters here take the input held or linear
+            raise OptionError("hold='bandlimited' is output error's (method='oe' or 'auto'); srivc filters the input "
+                              "as held ('zoh') or linear ('foh') between samples: 'foh' is the nearest")
         self.samples = OutputError(model, data, initial_state=initial_state, hold=check_choice("hold", hold, _HOLDS))
         self.model, self.data = model, data
         self.poly = transfer_polynomials(model)
