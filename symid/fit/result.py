@@ -78,10 +78,16 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
     drop = ("" if offset.get("after") is None else
             f"this estimate's misfit would fall from {offset['misfit']:.3g} to {offset['after']:.3g}")
     if offset.get("kind", "initial_state") == "initial_state":
-        return (f"the record does not start where the model does ({where}output {offset['output']} is "
+        text = (f"the record does not start where the model does ({where}output {offset['output']} is "
                 f"{offset['measured']:.6g} at its first sample, the model's {offset['model']:.6g}"
                 f"{'; with the initial state estimated ' + drop if drop else ''}): estimate the initial state "
                 f"(initial_state=\"estimate\"; --option initial_state=estimate) or remove the offset from the data")
+        if (level := offset.get("level")) is not None:
+            text += (f". Output {level['output']} also sits at a level (mean {level['mean']:.6g}, standard deviation "
+                     f"{level['std']:.3g}): if the record lies around an operating point, the initial state alone "
+                     f"will not fit it; subtract the operating point (deviation variables) or model it (guide: "
+                     f"records around an operating point)")
+        return text
     if offset.get("kind") == "level":
         return (f"{where}output {offset['output']} sits at a level (mean {offset['mean']:.6g}, standard deviation "
                 f"{offset['std']:.3g}): if the record lies around an operating point (absolute levels, "

@@ -738,9 +738,14 @@ class OutputError(Estimator, FisherInformation):
         first = np.flatnonzero(o[:, j])
         k = int(first[0]) if first.size else 0
         raw = np.where(o[:, j], r.y[:, j] - s[:, j], 0.0)
-        return {"kind": kind, "record": e, "output": j, "misfit": misfit, "after": after, "sample": k,
-                "measured": float(r.y[k, j]), "model": float(s[k, j]),
-                "mean": float(raw.sum() / max(int(o[:, j].sum()), 1))}
+        out = {"kind": kind, "record": e, "output": j, "misfit": misfit, "after": after, "sample": k,
+               "measured": float(r.y[k, j]), "model": float(s[k, j]),
+               "mean": float(raw.sum() / max(int(o[:, j].sum()), 1))}
+        if kind == "initial_state" and (level := _level(rows, misfit)) is not None:
+            # a record at a level also starts away from a model at rest; estimating the initial state alone does
+            # not fit it (a new user's absolute temperatures: 0.0286 → 0.0112, no fit), so both are said
+            out["level"] = {key: level[key] for key in ("record", "output", "mean", "std")}
+        return out
 
     def _explains(self, misfit: float, after: float, n_values: int, extra: int) -> bool:
         """Whether ``extra`` more unknowns (initial states, offsets) that lower the misfit to ``after`` explain a
