@@ -599,6 +599,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     _say(args, f"model: {spec.name}   data: {source}")
     model = spec.free_model()
     options, noise_floor = _compare_options(model, data, methods, spec, args)
+    methods = _methods_that_take(model, data, methods, options, noise_floor, args)
     try:
         cmp = compare(model, data, methods=methods, starts=args.starts, seed=args.seed, truth=truth,
                       x0=spec.start, progress=True, options=options or None, noise_floor=noise_floor)
@@ -665,6 +666,29 @@ def _compare_options(model, data, methods, spec, args) -> tuple[dict, float | No
         for m in takers:
             options.setdefault(m.removesuffix("+polish"), {})[name] = value
     return options, noise_floor
+
+
+def _methods_that_take(model, data, methods, options, noise_floor, args) -> tuple:
+    """The methods that accept the model and data (each built once); one that refuses is said with its reason and
+    left out, so that the others' rows are not lost (a new user's scr refused an unstable black box, and no table
+    came at all); all refusing is an error naming each reason."""
+    from symid.errors import SymidError
+    from symid.fit.registry import data_kind
+
+    kind, kept, refused = data_kind(data), [], []
+    for m in methods:
+        try:
+            kind.prepare(model, data, m.removesuffix("+polish"), dict(options.get(m.removesuffix("+polish"), {})),
+                         noise_floor=noise_floor)
+        except SymidError as exc:
+            refused.append(f"{m}: {exc}")
+            continue
+        kept.append(m)
+    for text in refused:
+        _say(args, f"note: left out, {text}")
+    if not kept:
+        raise _UsageError("symid compare: error: every method refused the model or data:\n  " + "\n  ".join(refused))
+    return tuple(kept)
 
 
 def _write_compare(out, cmp) -> None:

@@ -675,3 +675,26 @@ def test_validate_reads_files_with_their_own_columns_and_units(tmp_path, capsys)
     assert "verdict: residual white and independent of the " in said
     assert main(["identify", str(tmp_path / "pk.py"), *args[:-2], "--validate-units", "time=min"]) == 2
     assert "give --validate FILE too" in capsys.readouterr().err
+
+
+def test_compare_leaves_out_a_method_that_refuses_and_keeps_the_others(tmp_path, capsys):
+    """A new user's trial: scr refused the data (an unstable black box) and `symid compare` gave no table at all;
+    now that method is left out with its reason and the others run. Every method refusing is an error. (Here scr
+    refuses an acceleration output, thesis §7-7-3.)"""
+    (tmp_path / "mass.py").write_text(
+        "import symid as si\n"
+        "m, c, k = si.parameters('m c k', positive=True)\n"
+        "model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]], output='acceleration')\n"
+        "start = {'m': 1.5, 'c': 1.0, 'k': 40.0}\n")
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]], output="acceleration")
+    io = si.simulate_io(model, {"m": 2.0, "c": 0.8, "k": 50.0}, np.random.default_rng(0).standard_normal(400), 0.05)
+    np.savetxt(tmp_path / "rec.csv", np.column_stack([io.t, io.u[:, 0], io.y[:, 0]]), delimiter=",",
+               header="t,f,a", comments="")
+    data = ["--data", str(tmp_path / "rec.csv"), "--columns", "time=t", "input=f", "output=a", "--units", "time=s",
+            "--starts", "1"]
+    assert main(["compare", str(tmp_path / "mass.py"), *data, "--methods", "oe,scr"]) == 0
+    said = capsys.readouterr().out
+    assert "note: left out, scr:" in said and "    oe        1/1" in said
+    assert main(["compare", str(tmp_path / "mass.py"), *data, "--methods", "scr"]) == 2
+    assert "every method refused the model or data" in capsys.readouterr().err
