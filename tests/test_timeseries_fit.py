@@ -507,6 +507,13 @@ def test_a_given_noise_std_judges_the_fit():
     wrong = si.identify(first, noisy, method="oe", x0={"a": 1.0, "g": 1.0}, identifiability_check=False,
                         noise_std=sigma)
     assert not wrong.success
+    # a noise_std three times the noise's makes a lenient floor: the residual, a third of it, says so
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        si.identify(model, noisy, method="oe", x0=start, identifiability_check=False, noise_std=3 * sigma)
+        si.identify(model, noisy, method="oe", x0=start, identifiability_check=False, noise_std=sigma)
+    said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)]
+    assert len(said) == 1 and said[0].startswith("the residual is 0.34 times the noise_std given"), said  # ≈ 1/3
 
 
 def test_records_around_an_operating_point_are_named_in_next():

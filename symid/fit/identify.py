@@ -423,4 +423,36 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     # summary still says it, beside the NEXT line that matters more (a new user's room at misfit 0.82 was warned)
     if ambiguity is not None and (result.success or result.cost <= 1e-2):
         warnings.warn(ambiguity, IdentifiabilityWarning, stacklevel=2)
+    if noise_std is not None and result.uncertainty is not None:
+        # the declared noise judges the fit (noise floor): a residual improbably smaller than it says the noise_std
+        # is too large, and then a wrong model fits (a new user's k2 5 % off, noise_std 3 times the noise's: success,
+        # residual/noise rms 0.55, said nowhere but in the summary's uncertainty line)
+        text = too_small_residual(result.uncertainty.residual_ratio, estimator.n_data(), model.n_parameters)
+        if text is not None:
+            warnings.warn(text, DataWarning, stacklevel=2)
     return result
+
+
+def too_small_residual(ratio: float | None, n_data: int, n_parameters: int) -> str | None:
+    """What a residual smaller than the given noise says: ``ratio`` the residual's rms over the given noise's, whose
+    square is about χ²(N − l)/N for noise of that level; below its 0.1 % quantile the noise given is too large.
+
+    Examples
+    --------
+    >>> from symid.fit.identify import too_small_residual
+    >>> too_small_residual(0.55, 4000, 4)[:58]
+    'the residual is 0.55 times the noise_std given (rms): far '
+    >>> too_small_residual(0.99, 4000, 4) is None
+    True
+    """
+    from scipy.stats import chi2
+
+    if ratio is None or not np.isfinite(ratio) or n_data <= n_parameters:
+        return None
+    dof = n_data - n_parameters
+    if ratio**2 >= chi2.ppf(0.001, dof) / n_data:
+        return None
+    return (f"the residual is {ratio:.2g} times the noise_std given (rms): far less than noise of that level leaves "
+            f"(below {np.sqrt(chi2.ppf(0.001, dof) / n_data):.3g} in 99.9 % of records). The noise_std is too large, "
+            f"and the fit was judged against a noise floor too lenient for it: a wrong model can pass. Give the "
+            f"data's noise level, or leave noise_std out (the level is then estimated from the residual)")
