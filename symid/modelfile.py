@@ -190,6 +190,14 @@ class ModelFile:
         else:
             scale_ = {n: v for n, v in self.scale.items() if n in free} if all(n in self.scale for n in free) else {}
         bounds_ = {n: b for n, b in self.bounds.items() if n in free}
+        for n, (lo, hi) in self.bounds.items():  # they drop out with the value made known: said when it lies outside
+            if n in known_ and not lo <= known_[n] <= hi:
+                import warnings
+
+                from symid.errors import DataWarning
+
+                warnings.warn(f"{where}: {n} is known as {known_[n]:g}, outside the bounds [{lo:g}, {hi:g}] the "
+                              f"model file gives for it: check the value or the bounds", DataWarning, stacklevel=2)
         bounds_.update(_bounds_values(bounds or {}, free, known_, where))
         if start is not None:  # a partial start is completed from the file's start, the scale, then the bounds
             given = _name_map(start, f"{where}: x0")

@@ -357,6 +357,10 @@ def test_a_model_files_dicts_serve_the_model_with_some_values_known():
     np.testing.assert_allclose([res.theta["c"], res.theta["k"]], [0.8, 50.0], rtol=1e-6)
     cmp = si.compare(known, io, methods=("oe",), starts=1, x0=start, options={"oe": {"scale": scale, "bounds": bounds}})
     assert cmp.stats[0].n_success == 1
+    # a known value outside the bounds given for it is said (they drop out with it)
+    with pytest.warns(si.DataWarning, match=r"m is known as 20, outside the bounds \[0.1, 10\] given for it"):
+        si.identify(model.with_known({"m": 20.0}), io, x0=start, bounds=bounds, identifiability_check=False,
+                    max_iter=1)
 
 
 def test_a_unit_per_second_against_a_record_in_milliseconds_warns():
@@ -378,3 +382,21 @@ def test_a_unit_per_second_against_a_record_in_milliseconds_warns():
         said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)]
         assert any("the model file's output unit m/s^2 is per s, but the record's time unit (the model's time "
                    "axis) is ms" in t for t in said) == warned, said
+
+
+def test_a_known_value_outside_the_model_files_bounds_is_said(tmp_path):
+    """A new user's `--known k2=5` against the model file's bounds k2 in [10, 1000]: nothing said, and the fit's
+    advice named another parameter's bound."""
+    (tmp_path / "m.py").write_text(
+        "import symid as si\n"
+        "m, k = si.parameters('m k', positive=True)\n"
+        "model = si.SecondOrderModel(M=[[m]], V=[[0.1]], K=[[k]], B=[[1]], C=[[1]])\n"
+        "bounds = {'m': (0.1, 10.0), 'k': (10.0, 1000.0)}\n")
+    spec = si.load_model(str(tmp_path / "m.py"))
+    with pytest.warns(si.DataWarning, match=r"k is known as 5, outside the bounds \[10, 1000\] the model file gives"):
+        spec.updated(known={"k": 5.0})
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", si.DataWarning)
+        assert spec.updated(known={"k": 50.0}).known == {"k": 50.0}

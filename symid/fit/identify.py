@@ -6,6 +6,7 @@ import dataclasses
 import re
 import time
 import warnings
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -301,6 +302,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     check_model(model)
     # a model file's start, scale and bounds name every parameter; with some made known (with_known) they still serve
     known = model.known_values if hasattr(model, "known_values") else {}
+    for text in _known_outside(known, options.get("bounds")):
+        warnings.warn(text, DataWarning, stacklevel=2)
     x0 = without_known(x0, known)
     options = {k: (without_known(v, known) if k in ("scale", "bounds") else v) for k, v in options.items()}
     options = scale_by_name(options, model.parameter_names)  # a dict by name, as x0 may be
@@ -431,6 +434,23 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if text is not None:
             warnings.warn(text, DataWarning, stacklevel=2)
     return result
+
+
+def _known_outside(known: Mapping[str, float], bounds: Any) -> list[str]:
+    """A value made known (with_known, --known) outside the bounds given for it: said, since the bounds then drop
+    out (a new user's k2 = 5 against the model file's [10, 1000], and the fit's advice named another bound)."""
+    if not known or not isinstance(bounds, Mapping):
+        return []
+    out = []
+    for name, value in known.items():
+        b = bounds.get(name)
+        if b is None or np.ndim(b) != 1 or len(b) != 2:
+            continue
+        lo, hi = (-np.inf if v is None else float(v) for v in b)
+        if not lo <= value <= hi:
+            out.append(f"{name} is known as {value:g}, outside the bounds [{lo:g}, {hi:g}] given for it: check the "
+                       f"value or the bounds")
+    return out
 
 
 def too_small_residual(ratio: float | None, n_data: int, n_parameters: int) -> str | None:
