@@ -652,15 +652,17 @@ def _compare_options(model, data, methods, spec, args) -> tuple[dict, float | No
             return True
         return True
 
-    flags = {"backend": "--backend", "max_iter": "--max-iter", "tol": "--tol", "time_limit": "--time-limit"}
+    flags = {"backend": "--backend", "max_iter": "--max-iter", "tol": "--tol", "time_limit": "--time-limit",
+             "scale": "--scale", "bounds": "--bounds"}
+    flagged = set(given) | {n for n in ("scale", "bounds") if getattr(args, n, None)}  # the command line's own
     options: dict[str, dict] = {}
     for name, value in {**from_file, **given}.items():
         takers = [m for m in methods if takes(m, name, value)]
-        if name in given and not takers:
+        if name in flagged and not takers:
             flag = flags.get(name, f"--option {name}")
             raise _UsageError(f"symid compare: error: {flag}: none of the methods compared ({', '.join(methods)}) "
                               f"takes {name} with this data")
-        if name in given and len(takers) < len(methods):
+        if name in flagged and len(takers) < len(methods):
             _say(args, f"note: {flags.get(name, f'--option {name}')} goes to {', '.join(takers)} (the others do not "
                        f"take it)")
         for m in takers:
