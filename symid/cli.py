@@ -652,8 +652,7 @@ def _compare_options(model, data, methods, spec, args) -> tuple[dict, float | No
             return True
         return True
 
-    flags = {"backend": "--backend", "max_iter": "--max-iter", "tol": "--tol", "time_limit": "--time-limit",
-             "scale": "--scale", "bounds": "--bounds"}
+    flags = {**{name: flag for flag, name in _FLAG_OPTIONS.items()}, "scale": "--scale", "bounds": "--bounds"}
     flagged = set(given) | {n for n in ("scale", "bounds") if getattr(args, n, None)}  # the command line's own
     options: dict[str, dict] = {}
     for name, value in {**from_file, **given}.items():
@@ -747,6 +746,19 @@ def _add_data_arguments(p: argparse.ArgumentParser, default: str) -> None:
                    help="separator of a CSV table: , ; tab | or a space (default: ,)")
 
 
+def _add_method_options(g) -> None:
+    """The flags of the methods' options (``identify`` and ``compare``; :func:`_method_options` reads them)."""
+    g.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
+    g.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
+                   help="iteration limit per start (≥ 1)")
+    g.add_argument("--tol", type=_positive_number, metavar="TOL", help="the method's stopping tolerance")
+    g.add_argument("--time-limit", type=_positive_seconds, dest="time_limit", metavar="S",
+                   help="wall-time budget of one start in seconds (methods that take time_limit)")
+    g.add_argument("--option", nargs="+", action="extend", metavar="NAME=VALUE",
+                   help="any other option of the method (see the options table), e.g. aux_init=model, hold=foh "
+                        "or initial_state=estimate; VALUE is a number, true/false/none, JSON, or text")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``symid`` command."""
     parser = _Parser(
@@ -810,16 +822,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "replaces the model file's for it, both ends): the start must lie inside; the methods "
                         "that take bounds= (auto, lm, oe, ipopt) keep the estimate inside and say which parameters "
                         "sit on a bound; for the others an estimate outside is reported")
-    g = p.add_argument_group("method options (an option the method does not take is an error naming the flag)")
-    g.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
-    g.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
-                   help="iteration limit per start (≥ 1)")
-    g.add_argument("--tol", type=_positive_number, metavar="TOL", help="the method's stopping tolerance")
-    g.add_argument("--time-limit", type=_positive_seconds, dest="time_limit", metavar="S",
-                   help="wall-time budget of one start in seconds (methods that take time_limit)")
-    g.add_argument("--option", nargs="+", action="extend", metavar="NAME=VALUE",
-                   help="any other option of the method (see the options table), e.g. aux_init=model or "
-                        "substitution=both; VALUE is a number, true/false/none, JSON, or text")
+    _add_method_options(p.add_argument_group(
+        "method options (an option the method does not take is an error naming the flag)"))
     p.add_argument("--polish", action="store_true", help="refine the SCR estimate with IPOPT (reported apart)")
     p.add_argument("--out", metavar="DIR",
                    help="write result.json and summary.txt here, with bode.png (frequency response; "
@@ -850,16 +854,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "that take scale=")
     p.add_argument("--bounds", nargs="+", action="extend", metavar="NAME=LOW:HIGH",
                    help="plausible ranges, for the methods that take bounds= (the start must lie inside)")
-    g = p.add_argument_group("method options: each goes to the methods that take it (one that no method takes is an "
-                             "error); --option noise_floor=PHI judges every method's fit against that noise floor")
-    g.add_argument("--backend", choices=("admm", "cvxpy"), help="SCR back end")
-    g.add_argument("--max-iter", type=_int_in(1), dest="max_iter", metavar="K",
-                   help="iteration limit per start (≥ 1)")
-    g.add_argument("--tol", type=_positive_number, metavar="TOL", help="the methods' stopping tolerance")
-    g.add_argument("--time-limit", type=_positive_seconds, dest="time_limit", metavar="S",
-                   help="wall-time budget of one start in seconds (methods that take time_limit)")
-    g.add_argument("--option", nargs="+", action="extend", metavar="NAME=VALUE",
-                   help="any other option (see the options table), e.g. hold=foh or initial_state=estimate")
+    _add_method_options(p.add_argument_group(
+        "method options: each goes to the methods that take it (one that no method takes is an error); "
+        "--option noise_floor=PHI judges every method's fit against that noise floor"))
     p.add_argument("--out", metavar="DIR", help="write comparison.json and comparison.md here")
     p.add_argument("--json", action="store_true", help="print the comparison as JSON on standard output")
     p.set_defaults(func=_cmd_compare)

@@ -19,3 +19,31 @@ def families():
         yield importlib.import_module("identifiability_models")
     finally:
         sys.path.remove(str(BENCH))
+
+
+@pytest.fixture
+def motor(tmp_path):
+    """A DC motor's model file (inertia J, friction b; torque in N m, speed in rad/s) at ``tmp_path / "motor.py"``,
+    and a function giving its record's CSV rows ``t,tau,w`` (a square-wave torque, the exact response at the file's
+    start J = 1e-3, b = 1e-2, 100 samples a second) for a number of samples."""
+    import numpy as np
+
+    import symid as si
+
+    path = tmp_path / "motor.py"
+    path.write_text(
+        "import symid as si\n"
+        "J, b = si.parameters('J b', positive=True)\n"
+        "model = si.SecondOrderModel(M=[[J]], V=[[b]], K=[[0]], B=[[1]], C=[[1]], output='velocity')\n"
+        "start = {'J': 1e-3, 'b': 1e-2}\n"
+        "input_units, output_units = 'N m', 'rad/s'\n")
+    J, b = si.parameters("J b", positive=True)
+    model = si.SecondOrderModel(M=[[J]], V=[[b]], K=[[0]], B=[[1]], C=[[1]], output="velocity")
+
+    def rows(samples: int = 200) -> str:
+        t = np.arange(samples) * 0.01
+        u = np.where((t * 3).astype(int) % 2 == 0, 1.0, -1.0)
+        y = si.simulate_io(model, {"J": 1e-3, "b": 1e-2}, u, 0.01).y[:, 0]
+        return "\n".join(f"{a:.2f},{c},{float(d)!r}" for a, c, d in zip(t, u, y, strict=True))
+
+    return path, rows

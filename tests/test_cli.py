@@ -634,22 +634,11 @@ def test_compare_takes_the_method_options_and_a_noise_floor(tmp_path, capsys):
     assert "--backend: none of the methods compared (auto, oe) takes backend" in capsys.readouterr().err
 
 
-def test_a_warning_is_said_once_per_command(tmp_path, capsys):
+def test_a_warning_is_said_once_per_command(tmp_path, capsys, motor):
     """A new user's trial: each DataWarning printed twice, by the fit and by its validation on the same record."""
-    (tmp_path / "motor.py").write_text(
-        "import symid as si\n"
-        "J, b = si.parameters('J b', positive=True)\n"
-        "model = si.SecondOrderModel(M=[[J]], V=[[b]], K=[[0]], B=[[1]], C=[[1]], output='velocity')\n"
-        "start = {'J': 1e-3, 'b': 1e-2}\n"
-        "input_units, output_units = 'N m', 'rad/s'\n")
-    J, b = si.parameters("J b", positive=True)
-    model = si.SecondOrderModel(M=[[J]], V=[[b]], K=[[0]], B=[[1]], C=[[1]], output="velocity")
-    t = np.arange(300) * 0.01
-    u = np.where((t * 3).astype(int) % 2 == 0, 1.0, -1.0)
-    y = si.simulate_io(model, {"J": 1e-3, "b": 1e-2}, u, 0.01).y[:, 0]
-    rows = "\n".join(f"{a:.2f},{c},{float(d)!r}" for a, c, d in zip(t, u, y, strict=True))
+    rows = motor[1](300)
     (tmp_path / "rec.csv").write_text(f"# units: t [s], tau [N m], w [deg/s]\nt,tau,w\n{rows}\n")
-    main(["identify", str(tmp_path / "motor.py"), "--data", str(tmp_path / "rec.csv"), "--columns", "time=t",
+    main(["identify", str(motor[0]), "--data", str(tmp_path / "rec.csv"), "--columns", "time=t",
           "input=tau", "output=w", "--units", "time=s"])
     err = capsys.readouterr().err
     assert err.count("the file states deg/s for output 'w'") == 1, err

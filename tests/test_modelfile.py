@@ -284,25 +284,16 @@ def test_the_non_symmetric_warning_is_said_once_per_model_not_again_for_its_know
         spec.model.with_known({"m2": 3.0})
 
 
-def test_identify_warns_when_a_data_files_units_differ_from_the_model_files(tmp_path):
+def test_identify_warns_when_a_data_files_units_differ_from_the_model_files(tmp_path, motor):
     """A new user's trial, in Python: encoder angles stated in degrees (`# units: theta [deg]`) fitted a model
     file whose output unit is rad: success=True with every inertia off by π/180 and nothing said (the command line
     warned; Python dropped the comment). si.identify now compares the units the file states for its input and
     output columns with the model file's, and a DataWarning names both; the same units say nothing."""
     import warnings
 
-    (tmp_path / "motor.py").write_text(
-        "import symid as si\n"
-        "J, b = si.parameters('J b', positive=True)\n"
-        "model = si.SecondOrderModel(M=[[J]], V=[[b]], K=[[0]], B=[[1]], C=[[1]], output='velocity')\n"
-        "start = {'J': 1e-3, 'b': 1e-2}\n"
-        "input_units, output_units = 'N m', 'rad/s'\n")
-    spec = si.load_model(str(tmp_path / "motor.py"))
+    spec = si.load_model(str(motor[0]))
     assert spec.free_model().io_units == {"input": ("N m",), "output": ("rad/s",)}
-    t = np.arange(200) * 0.01
-    u = np.where((t * 3).astype(int) % 2 == 0, 1.0, -1.0)
-    y = si.simulate_io(spec.model, {"J": 1e-3, "b": 1e-2}, u, 0.01).y[:, 0]
-    rows = "\n".join(f"{a:.2f},{b},{float(c)!r}" for a, b, c in zip(t, u, y, strict=True))
+    rows = motor[1](200)
     cols = {"time": "t", "input": "tau", "output": "w"}
     for unit, warned in (("deg/s", True), ("rad / s", False)):
         path = tmp_path / "rec.csv"
