@@ -179,7 +179,9 @@ class GlobalResult:
         ``"ladder"`` when a chain driven and measured at one mass was inverted (at an end
         mass by continued fractions, :mod:`~symid.structural.ladder`; at an interior mass by
         a pole split and continued fractions on either side,
-        :mod:`~symid.structural.ladder_interior`): one solution, no Gröbner basis.
+        :mod:`~symid.structural.ladder_interior`), or driven next to its free end and
+        measured there (a case analysis, :mod:`~symid.structural.ladder_adjacent`): one
+        solution, no Gröbner basis.
     slice_values : dict of str to sympy.Rational
         For a model that is not locally identifiable, solved on a slice
         (:mod:`~symid.structural.slicing`): the random values given to the parameters
@@ -773,6 +775,12 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
             notes.append("a mass chain driven and measured at an end mass: its continued fraction gives every "
                          "parameter as a rational function of the transfer function (symid.structural.ladder), so "
                          "no Gröbner basis was needed")
+        elif ladder == "adjacent":
+            notes.append("a mass chain driven next to its free end and measured there (or the reverse): of the ways "
+                         "a solution could explain the response (a root of the numerator for the last element, a "
+                         "pair of zeros of the last mass's dynamic stiffness, each left chain peeled as a continued "
+                         "fraction) only θ*'s passes (a floating-point test with wide margins; "
+                         "symid.structural.ladder_adjacent), so no Gröbner basis was needed")
         elif ladder:
             notes.append("a mass chain driven and measured at an interior mass: of the splits of the driving-point "
                          "impedance's poles between the two sides only θ*'s meets the necessary conditions (a "
@@ -1444,9 +1452,10 @@ def generic_global(model, known: Mapping[str, object] | None = None, *, positive
         if not _claims_global(res):
             return replace(res, notes=(*res.notes, *notes), draws=draws)
         # the run started beside θ* had the same arguments as this call when θ* was the first draw and msolve
-        # decided there; otherwise (or when it never started for want of a spare core) the confirmation runs now
-        # (a run not wanted is always closed here: its thread must not outlive this call in a child process)
-        found = ahead.take(wanted=draws == 1 and res.engine == "msolve") if ahead is not None else None
+        # or a chain's inversion decided there (the inversion is tried first at θ** too, whatever the engine);
+        # otherwise (or when it never started for want of a spare core) the confirmation runs now (a run not
+        # wanted is always closed here: its thread must not outlive this call in a child process)
+        found = ahead.take(wanted=draws == 1 and res.engine in ("msolve", "ladder")) if ahead is not None else None
         ahead = None
         if found is None:
             found = confirm_mod_p(model, **confirm_args, msolve=msolve if res.engine == "msolve" else None,

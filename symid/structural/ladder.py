@@ -89,7 +89,7 @@ import sympy as sp
 from symid.errors import ModelError, OptionError
 from symid.structural.summary import free_parameters, model_kind, model_matrices
 
-__all__ = ["Ladder", "impedance", "invert", "ladder_of", "peel", "proves_global", "series"]
+__all__ = ["ChainParts", "Ladder", "chain_parts", "impedance", "invert", "ladder_of", "peel", "proves_global", "series"]
 
 _S = sp.Symbol("s")
 _SHIFT = {"position": 0, "velocity": 1, "acceleration": 2}
@@ -144,27 +144,42 @@ def _unit(vec: sp.Matrix) -> tuple[int, sp.Rational] | None:
     return nz[0]
 
 
-def ladder_of(model, known: Mapping[str, object] | None = None, *, driven_anywhere: bool = False) -> Ladder | None:
-    """The chain structure of ``model`` (see the module notes), or None when it is not one.
+@dataclass(frozen=True)
+class ChainParts:
+    """A second-order model read as masses joined by elements (:func:`chain_parts`).
 
-    ``driven_anywhere=True`` also recognises a chain driven and measured at an interior
-    mass (for :mod:`symid.fit.frf.chain` and :mod:`symid.structural.ladder_interior`; the
-    inversion of this module needs an end):
-    ``order`` then runs from the end that has the ground element (ground elements at one
-    end only, never at the driven mass) and ``at`` says where the driven mass is.
-
-    Examples
-    --------
-    >>> import sympy as sp
-    >>> import symid as si
-    >>> from symid.structural.ladder import ladder_of
-    >>> m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
-    >>> chain = si.SecondOrderModel(M=sp.diag(m1, m2), V=[[c1 + c2, -c2], [-c2, c2]],
-    ...                             K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[0, 1]])
-    >>> lad = ladder_of(chain)
-    >>> lad.order, lad.masses, lad.edges, lad.grounds
-    ((1, 0), (m2, m1), ((c2, k2),), ((0, 0), (c1, k1)))
+    Attributes
+    ----------
+    n : int
+        Number of masses.
+    params : set of sympy.Symbol
+        The free parameters.
+    masses : list of sympy.Expr
+        Mass of each model coordinate (never 0).
+    edge : dict
+        ``edge[i, j]`` (both orders) = (damper, spring) of the element joining masses i and j.
+    ground : list of (sympy.Expr, sympy.Expr)
+        (damper, spring) from each mass to the ground.
+    shift : int
+        0, 1 or 2: position, velocity or acceleration output.
+    b, c : (int, sympy.Rational)
+        The mass B and C^T act on and their nonzero known value.
     """
+
+    n: int
+    params: set
+    masses: list
+    edge: dict
+    ground: list
+    shift: int
+    b: tuple
+    c: tuple
+
+
+def chain_parts(model, known: Mapping[str, object] | None = None) -> ChainParts | None:
+    """``model`` as masses, elements and ground elements with a single input and a single sensor, each acting on
+    one mass (M diagonal, V and K weighted Laplacians plus ground elements, every value 0, known or one free
+    parameter; module notes), or None."""
     try:
         if model_kind(model) != "second-order":
             return None
@@ -180,7 +195,7 @@ def ladder_of(model, known: Mapping[str, object] | None = None, *, driven_anywhe
         return None
     params = set(free_parameters(model, known))
     b, c = _unit(B), _unit(C)
-    if b is None or c is None or b[0] != c[0]:
+    if b is None or c is None:
         return None
     if any(M[i, j] != 0 for i in range(n) for j in range(n) if i != j):
         return None
@@ -205,6 +220,35 @@ def ladder_of(model, known: Mapping[str, object] | None = None, *, driven_anywhe
         if pair[0] is None or pair[1] is None:
             return None
         ground.append(pair)
+    return ChainParts(n, params, masses, edge, ground, shift, b, c)
+
+
+def ladder_of(model, known: Mapping[str, object] | None = None, *, driven_anywhere: bool = False) -> Ladder | None:
+    """The chain structure of ``model`` (see the module notes), or None when it is not one.
+
+    ``driven_anywhere=True`` also recognises a chain driven and measured at an interior
+    mass (for :mod:`symid.fit.frf.chain` and :mod:`symid.structural.ladder_interior`; the
+    inversion of this module needs an end):
+    ``order`` then runs from the end that has the ground element (ground elements at one
+    end only, never at the driven mass) and ``at`` says where the driven mass is.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> import symid as si
+    >>> from symid.structural.ladder import ladder_of
+    >>> m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+    >>> chain = si.SecondOrderModel(M=sp.diag(m1, m2), V=[[c1 + c2, -c2], [-c2, c2]],
+    ...                             K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[0, 1]])
+    >>> lad = ladder_of(chain)
+    >>> lad.order, lad.masses, lad.edges, lad.grounds
+    ((1, 0), (m2, m1), ((c2, k2),), ((0, 0), (c1, k1)))
+    """
+    parts = chain_parts(model, known)
+    if parts is None or parts.b[0] != parts.c[0]:
+        return None
+    n, params, masses, edge, ground, shift = parts.n, parts.params, parts.masses, parts.edge, parts.ground, parts.shift
+    b, c = parts.b, parts.c
     # the path from the driven mass
     start = b[0]
     around = [j for j in range(n) if (start, j) in edge]
@@ -484,7 +528,9 @@ def _matches_model(D: _RF, ladder: Ladder, model, known, subs: Mapping) -> bool:
 def proves_global(model, known: Mapping[str, object] | None, star: Sequence[object]) -> str:
     """Whether ``model`` is a chain whose inversion succeeds at θ* = ``star``: ``"end"`` (driven and measured at an
     end mass, :func:`invert`), ``"interior"`` (at an interior mass,
-    :func:`~symid.structural.ladder_interior.invert_interior`), or ``""`` (no proof).
+    :func:`~symid.structural.ladder_interior.invert_interior`), ``"adjacent"`` (driven next to the free end and
+    measured there, or the reverse, :func:`~symid.structural.ladder_adjacent.invert_adjacent`), or ``""`` (no
+    proof).
 
     Non-empty: every free parameter is globally identifiable and summary(θ) = summary(θ*)
     has one complex solution for generic θ* (module notes).
@@ -494,7 +540,10 @@ def proves_global(model, known: Mapping[str, object] | None, star: Sequence[obje
         return "end" if invert(ladder, model, known, star) else ""
     inner = ladder_of(model, known, driven_anywhere=True)
     if inner is None or not 0 < inner.at < len(inner.masses) - 1:
-        return ""
+        from symid.structural.ladder_adjacent import adjacent_of, invert_adjacent  # they build on this module
+
+        near = adjacent_of(model, known)
+        return "adjacent" if near is not None and invert_adjacent(near, model, known, star) else ""
     from symid.structural.ladder_interior import invert_interior  # it builds on this module
 
     return "interior" if invert_interior(inner, model, known, star) else ""

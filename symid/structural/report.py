@@ -144,7 +144,9 @@ class IdentifiabilityReport:
         (empty when the exact step did not finish), ``"ladder"`` for a mass chain driven and
         measured at one mass, inverted by continued fractions with no Gröbner basis
         (:mod:`symid.structural.ladder` at an end mass; :mod:`symid.structural.ladder_interior`
-        at an interior one, whose pole split is a floating-point test), ``"formula"`` when
+        at an interior one, whose pole split is a floating-point test;
+        :mod:`symid.structural.ladder_adjacent` driven next to the free end and measured
+        there, a case analysis with floating-point exclusions), ``"formula"`` when
         checked rational formulas decided every verdict. Like ``timing``, a record of how the
         report was made: the rest of the report is the same whichever ran (the floats of
         ``solutions`` agree to rounding).
