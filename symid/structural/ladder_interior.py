@@ -212,12 +212,13 @@ def _setup(ladder: Ladder, model, known, star) -> _Setup | None:
 
 def _poles_of(Z: _RF, poles) -> bool:
     """Whether every one of ``poles`` (complex) is a root of Z's denominator, to 1e-12 of the size of its terms."""
-    with mpmath.workdps(DPS):
-        den = [mpmath.mpf(int(c.p)) / int(c.q) for c in Z.den.all_coeffs()]
-        for z in poles:
-            size = mpmath.fsum(abs(c) * abs(z) ** i for i, c in enumerate(reversed(den)))
-            if abs(mpmath.polyval(den, mpmath.mpc(z))) > 1e-12 * size:
-                return False
+    mp = mpmath.MPContext()  # a context of its own: mpmath's global one is shared with other threads
+    mp.dps = DPS
+    den = [mp.mpf(int(c.p)) / int(c.q) for c in Z.den.all_coeffs()]
+    for z in poles:
+        size = mp.fsum(abs(c) * abs(z) ** i for i, c in enumerate(reversed(den)))
+        if abs(mp.polyval(den, mp.mpc(z))) > 1e-12 * size:
+            return False
     return True
 
 

@@ -52,6 +52,7 @@ masses, five random points each; ``benchmarks/pole_split_margins.py``) θ*'s spl
 from __future__ import annotations
 
 import math
+import threading
 from itertools import combinations
 
 import mpmath
@@ -77,8 +78,20 @@ _C_MIN = 1e-8
 nonzero: condition 2 needs c ≠ 0, so such a split is not decided."""
 
 
+class _PerThread(threading.local):
+    """mpmath's global context (its precision) is shared by every thread, and the confirmation at θ** runs this
+    module in a thread beside the step at θ*: each thread computes in a context of its own."""
+
+    def __init__(self):
+        self.ctx = mpmath.MPContext()
+
+
+_THREAD = _PerThread()
+
+
 def _mpc(x: sp.Rational) -> mpmath.mpf:
-    return mpmath.mpf(int(x.p)) / int(x.q)
+    mp = _THREAD.ctx
+    return mp.mpf(int(x.p)) / int(x.q)
 
 
 def split_residuals(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Rational, n_right: int,
@@ -94,20 +107,21 @@ def split_residuals(P: sp.Poly, rem: sp.Poly, alpha: sp.Rational, beta: sp.Ratio
         root to test). None when the poles are not simple or there are more than
         :data:`MAX_SPLITS` splits.
     """
+    mp = _THREAD.ctx
     if P.degree() < 2 or P.gcd(P.diff()).degree() > 0:
         return None  # a multiple pole: the partial fractions below do not apply
     if math.comb(P.degree(), n_right) > MAX_SPLITS:
         return None
-    with mpmath.workdps(DPS):
+    with mp.workdps(DPS):
         coeffs = [_mpc(c) for c in P.all_coeffs()]
         roots = _roots(coeffs)
         dP = P.diff()
-        rho = [mpmath.polyval([_mpc(c) for c in rem.all_coeffs()], z)
-               / mpmath.polyval([_mpc(c) for c in dP.all_coeffs()], z) for z in roots]
+        rho = [mp.polyval([_mpc(c) for c in rem.all_coeffs()], z)
+               / mp.polyval([_mpc(c) for c in dP.all_coeffs()], z) for z in roots]
         al, be = _mpc(alpha), _mpc(beta)
         # in units of the poles' geometric mean size (the residuals are invariant under s → s/w: ρ → ρ/w,
         # α → α w), so that the double computation works on numbers near 1
-        w = mpmath.exp(mpmath.fsum(mpmath.log(abs(r)) for r in roots) / len(roots)) if all(roots) else 1
+        w = mp.exp(mp.fsum(mp.log(abs(r)) for r in roots) / len(roots)) if all(roots) else 1
         z = np.array([complex(r / w) for r in roots])
         rh = np.array([complex(r / w) for r in rho])
         splits = np.array(list(combinations(range(len(z)), n_right)), dtype=int)
@@ -165,22 +179,23 @@ def _roots(coeffs: list) -> list:
     does not converge or two refined roots coincide, ``mpmath.polyroots`` (a few hundred ms
     at degree 14) instead.
     """
+    mp = _THREAD.ctx
     d = [coeffs[i] * (len(coeffs) - 1 - i) for i in range(len(coeffs) - 1)]
-    tol = mpmath.mpf(10) ** (5 - mpmath.mp.dps)
+    tol = mp.mpf(10) ** (5 - mp.dps)
     out = []
     for x0 in np.roots([complex(c) for c in coeffs]):
-        x = mpmath.mpc(x0)
+        x = mp.mpc(x0)
         for _ in range(40):
-            step = mpmath.polyval(coeffs, x) / mpmath.polyval(d, x)
+            step = mp.polyval(coeffs, x) / mp.polyval(d, x)
             x -= step
             if abs(step) <= tol * max(abs(x), 1):
                 break
         else:
-            return mpmath.polyroots(coeffs, maxsteps=400, extraprec=4 * mpmath.mp.dps)
+            return mp.polyroots(coeffs, maxsteps=400, extraprec=4 * mp.dps)
         out.append(x)
     sep = min((abs(p - q) / max(abs(p), abs(q), 1) for i, p in enumerate(out) for q in out[:i]), default=1)
-    if len(out) != len(coeffs) - 1 or sep < mpmath.mpf(10) ** (-mpmath.mp.dps // 2):
-        return mpmath.polyroots(coeffs, maxsteps=400, extraprec=4 * mpmath.mp.dps)
+    if len(out) != len(coeffs) - 1 or sep < mp.mpf(10) ** (-mp.dps // 2):
+        return mp.polyroots(coeffs, maxsteps=400, extraprec=4 * mp.dps)
     return out
 
 
@@ -243,6 +258,7 @@ def _side_mp(roots, rho, S, c, beta, cscale, free: bool) -> mpmath.mpf | None:
     On a free side c and β make h = Z vanish to second order at 0 (condition 1), a double
     root at which g′(0) = −c ≠ 0: the two eigenvalues nearest 0 are that root and are left out.
     """
+    mp = _THREAD.ctx
     if abs(c) < _C_MIN * cscale:
         return None
     z = [roots[i] for i in S]
@@ -255,7 +271,7 @@ def _side_mp(roots, rho, S, c, beta, cscale, free: bool) -> mpmath.mpf | None:
     A[np.arange(1, k + 1), np.arange(1, k + 1)] = [complex(x) for x in z]
     if not np.isfinite(A).all():
         return None
-    tol = mpmath.mpf(10) ** (5 - mpmath.mp.dps)
+    tol = mp.mpf(10) ** (5 - mp.dps)
     found = []
     eig = sorted(np.linalg.eigvals(A), key=abs)
     if free:  # the double root splits into two eigenvalues ~ sqrt(u) from 0: they must stand apart from the rest
@@ -263,10 +279,10 @@ def _side_mp(roots, rho, S, c, beta, cscale, free: bool) -> mpmath.mpf | None:
             return None
         eig = eig[2:]
     for x0 in eig:
-        x = mpmath.mpc(x0)
+        x = mp.mpc(x0)
         for _ in range(60):
-            h = c * x + beta + mpmath.fsum(ri / (x - zi) for ri, zi in zip(r, z, strict=True))
-            dh = c - mpmath.fsum(ri / (x - zi) ** 2 for ri, zi in zip(r, z, strict=True))
+            h = c * x + beta + mp.fsum(ri / (x - zi) for ri, zi in zip(r, z, strict=True))
+            dh = c - mp.fsum(ri / (x - zi) ** 2 for ri, zi in zip(r, z, strict=True))
             step = h / dh
             x -= step
             if abs(step) <= tol * max(abs(x), 1):
@@ -275,29 +291,30 @@ def _side_mp(roots, rho, S, c, beta, cscale, free: bool) -> mpmath.mpf | None:
             return None
         found.append(x)
     sep = min((abs(p - q) / max(abs(p), abs(q), 1) for i, p in enumerate(found) for q in found[:i]), default=1)
-    if sep < mpmath.mpf(10) ** (-mpmath.mp.dps // 2):
+    if sep < mp.mpf(10) ** (-mp.dps // 2):
         return None  # two eigenvalues refined to one root: one may be missed
     best = None
     for x in found:
         terms = [ri / (x - zi) ** 2 for ri, zi in zip(r, z, strict=True)]
-        v = abs(mpmath.fsum(terms)) / mpmath.fsum(abs(t) for t in terms)
+        v = abs(mp.fsum(terms)) / mp.fsum(abs(t) for t in terms)
         best = v if best is None else min(best, v)
     return best
 
 
 def _residual_mp(roots, rho, right, left, al, be, left_free) -> float | None:
-    cR = mpmath.fsum(rho[i] / roots[i] ** 2 for i in right)
-    bR = mpmath.fsum(rho[i] / roots[i] for i in right)
-    gap = mpmath.mpf(0)
+    mp = _THREAD.ctx
+    cR = mp.fsum(rho[i] / roots[i] ** 2 for i in right)
+    bR = mp.fsum(rho[i] / roots[i] for i in right)
+    gap = mp.mpf(0)
     if left_free:
-        cL = mpmath.fsum(rho[i] / roots[i] ** 2 for i in left)
-        bL = mpmath.fsum(rho[i] / roots[i] for i in left)
+        cL = mp.fsum(rho[i] / roots[i] ** 2 for i in left)
+        bL = mp.fsum(rho[i] / roots[i] for i in left)
         gap = abs(cL + cR - al) / (abs(cL) + abs(cR) + abs(al)) + abs(bL + bR - be) / (abs(bL) + abs(bR) + abs(be))
     else:
         cL, bL = al - cR, be - bR
     terms = {i: abs(rho[i] / roots[i] ** 2) for i in range(len(roots))}
-    sR = mpmath.fsum(terms[i] for i in right)
-    sL = mpmath.fsum(terms[i] for i in left) if left_free else sR + abs(al)
+    sR = mp.fsum(terms[i] for i in right)
+    sL = mp.fsum(terms[i] for i in left) if left_free else sR + abs(al)
     sides = [_side_mp(roots, rho, right, cR, bR, sR, True), _side_mp(roots, rho, left, cL, bL, sL, left_free)]
     if any(x is None for x in sides):
         return None
