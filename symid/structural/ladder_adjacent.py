@@ -84,7 +84,7 @@ from symid.errors import OptionError
 from symid.structural.ladder import _RF, _S, Ladder, _matches_model, _value, chain_parts
 from symid.structural.summary import free_parameters
 
-__all__ = ["DPS", "FAIL", "PASS", "adjacent_of", "invert_adjacent"]
+__all__ = ["DPS", "FAIL", "PASS", "adjacent_of", "case_margins", "invert_adjacent"]
 
 DPS = 80
 """Decimal digits of the high-precision steps."""
@@ -167,6 +167,50 @@ def invert_adjacent(ladder: Ladder, model, known: Mapping[str, object] | None, s
     >>> invert_adjacent(adjacent_of(chain), chain, None, [3, 5, 7, sp.Rational(1, 2), 11, 2, 13, 17, 19])
     True
     """
+    setup = _setup(ladder, model, known, star)
+    if setup is None:
+        return False
+    P, N, theta, n = setup
+    for dps in (DPS, 2 * DPS):  # twice the digits when a check is in the grey zone (rounding on spread values)
+        mp = mpmath.MPContext()  # a context of its own: mpmath's global one is shared with other threads
+        mp.dps = dps
+        try:
+            sols, undecided = _solutions(*_exact_mp(P, N, mp), n, mp)
+        except mpmath.NoConvergence:  # a polynomial whose roots mpmath does not find: no claim
+            return False
+        if not undecided:
+            return len(sols) == 1 and _gap(sols[0], theta, mp) < PASS
+    return False
+
+
+def case_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequence[object]) -> dict | None:
+    """How clearly the case analysis separates θ*'s case from the others, at θ* = ``star``.
+
+    Returns ``{"cases": number of cases that failed a check, "solutions": number passing,
+    "theta_star": the largest relative difference of the passing case from θ*,
+    "nearest": the smallest residual of a failed check, "undecided": bool, "digits": 80, or
+    160 where a check was undecided in 80 as in :func:`invert_adjacent`}``, or None
+    outside the structure of the module notes. For the benchmarks: a case passes below
+    :data:`PASS` and fails above :data:`FAIL`.
+    """
+    setup = _setup(ladder, model, known, star)
+    if setup is None:
+        return None
+    P, N, theta, n = setup
+    for dps in (DPS, 2 * DPS):  # as invert_adjacent
+        mp = mpmath.MPContext()
+        mp.dps = dps
+        misses = []
+        sols, undecided = _solutions(*_exact_mp(P, N, mp), n, mp, misses)
+        if not undecided:
+            break
+    return {"cases": len(misses), "solutions": len(sols),
+            "theta_star": float(_gap(sols[0], theta, mp)) if len(sols) == 1 else None,
+            "nearest": float(min(misses)) if misses else None, "undecided": undecided, "digits": dps}
+
+
+def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, int] | None:
+    """P, N and θ* as [c, k, m] per node from node 0 (checked against the model's response), or None."""
     params = free_parameters(model, known)
     if len(star) != len(params):
         raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
@@ -175,22 +219,16 @@ def invert_adjacent(ladder: Ladder, model, known: Mapping[str, object] | None, s
     e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
     g = _value(ladder.grounds[0][0], subs), _value(ladder.grounds[0][1], subs)
     if any(x == 0 for x in (*m, *(x for pair in e for x in pair), *g)):
-        return False  # an element of the structure is 0 at θ*: not a generic point
+        return None  # an element of the structure is 0 at θ*: not a generic point
     P, N = _polys(m, e, g)
     if P.gcd(N).degree() != 0 or not _matches_model(_RF(P, N), ladder, model, known, subs):
-        return False
-    theta = [g[0], g[1], m[0], *(x for j in range(1, len(m)) for x in (*e[j - 1], m[j]))]  # [c, k, m] per node
-    for dps in (DPS, 2 * DPS):  # twice the digits when a check is in the grey zone (rounding on spread values)
-        mp = mpmath.MPContext()  # a context of its own: mpmath's global one is shared with other threads
-        mp.dps = dps
-        try:
-            sols, undecided = _solutions(*_exact_mp(P, N, mp), len(m), mp)
-        except mpmath.NoConvergence:  # a polynomial whose roots mpmath does not find: no claim
-            return False
-        if not undecided:
-            return len(sols) == 1 and max(abs(v - _mpq(w, mp)) / abs(_mpq(w, mp))
-                                          for v, w in zip(sols[0], theta, strict=True)) < PASS
-    return False
+        return None
+    return P, N, [g[0], g[1], m[0], *(x for j in range(1, len(m)) for x in (*e[j - 1], m[j]))], len(m)
+
+
+def _gap(values: list, theta: list, mp: mpmath.MPContext) -> mpmath.mpf:
+    """The largest relative difference of ``values`` from the exact ``theta``."""
+    return max(abs(v - _mpq(w, mp)) / abs(_mpq(w, mp)) for v, w in zip(values, theta, strict=True))
 
 
 # -- exact polynomials at θ* ----------------------------------------------------------------------------------------
@@ -395,13 +433,14 @@ def _case(Pm: list, Nm: list, z0, sig, n: int, mp: mpmath.MPContext) -> tuple[li
     return [*values, c, c * z0, mn], max(res, r)
 
 
-def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext) -> tuple[list, bool]:
+def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext, misses: list | None = None) -> tuple[list, bool]:
     """Every case of the module notes in working precision: (solutions as in :func:`_case`, undecided).
 
     P and N have real coefficients, so the cases come in complex-conjugate pairs whose
     solutions are conjugate: (z̄₀, σ̄) gives θ̄ when (z₀, σ) gives θ. Only one of each pair
     is computed (Im z₀ ≥ 0, and Im σ ≥ 0 for a real z₀); a solution found that is not
     real then stands for two, and the caller, which asks for θ* alone, claims nothing.
+    ``misses``: a list that gets the residual of each case's failed check.
     """
     sols, undecided = [], False
     real = mp.mpf(10) ** (-mp.dps // 3)  # |Im| below this (relative): a real number to rounding
@@ -434,6 +473,8 @@ def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext) -> tuple[list, 
             got, r = _case(Pm, Nm, z0, sig, n, mp)
             if got is None:
                 undecided = undecided or r < FAIL
+                if misses is not None:
+                    misses.append(r)
                 continue
             _keep(sols, got, mp)
     return sols, undecided
