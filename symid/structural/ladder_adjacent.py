@@ -13,7 +13,8 @@ A chain in the sense of :func:`~symid.structural.ladder.ladder_of` (M diagonal, 
 weighted Laplacians of a path through all n ≥ 3 masses, every value 0, known or one free
 parameter) with
 
-- the ground element at one end only (node 0), with a damper and a spring;
+- the ground element at one end only (node 0), with a damper and a spring, or none (a free
+  chain);
 - every element joining two masses with a damper and a spring;
 - B and C^T nonzero known numbers times unit vectors of the two masses at the other
   end (nodes n − 2 and n − 1, either way round), any sensor derivative.
@@ -40,14 +41,18 @@ c = Ω(σ₁) = Ω(σ₂) with Ω(s) = −H(s) / (s + z₀); and 1/σ₁ + 1/σ�
    double zero of V);
 3. c = Ω(σ₁) and m = H(σ₁) / σ₁²; then V divides Q = P + e N = (X + e) l V, and
    X = c Q / (V N) · (s + z₀) − e;
-4. X a grounded chain's driving-point stiffness of n − 1 masses: it peels as a continued
-   fraction (:func:`_peel`, steps as in :mod:`~symid.structural.ladder`), uniquely when
-   it does.
+4. X the driving-point stiffness at an end of a chain of n − 1 masses, grounded at the
+   other end or free (then every remainder vanishes to second order at s = 0, checked):
+   it peels as a continued fraction (:func:`_peel`, steps as in
+   :mod:`~symid.structural.ladder`), uniquely when it does.
 
-Degenerate choices (σ₁ = 0, σ₁ = −z₀, σ₁ a pole of Ω) are impossible on a solution: P(0)
-≠ 0 needs k ≠ 0, and P and N are coprime (checked exactly at θ*). Every solution is one
-of at most deg N · (4n − 3) cases, each giving at most one θ; θ* is the only one when one
-case passes and gives θ*'s values.
+Degenerate choices are impossible on a solution: σ₁ = 0 and σ₁ = −z₀ are no zeros of V
+(V(0) = c z₀, V(−z₀) = m z₀²), σ₁ a pole of Ω would make P and N share a root (they are
+coprime, checked exactly at θ*), and σ₁ a zero of P gives c = 0. Every solution is one of
+at most deg N · (4n − 3) cases, each giving at most one θ; θ* is the only one when one
+case passes and gives θ*'s values. A free chain of 3 masses has 3 solutions (the case
+analysis finds them, as the Gröbner step counts) and is left to the usual step; from 4
+masses on, free chains are global.
 
 How it is computed
 ------------------
@@ -135,8 +140,8 @@ def adjacent_of(model, known: Mapping[str, object] | None = None) -> Ladder | No
     if len(order) != n:
         return None
     order.reverse()  # from the grounded end
-    if any(ground[i] != (0, 0) for i in order[1:]) or 0 in ground[order[0]]:
-        return None
+    if any(ground[i] != (0, 0) for i in order[1:]) or (0 in ground[order[0]] and ground[order[0]] != (0, 0)):
+        return None  # a ground element elsewhere than node 0, or one without a damper or a spring
     edges = [edge[i, j] for i, j in pairwise(order)]
     if any(0 in pair_ for pair_ in edges):
         return None
@@ -170,13 +175,13 @@ def invert_adjacent(ladder: Ladder, model, known: Mapping[str, object] | None, s
     setup = _setup(ladder, model, known, star)
     if setup is None:
         return False
-    P, N, theta, n = setup
+    P, N, theta, n, free = setup
     for dps in (DPS, 2 * DPS):  # twice the digits when a check is in the grey zone (rounding on spread values)
         mp = mpmath.MPContext()  # a context of its own: mpmath's global one is shared with other threads
         mp.dps = dps
         try:
-            sols, undecided = _solutions(*_exact_mp(P, N, mp), n, mp)
-        except mpmath.NoConvergence:  # a polynomial whose roots mpmath does not find: no claim
+            sols, undecided = _solutions(*_exact_mp(P, N, mp), n, mp, free=free)
+        except mp.NoConvergence:  # a polynomial whose roots mpmath does not find: no claim
             return False
         if not undecided:
             return len(sols) == 1 and _gap(sols[0], theta, mp) < PASS
@@ -196,12 +201,12 @@ def case_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star
     setup = _setup(ladder, model, known, star)
     if setup is None:
         return None
-    P, N, theta, n = setup
+    P, N, theta, n, free = setup
     for dps in (DPS, 2 * DPS):  # as invert_adjacent
         mp = mpmath.MPContext()
         mp.dps = dps
         misses = []
-        sols, undecided = _solutions(*_exact_mp(P, N, mp), n, mp, misses)
+        sols, undecided = _solutions(*_exact_mp(P, N, mp), n, mp, misses, free=free)
         if not undecided:
             break
     return {"cases": len(misses), "solutions": len(sols),
@@ -209,8 +214,9 @@ def case_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star
             "nearest": float(min(misses)) if misses else None, "undecided": undecided, "digits": dps}
 
 
-def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, int] | None:
-    """P, N and θ* as [c, k, m] per node from node 0 (checked against the model's response), or None."""
+def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, int, bool] | None:
+    """P, N, θ* as [c, k, m] per node from node 0 (no c, k at node 0 of a free chain; checked against the model's
+    response), the number of masses and whether the chain is free, or None."""
     params = free_parameters(model, known)
     if len(star) != len(params):
         raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
@@ -218,12 +224,14 @@ def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, 
     m = [_value(v, subs) for v in ladder.masses]
     e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
     g = _value(ladder.grounds[0][0], subs), _value(ladder.grounds[0][1], subs)
-    if any(x == 0 for x in (*m, *(x for pair in e for x in pair), *g)):
+    free = ladder.grounds[0] == (0, 0)
+    if any(x == 0 for x in (*m, *(x for pair in e for x in pair), *(() if free else g))):
         return None  # an element of the structure is 0 at θ*: not a generic point
     P, N = _polys(m, e, g)
     if P.gcd(N).degree() != 0 or not _matches_model(_RF(P, N), ladder, model, known, subs):
         return None
-    return P, N, [g[0], g[1], m[0], *(x for j in range(1, len(m)) for x in (*e[j - 1], m[j]))], len(m)
+    theta = [*(() if free else g), m[0], *(x for j in range(1, len(m)) for x in (*e[j - 1], m[j]))]
+    return P, N, theta, len(m), free
 
 
 def _gap(values: list, theta: list, mp: mpmath.MPContext) -> mpmath.mpf:
@@ -341,7 +349,7 @@ def _roots(p: list, mp: mpmath.MPContext) -> list:
             q, _ = _divmod(q, [1, -x])
         try:
             rest = mp.polyroots(q, maxsteps=200, extraprec=mp.dps)
-        except mpmath.NoConvergence:
+        except mp.NoConvergence:
             rest = [mp.mpc(0)] * (d - len(found))  # coincide with a found root: the fallback below
         found += [newton(mp.mpc(x0), 20) or mp.mpc(x0) for x0 in rest]
     if min((abs(a - b) / max(abs(a), abs(b), 1) for i, a in enumerate(found) for b in found[:i]), default=1) < sep:
@@ -364,19 +372,28 @@ def _phi_poly(F: list, z0, mp: mpmath.MPContext) -> list:
 
 # -- the peel of the left chain (step 4) ----------------------------------------------------------------------------
 
-def _peel(A: list, B: list, nmass: int, mp: mpmath.MPContext) -> tuple[list | None, mpmath.mpf]:
-    """Invert X = A / B as the driving-point stiffness at the free end of a chain of ``nmass`` masses grounded at
-    the other (every element with a damper and a spring).
+def _peel(A: list, B: list, nmass: int, mp: mpmath.MPContext, free: bool = False) -> tuple[list | None, mpmath.mpf]:
+    """Invert X = A / B as the driving-point stiffness at an end of a chain of ``nmass`` masses grounded at the
+    other (``free``: not grounded; every element with a damper and a spring).
 
     Returns (values, worst): values [m, c, k] per node from the driven end (c, k of the element towards the
-    ground), worst the largest residual of a check that held; or (None, r), r the residual of the first check
-    that failed (0 when two roots pass one step: undecided). Every check is a necessary condition.
+    ground; [m] at the last node of a free chain), worst the largest residual of a check that held; or (None, r),
+    r the residual of the first check that failed (0 when two roots pass one step: undecided). Every check is a
+    necessary condition. A free sub-chain's stiffness vanishes to second order at s = 0 (it moves as a rigid
+    body), so beyond a node whose sub-chain is free the remainder has the double root 0, checked and divided out
+    before the roots are sought.
     """
     out, worst = [], mp.mpf(0)
     A, B = list(A), list(B)
     for j in range(nmass, 0, -1):
         mj = A[0] / B[0]  # A / B = m s² + e D / (e + D): deg A = 2j, deg B = 2j − 2
         rest = _add(A, _scale(_mul([1, 0, 0], B), -mj))[1:]
+        if j == 1 and free:  # the last node is a mass alone: rest = 0
+            res = max(abs(x) for x in rest) / mp.fsum(abs(x) for x in A)
+            if res > PASS:
+                return None, res
+            out.append([mj])
+            return out, max(worst, res)
         if j == 1:  # the last node's element is the ground's: rest = e B, B constant
             res = max(abs(x) for x in rest[:-2]) / mp.fsum(abs(x) for x in rest) if len(rest) > 2 else mp.mpf(0)
             if res > PASS:
@@ -385,8 +402,15 @@ def _peel(A: list, B: list, nmass: int, mp: mpmath.MPContext) -> tuple[list | No
             return out, max(worst, res)
         cj = rest[0] / B[0]
         d_rest = _deriv(rest)
+        sought = rest
+        if free:  # the free sub-chain beyond: rest = O(s²)
+            res = (abs(rest[-1]) + abs(rest[-2])) / mp.fsum(abs(x) for x in rest)
+            if res > PASS:
+                return None, res
+            worst = max(worst, res)
+            sought = rest[:-2]
         best, s0, passing = None, None, 0
-        for z in _roots(rest, mp):  # −k/c: a root of rest where rest′ = c B (e − Z has a double zero there)
+        for z in _roots(sought, mp):  # −k/c: a root of rest where rest′ = c B (e − Z has a double zero there)
             r = (abs(cj * mp.polyval(B, z) - mp.polyval(d_rest, z))
                  / (abs(cj * mp.polyval(B, z)) + abs(mp.polyval(d_rest, z))))
             passing += r < FAIL
@@ -413,7 +437,8 @@ def _peel(A: list, B: list, nmass: int, mp: mpmath.MPContext) -> tuple[list | No
 
 # -- the cases (steps 1–3) --------------------------------------------------------------------------------------------
 
-def _case(Pm: list, Nm: list, z0, sig, n: int, mp: mpmath.MPContext) -> tuple[list | None, mpmath.mpf]:
+def _case(Pm: list, Nm: list, z0, sig, n: int, mp: mpmath.MPContext, free: bool = False,
+          ) -> tuple[list | None, mpmath.mpf]:
     """Steps 3 and 4 for the zero −z₀ of N and σ₁ = ``sig`` in working precision: (θ as [c, k, m] per node from
     node 0 (c, k of the element towards the ground), residual) or (None, residual of the failed check)."""
     H = mp.polyval(Pm, sig) / mp.polyval(Nm, sig)
@@ -426,14 +451,15 @@ def _case(Pm: list, Nm: list, z0, sig, n: int, mp: mpmath.MPContext) -> tuple[li
         return None, res if mp.isfinite(res) else mp.mpf(1)
     lhat, _ = _divmod(Nm, [Nm[0], Nm[0] * z0])  # N / (ν (s + z₀)): the left determinant, monic
     X = _add(_scale(Lq, c / Nm[0]), _scale(_mul([c, c * z0], lhat), -1))
-    got, r = _peel(X, lhat, n - 1, mp)
+    got, r = _peel(X, lhat, n - 1, mp, free)
     if got is None:
         return None, r
-    values = [x for node in reversed(got) for x in (node[1], node[2], node[0])]  # [c, k, m] per node from node 0
+    values = [x for node in reversed(got) for x in (node[1:] + node[:1])]  # [c, k, m] per node from node 0
     return [*values, c, c * z0, mn], max(res, r)
 
 
-def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext, misses: list | None = None) -> tuple[list, bool]:
+def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext, misses: list | None = None, *,
+               free: bool = False) -> tuple[list, bool]:
     """Every case of the module notes in working precision: (solutions as in :func:`_case`, undecided).
 
     P and N have real coefficients, so the cases come in complex-conjugate pairs whose
@@ -463,6 +489,8 @@ def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext, misses: list | 
         for sig, pair in [(x, True) for x in _roots(E, mp)] + [(-2 * z0, False)]:
             if real_z0 and sig.imag < -real * abs(sig):
                 continue  # the conjugate case
+            if min(abs(sig), abs(sig + z0)) <= real * abs(z0):
+                continue  # σ = 0 or −z₀: V(σ) = c z₀ or m z₀², never 0, so no solution has it
             if pair and any(abs(sig - t) < mp.mpf(10) ** (-mp.dps // 4) * (1 + abs(t)) for t in seen):
                 continue  # the other zero of a pair already tried
             seen += [sig, -z0 * sig / (sig + z0)]
@@ -470,7 +498,10 @@ def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext, misses: list | 
                 size = mp.fsum(abs(x) * abs(sig) ** i for i, x in enumerate(reversed(Nm))) * (abs(sig) + abs(z0))
                 if abs(mp.polyval(Nm, sig) * (sig + z0)) / size < mp.mpf(10) ** (-mp.dps // 3):
                     continue  # σ a pole of Ω: P and N are coprime, so no solution has it
-            got, r = _case(Pm, Nm, z0, sig, n, mp)
+            try:
+                got, r = _case(Pm, Nm, z0, sig, n, mp, free)
+            except ZeroDivisionError:  # a zero damper or mass (σ a zero of P) or a zero leading coefficient in the
+                got, r = None, mp.mpf(1)  # peel: no solution has one (θ* generic, every element present)
             if got is None:
                 undecided = undecided or r < FAIL
                 if misses is not None:
