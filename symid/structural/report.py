@@ -236,7 +236,7 @@ class IdentifiabilityReport:
                 sol = (f"{self.n_solutions} admissible of {self.n_solutions_real} real, "
                        f"{self.n_solutions_complex} complex")
             if self.engine == "ladder":
-                L.append(f"global (chain)     : summary(θ) = summary(θ*): {sol} (continued-fraction inversion)")
+                L.append(f"global (chain)     : summary(θ) = summary(θ*): {sol} (a chain inverted: see the notes)")
             elif self.engine == "formula":
                 L.append(f"global (formula)   : summary(θ) = summary(θ*): {sol} (rational formulas, checked exactly)")
             else:
