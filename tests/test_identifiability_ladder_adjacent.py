@@ -103,6 +103,19 @@ def test_free_chains_agree_with_the_groebner_step(n, count, monkeypatch):
     assert margins["solutions"] >= 2 if count > 1 else margins["solutions"] == 1
 
 
+@pytest.mark.parametrize("known", [{"m1": 2}, {"k2": 5}])
+def test_a_known_value_leaves_one_of_the_free_chains_solutions(known, monkeypatch):
+    """The free 3-mass chain's 3 solutions (whole structure) are filtered by the known value: only θ*'s has it
+    (Gröbner on the model with the known value: 1)."""
+    model = _free_chain(3)
+    rep = si.identifiability(model, known=known)
+    with monkeypatch.context() as mpatch:
+        mpatch.setattr(gg, "proves_global", lambda *a, **k: "")
+        ref = si.identifiability(model, known=known)
+    assert ref.engine != "ladder" and ref.n_solutions_complex == 1
+    assert rep.engine == "ladder" and rep.verdict == "global" and rep.n_solutions_complex == 1
+
+
 def test_a_free_chain_of_six_masses_is_proven_at_theta_star_and_theta_2():
     model = _free_chain(6)
     for draw in (0, 500):

@@ -51,8 +51,11 @@ Degenerate choices are impossible on a solution: σ₁ = 0 and σ₁ = −z₀ a
 coprime, checked exactly at θ*), and σ₁ a zero of P gives c = 0. Every solution is one of
 at most deg N · (4n − 3) cases, each giving at most one θ; θ* is the only one when one
 case passes and gives θ*'s values. A free chain of 3 masses has 3 solutions (the case
-analysis finds them, as the Gröbner step counts) and is left to the usual step; from 4
-masses on, free chains are global.
+analysis finds them, as the Gröbner step counts); from 4 masses on, free chains are
+global. Known values: the case analysis finds every solution of the whole structure (every
+element free), and the model's solutions are those among them with its known values; so
+a free 3-mass chain with a known mass or element is global when only θ* has it (the
+usual step decides when a known value is neither clearly met nor clearly missed).
 
 How it is computed
 ------------------
@@ -175,7 +178,7 @@ def invert_adjacent(ladder: Ladder, model, known: Mapping[str, object] | None, s
     setup = _setup(ladder, model, known, star)
     if setup is None:
         return False
-    P, N, theta, n, free = setup
+    P, N, theta, n, free, fixed = setup
     for dps in (DPS, 2 * DPS):  # twice the digits when a check is in the grey zone (rounding on spread values)
         mp = mpmath.MPContext()  # a context of its own: mpmath's global one is shared with other threads
         mp.dps = dps
@@ -184,15 +187,32 @@ def invert_adjacent(ladder: Ladder, model, known: Mapping[str, object] | None, s
         except mp.NoConvergence:  # a polynomial whose roots mpmath does not find: no claim
             return False
         if not undecided:
-            return len(sols) == 1 and _gap(sols[0], theta, mp) < PASS
+            sols = _with_known(sols, theta, fixed, mp)
+            return sols is not None and len(sols) == 1 and _gap(sols[0], theta, mp) < PASS
     return False
+
+
+def _with_known(sols: list, theta: list, fixed: list, mp: mpmath.MPContext) -> list | None:
+    """The solutions whose known values (``fixed[i]``: θ[i] is known) are the model's: a known value is a
+    constraint the full structure's solutions need not meet. None when one is neither clearly equal (1e-20) nor
+    clearly different (1e-8)."""
+    out = []
+    for values in sols:
+        gaps = [abs(v - _mpq(w, mp)) / abs(_mpq(w, mp)) for v, w, f in zip(values, theta, fixed, strict=True) if f]
+        if all(g < 1e-20 for g in gaps):
+            out.append(values)
+        elif not any(g > 1e-8 for g in gaps):
+            return None
+    return out
 
 
 def case_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequence[object]) -> dict | None:
     """How clearly the case analysis separates θ*'s case from the others, at θ* = ``star``.
 
-    Returns ``{"cases": number of cases that failed a check, "solutions": number passing,
-    "theta_star": the largest relative difference of the passing case from θ*,
+    Returns ``{"cases": number of cases that failed a check, "solutions": number passing
+    (solutions of the whole structure, one of each complex-conjugate pair), "with_known": of
+    them, those with the model's known values, "theta_star": the largest relative
+    difference of the one left from θ*,
     "nearest": the smallest residual of a failed check, "undecided": bool, "digits": 80, or
     160 where a check was undecided in 80 as in :func:`invert_adjacent`}``, or None
     outside the structure of the module notes. For the benchmarks: a case passes below
@@ -201,7 +221,7 @@ def case_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star
     setup = _setup(ladder, model, known, star)
     if setup is None:
         return None
-    P, N, theta, n, free = setup
+    P, N, theta, n, free, fixed = setup
     for dps in (DPS, 2 * DPS):  # as invert_adjacent
         mp = mpmath.MPContext()
         mp.dps = dps
@@ -209,14 +229,15 @@ def case_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star
         sols, undecided = _solutions(*_exact_mp(P, N, mp), n, mp, misses, free=free)
         if not undecided:
             break
-    return {"cases": len(misses), "solutions": len(sols),
-            "theta_star": float(_gap(sols[0], theta, mp)) if len(sols) == 1 else None,
+    mine = _with_known(sols, theta, fixed, mp)
+    return {"cases": len(misses), "solutions": len(sols), "with_known": None if mine is None else len(mine),
+            "theta_star": float(_gap(mine[0], theta, mp)) if mine and len(mine) == 1 else None,
             "nearest": float(min(misses)) if misses else None, "undecided": undecided, "digits": dps}
 
 
-def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, int, bool] | None:
+def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, int, bool, list] | None:
     """P, N, θ* as [c, k, m] per node from node 0 (no c, k at node 0 of a free chain; checked against the model's
-    response), the number of masses and whether the chain is free, or None."""
+    response), the number of masses, whether the chain is free and which values of θ* are known, or None."""
     params = free_parameters(model, known)
     if len(star) != len(params):
         raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
@@ -231,7 +252,9 @@ def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, 
     if P.gcd(N).degree() != 0 or not _matches_model(_RF(P, N), ladder, model, known, subs):
         return None
     theta = [*(() if free else g), m[0], *(x for j in range(1, len(m)) for x in (*e[j - 1], m[j]))]
-    return P, N, theta, len(m), free
+    slots = [*(() if free else ladder.grounds[0]), ladder.masses[0],
+             *(x for j in range(1, len(m)) for x in (*ladder.edges[j - 1], ladder.masses[j]))]
+    return P, N, theta, len(m), free, [x not in subs for x in slots]
 
 
 def _gap(values: list, theta: list, mp: mpmath.MPContext) -> mpmath.mpf:
