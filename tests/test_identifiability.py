@@ -210,8 +210,10 @@ def _hang(*args, **kwargs):
 
 def test_timeout_returns_the_exact_local_verdict_and_never_hangs(monkeypatch):
     # the Gröbner step made to hang on the belt drive (globally identifiable: no witness can
-    # exist): the child running it is killed at the deadline and the verdict is undetermined
+    # exist), and the formula search off: the child running it is killed at the deadline and the verdict is
+    # undetermined
     monkeypatch.setattr("symid.structural.steps.generic_global", _hang)
+    monkeypatch.setattr("symid.structural.steps.rational_formulas", lambda *a, **k: {})
     model = si.load_model("belt_drive").model
     t0 = time.perf_counter()
     rep = si.identifiability(model, timeout=4.0)
@@ -225,6 +227,17 @@ def test_timeout_returns_the_exact_local_verdict_and_never_hangs(monkeypatch):
     assert any("no second solution found numerically" in n for n in rep.notes)
     assert "global verdict undetermined" in rep.summary()
     assert elapsed < 4.0 + 0.5  # the deadline holds: a killed child, not a signal that can be lost
+
+
+def test_formulas_decide_what_the_timed_out_groebner_step_does_not(monkeypatch):
+    """With the Gröbner step hung and no witness (the belt drive is globally identifiable), the checked rational
+    formulas, tried beside the witness search, still prove each parameter a function of the transfer function:
+    global, and so the model (before, every verdict read "local, global undetermined")."""
+    monkeypatch.setattr("symid.structural.steps.generic_global", _hang)
+    rep = si.identifiability(si.load_model("belt_drive").model, timeout=4.0)
+    assert not rep.global_determined and rep.global_status.startswith("undetermined (timeout after 4 s)")
+    assert set(rep.verdicts.values()) == {"global"} and rep.verdict == "global"
+    assert any("rational formula" in n for n in rep.notes)
 
 
 @pytest.mark.parametrize("t", [1.0, 2.0])

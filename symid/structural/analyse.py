@@ -296,6 +296,11 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
     """The global step, the verdicts, the combinations and the report (see :func:`identifiability`)."""
     timeout, seed, known_exact = args.timeout, args.seed, args.known
     fix = () if full_rank else tuple(q.name for q in parameters_to_fix(local))
+    if local.rank == 0:  # nothing to fix so that the rest becomes identifiable: there is no rest
+        fix = ()
+        notes.append("the response does not depend on any parameter: nothing about them can be learned from it"
+                     + (" (the output does not depend on the input at all: H ≡ 0; check which coordinates B and C "
+                        "act on)" if all(local.silent) and _zero_response(model, known_exact) else ""))
     # locally identifiable linear functions: with the identifiable parameters they span every one; the global
     # step says which of their combinations are globally identifiable
     linear = [] if full_rank else linear_space(local, model, known_exact, seed=seed)
@@ -355,6 +360,8 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
             verdicts[nm] = "none" if not loc[nm] else (
                 "global" if nm in out.formulas else (LOCAL if nm in moved else UNDETERMINED))
         verdict = "none" if not full_rank else (LOCAL if n_cert else UNDETERMINED)
+        if full_rank and all(v == "global" for v in verdicts.values()):
+            verdict = "global"  # every parameter a checked rational formula in the summary: one solution
         count = (f"at least {1 + n_cert} admissible solutions at θ* (certified lower bound: θ* and {n_cert} "
                  f"solution(s) certified by the Krawczyk test; exact count not computed: {why})") if n_cert else \
             f"not computed ({why})"
@@ -389,10 +396,19 @@ def _finish(model, args, local, monos, full_rank, free, names, pos, necessary, n
             if n_complex and n_real is not None and n_complex > n_real:
                 notes.append(f"{n_complex - n_real} of {n_complex} complex solutions are not real at θ* and were "
                              "discarded")
-            if n_complex is not None and n_complex > 1 and n_sol == 1:
+            open_ = [nm for nm in names if verdicts[nm] == UNDETERMINED]
+            if n_complex is not None and n_complex > 1 and n_sol == 1 and open_:
                 notes.append(f"only θ* itself is admissible at θ*, but summary(θ) = summary(θ*) has {n_complex} "
                              "complex solutions: whether the others become admissible elsewhere depends on θ*, so "
                              "the global verdict is undetermined (not 'global': that would hold at this θ* only)")
+            elif n_complex is not None and n_complex > 1 and n_sol == 1:
+                notes.append(f"only θ* itself is admissible at θ* of the {n_complex} complex solutions, but at "
+                             "another random point two admissible solutions differ (above): not global")
+            if open_:
+                global_status = (f"determined (the exact step finished: {n_complex} complex solutions); the "
+                                 f"verdicts of {', '.join(open_)} stay undetermined: no point tried had two "
+                                 "admissible solutions that differ in them, and a count of admissible solutions at "
+                                 "one θ* is not structural")
             if n_complex is not None and n_complex > 1:
                 notes.append("counts of real and admissible solutions are at the random point θ*; elsewhere they "
                              f"can differ (the complex count, {n_complex}, is generic)")
@@ -522,6 +538,11 @@ def _summary_candidates(model, known, local, limit: int) -> list[tuple]:
             continue
         out.append((_factored(num) / _factored(den), "summary", True, poly_gradients(num, den, local.points)))
     return out, skipped
+
+
+def _zero_response(model, known_exact) -> bool:
+    """Whether the model's transfer function is identically zero: its exhaustive summary has no entry."""
+    return len(exhaustive_summary(model, known_exact).labels) == 0
 
 
 def _check_fix(model, known_exact, fix: tuple[str, ...], seed: int, budget: float | None) -> str:

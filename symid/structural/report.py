@@ -81,7 +81,10 @@ class IdentifiabilityReport:
     global_determined : bool
         Whether the global (Gröbner) step finished.
     global_status : str
-        ``"determined"``; ``"NOT globally identifiable, proven by k certified
+        ``"determined"``; ``"determined (...); the verdicts of … stay undetermined: ..."``
+        when the exact step finished but only θ* is admissible at θ* among several complex
+        solutions and no other point showed two admissible ones that differ;
+        ``"NOT globally identifiable, proven by k certified
         solution(s) ..."`` when certified witnesses settled the verdicts before the
         Gröbner step finished; or ``"undetermined (...)"`` with the reason (timeout,
         error).
@@ -236,7 +239,9 @@ class IdentifiabilityReport:
                 sol = (f"{self.n_solutions} admissible of {self.n_solutions_real} real, "
                        f"{self.n_solutions_complex} complex")
             if self.engine == "ladder":
-                L.append(f"global (chain)     : summary(θ) = summary(θ*): {sol} (a chain inverted: see the notes)")
+                how = ("a chain inverted, with floating-point exclusions at wide margins"
+                       if any("floating-point test" in note for note in self.notes) else "a chain inverted exactly")
+                L.append(f"global (chain)     : summary(θ) = summary(θ*): {sol} ({how}: see the notes)")
             elif self.engine == "formula":
                 L.append(f"global (formula)   : summary(θ) = summary(θ*): {sol} (rational formulas, checked exactly)")
             else:

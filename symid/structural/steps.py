@@ -119,7 +119,7 @@ def _witness_step(model, known, positive, seed, rank):
     params, star, _, summ, _ = prepared
     moved = _moved(wit, [q.name for q in params])
     rest = [q.name for q in params if q.name not in moved]
-    formulas = rational_formulas(summ, rest, seed=seed, at=star) if moved and rest else {}
+    formulas = rational_formulas(summ, rest, seed=seed, at=star) if rest else {}
     return wit, {name: f.text(summ.labels) for name, f in formulas.items()}
 
 
