@@ -623,9 +623,29 @@ def test_summary_with_integer_or_fractional_coefficients(half):
     # transfer function's coefficients either way (H = 1/(m s² + half·c s + k), normalised by m)
     m, c, k = si.parameters("m c k", positive=True)
     model = si.SecondOrderModel(M=[[m]], V=[[half * c]], K=[[k]], B=[[1]], C=[[1]])
-    summ = exhaustive_summary(model)
+    summ = exhaustive_summary(model, kind="transfer-function coefficients")
     entries = dict(zip(summ.labels, summ.expressions(), strict=True))
     assert entries == {"d s^0": k / m, "d s^1": half * c / m, "N[0,0] s^0": 1 / m}
+
+
+def test_known_invertible_b_and_c_make_the_matrices_the_summary():
+    """B and C known, square and invertible: the response determines M, V, K (M s² + V s + K = B H⁻¹ C), so their
+    entries are the summary; the zoo's truss (108 parameters, B = C = I) is then global in seconds (its transfer
+    function's determinant of order 8 was too large to compute: "global undetermined"). A parameter in B, or a
+    B that is not square, leaves the transfer function as the summary."""
+    m1, m2, c1, c2, k1, k2, b = si.parameters("m1 m2 c1 c2 k1 k2 b", positive=True)
+    kw = {"M": sp.diag(m1, m2), "V": [[c1 + c2, -c2], [-c2, c2]], "K": [[k1 + k2, -k2], [-k2, k2]]}
+    summ = exhaustive_summary(si.SecondOrderModel(**kw, B=[[1, 0], [1, 2]], C=sp.eye(2), output="velocity"))
+    assert summ.kind == "entries of the model's matrices" and len(summ) == 10  # M's zeros (constants) dropped
+    assert dict(zip(summ.labels, summ.expressions(), strict=True))["V[0,0]"] == c1 + c2
+    assert exhaustive_summary(si.SecondOrderModel(**kw, B=[[b, 0], [0, 1]], C=sp.eye(2))).kind != summ.kind
+    assert exhaustive_summary(si.SecondOrderModel(**kw, B=[[1], [0]], C=sp.eye(2))).kind != summ.kind
+    a1, a2, a3 = si.parameters("a1 a2 a3")
+    ss = si.StateSpaceModel(A=[[-a1, a2], [a3, -a1]], B=sp.eye(2), C=[[1, 1], [0, 1]])
+    assert exhaustive_summary(ss).kind == "entries of the model's matrices"
+    rep = si.identifiability(si.load_model("truss8").model, timeout=30)
+    assert rep.verdict == "global" and rep.n_solutions_complex == 1 and rep.summary_kind == summ.kind
+    assert any("B and C are known, square and invertible" in n for n in rep.notes)
 
 
 def test_minimality_modulo_a_prime_never_claims_what_is_false():

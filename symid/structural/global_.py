@@ -97,6 +97,7 @@ from symid.structural.modp import BadPrime, compile_poly, residue, value_mod_p
 from symid.structural.msolve import MsolveCancelled, MsolveError, input_text, parse_output, run_msolve
 from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
+    KIND_MATRICES,
     KIND_TF,
     evaluator,
     exhaustive_summary,
@@ -338,7 +339,8 @@ def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: 
     params = free_parameters(model, known)
     rng = random.Random(10_007 + 1000 * seed + draw)
     star, minimal = _pick_theta_star(model, mats, kind, output, params, rng, known=known, rank=rank)
-    if summary is not None and summary.kind == KIND_TF and (minimal or summary.exhaustive_at(star)):
+    if summary is not None and (summary.kind == KIND_MATRICES
+                                or (summary.kind == KIND_TF and (minimal or summary.exhaustive_at(star)))):
         # (a summary built where the realisation was minimal keeps no reduced form: built again here)
         return params, star, minimal, summary, rng
     summ = exhaustive_summary(model, known, check_point=star)
@@ -729,7 +731,10 @@ def global_analysis(model, known: Mapping[str, object] | None = None, *, positiv
     theta_star = dict(zip(names, star, strict=True))
     times["summary"] = time.perf_counter() - t0
     notes = []
-    if summ.kind != KIND_TF:
+    if summ.kind == KIND_MATRICES:
+        notes.append("B and C are known, square and invertible, so the response determines the model's matrices "
+                     "(M s² + V s + K = s^r B H(s)⁻¹ C, or sI − A = B (H(s) − D)⁻¹ C): their entries are the summary")
+    elif summ.kind != KIND_TF:
         notes.append("the realisation is not minimal at random points; Markov parameters used as the summary")
     elif not minimal:
         shared = (f"; its numerator and denominator share the factor s^{summ.shift} for every θ (poles at s = 0 "

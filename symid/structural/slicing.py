@@ -48,7 +48,7 @@ import sympy as sp
 from symid.structural.global_ import EXTRA_POINTS, GlobalResult, draw_point, generic_global
 from symid.structural.local import local_analysis
 from symid.structural.rational_formulas import rational_formulas
-from symid.structural.summary import KIND_TF, exhaustive_summary, free_parameters
+from symid.structural.summary import KIND_MATRICES, KIND_TF, exhaustive_summary, free_parameters
 
 __all__ = ["sliced_global"]
 
@@ -137,7 +137,7 @@ def sliced_global(model, known: Mapping[str, object] | None = None, *, fix: Sequ
         if set(found) == set(wanted):
             glob = {n: n in found for n in names}
             text = "; ".join(f.text(summ.labels) for f in found.values())
-            markov = () if summ.kind == KIND_TF else (
+            markov = () if summ.kind in (KIND_TF, KIND_MATRICES) else (
                 "the realisation is not minimal at random points; Markov parameters used as the summary",)
             return GlobalResult(summ.kind, summ.labels, (), {}, False, None, None, None, (), (), glob, dict(glob),
                                 dict(glob), (), (), 0, notes=(*markov,

@@ -66,6 +66,10 @@ class SummaryTooLarge(SolverError):
 
 KIND_TF = "transfer-function coefficients"
 KIND_MARKOV = "Markov parameters"
+KIND_MATRICES = "entries of the model's matrices"
+"""The summary when B and C are known, square and invertible: the response then determines the model's matrices
+(second order: M s² + V s + K = s^r B H(s)⁻¹ C; state space: sI − A = B (H(s) − D)⁻¹ C and D = H(∞)), so their
+entries are an exhaustive summary, affine in θ (a model with a sensor and an actuator on every coordinate)."""
 
 
 def rational(value: object) -> sp.Rational:
@@ -137,7 +141,7 @@ class ExhaustiveSummary:
     Attributes
     ----------
     kind : str
-        ``"transfer-function coefficients"`` or ``"Markov parameters"``.
+        ``"transfer-function coefficients"``, ``"Markov parameters"`` or ``"entries of the model's matrices"``.
     ring : sympy.polys.rings.PolyRing
         The polynomial ring ℚ[θ] (free parameters only, grevlex order).
     parameters : tuple of sympy.Symbol
@@ -454,8 +458,10 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
         the transfer-function summary is used when the realisation is minimal there, or
         when the transfer function reduced by a common power of s is in lowest terms there.
         Default: a fixed pseudo-random point.
-    kind : {"transfer-function coefficients", "Markov parameters"}, optional
-        Force one summary.
+    kind : {"transfer-function coefficients", "Markov parameters", "entries of the model's matrices"}, optional
+        Force one summary. By default the matrices' entries when B and C are known, square
+        and invertible (:data:`KIND_MATRICES`), else the transfer-function coefficients
+        where they are exhaustive, else the Markov parameters.
 
     Returns
     -------
@@ -479,15 +485,28 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
     R = ring(names, QQ, grevlex_memo)[0] if names else ring([sp.Dummy("_none")], QQ, grevlex_memo)[0]
     if check_point is None:
         check_point = [sp.Rational(3 + 2 * i, 1 + (i % 3)) for i in range(len(params))]
-    minimal = is_minimal_at(mats, mkind, output, params, check_point)
+    if kind in (None, KIND_MATRICES):
+        found = _matrices_summary(mats, mkind, params)
+        if found is not None:
+            kind = KIND_MATRICES
+            nums = [R.from_expr(x) for x in found[0]]
+            dens, labels = [R.one] * len(nums), found[1]
+        elif kind == KIND_MATRICES:
+            raise ModelError("the matrices' entries are an exhaustive summary only when B and C are known, square "
+                             "and invertible")
+    minimal = True if kind == KIND_MATRICES else is_minimal_at(mats, mkind, output, params, check_point)
     normaliser, shift, reduced = None, 0, None
-    if kind in (None, KIND_TF):
+    if kind == KIND_MATRICES:
+        pass
+    elif kind in (None, KIND_TF):
         nums, dens, labels, shift, reduced = _tf_summary(mats, mkind, output, params)
         if kind is None:
             kind = KIND_TF if minimal or _lowest_terms_at(reduced, check_point) else KIND_MARKOV
         if minimal:
             reduced = None  # not needed where the realisation is minimal (10 MB at 8 masses)
-    if kind == KIND_TF:
+    if kind == KIND_MATRICES:
+        pass
+    elif kind == KIND_TF:
         if dens:
             normaliser = _to_ring(dens[0], R, names)
     elif kind == KIND_MARKOV:
@@ -513,6 +532,24 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
         normaliser = normaliser.quo_ground(normaliser.LC)
     return ExhaustiveSummary(kind, R, tuple(params), tuple(keep_n), tuple(keep_d), tuple(keep_l), minimal, n_const,
                              normaliser, shift, reduced)
+
+
+def _matrices_summary(mats: dict[str, sp.Matrix], mkind: str, params) -> tuple[list, list] | None:
+    """The entries of M, V, K (second order) or A, D (state space) and their labels when B and C are free of θ,
+    square and invertible (:data:`KIND_MATRICES`), else None."""
+    B, C = mats["B"], mats["C"]
+    if (B.free_symbols | C.free_symbols) & set(params):
+        return None
+    n = mats["M" if mkind == "second-order" else "A"].shape[0]
+    if B.shape != (n, n) or C.shape != (n, n) or B.det() == 0 or C.det() == 0:
+        return None
+    entries, labels = [], []
+    for key in ("MVK" if mkind == "second-order" else "AD"):
+        for i in range(mats[key].shape[0]):
+            for j in range(mats[key].shape[1]):
+                entries.append(sp.expand(mats[key][i, j]))
+                labels.append(f"{key}[{i},{j}]")
+    return entries, labels
 
 
 def evaluator(pt):
