@@ -180,3 +180,15 @@ def test_check_local_checks_its_arguments():
         check_local(_belt(), known={"zz": 1.0})
     # every parameter known is fine here (nothing can be unidentifiable)
     assert check_local(_belt(), known={"theta1": 1, "theta2": 2, "theta3": 3, "theta4": 4}) == ()
+
+
+def test_a_negative_known_value_for_a_positive_parameter_is_refused():
+    """A new user's known={"a": -1} for a mass declared positive was accepted silently (verdict 'global'); 0 stays
+    allowed (an element left out), and a mass given as 0 is named as the likely cause of a singular M."""
+    a, b, c = si.parameters("a b c", positive=True)
+    model = si.SecondOrderModel(M=[[a]], V=[[b]], K=[[c]], B=[[1]], C=[[1]])
+    with pytest.raises(si.ModelError, match=r"known\['a'\] = -1 is negative, but a is declared positive"):
+        si.identifiability(model, known={"a": -1})
+    with pytest.raises(si.ModelError, match=r"a mass given as 0 in known="):
+        si.identifiability(model, known={"a": 0})
+    assert si.identifiability(model, known={"b": 0}).verdict == "global"

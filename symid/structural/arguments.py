@@ -121,6 +121,10 @@ def checked_known(model, known: Any, *, require_free: bool = True) -> tuple[dict
         if not math.isfinite(as_float):
             raise ModelError(f"known[{name!r}] must be a finite real number; got {value!r:.80} "
                              f"({type(value).__name__})")
+        declared = dict(zip(names, getattr(model, "positive", ()) or (), strict=False))
+        if declared.get(name) and as_float < 0:
+            raise ModelError(f"known[{name!r}] = {value!r:.40} is negative, but {name} is declared positive "
+                             "(si.parameters(..., positive=True)); give a value > 0, or 0 to leave the element out")
         exact[name] = rational(value)
         values[name] = as_float
     if require_free:

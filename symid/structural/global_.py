@@ -300,7 +300,7 @@ def _pick_theta_star(model, mats, kind, output, params, rng: random.Random, *, k
             break  # checked at the point returned in any case)
     if singular == 50:
         raise ModelError("det M(θ) is identically zero (singular at 50 random points); the second-order model is "
-                         "degenerate")
+                         "degenerate (a mass given as 0 in known=?)")
     if fallback is None:
         raise ExactStepLimit("no point θ* with the generic Jacobian rank found in 50 random draws")
     return fallback, False

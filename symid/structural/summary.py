@@ -224,7 +224,8 @@ def first_order_polynomial(mats: dict[str, sp.Matrix], kind: str, output: str | 
     n = M.shape[0]
     d = _det(M)
     if d == R.zero:
-        raise ModelError("det M(θ) is identically zero; the second-order model is degenerate")
+        raise ModelError("det M(θ) is identically zero; the second-order model is degenerate (a mass given as 0 "
+                         "in known=?)")
     adjM = M.adjugate()
     Z = DomainMatrix.zeros((n, n), dom)
     dI = DomainMatrix.eye(n, dom) * d
@@ -680,7 +681,8 @@ def _tf_summary(mats, mkind, output, params):
         dcoef = _coeffs_in_s(detP, si, 2 * n)
         lead = dcoef[2 * n]
         if lead == Rs.zero:
-            raise ModelError("det M(θ) is identically zero; the second-order model is degenerate")
+            raise ModelError("det M(θ) is identically zero; the second-order model is degenerate (a mass given as 0 "
+                         "in known=?)")
         shift = {"position": 0, "velocity": 1, "acceleration": 2}[output]
         nums = {}
         Bl, Cl = B.to_list(), C.to_list()
