@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from symid.errors import DataWarning, IdentifiabilityWarning, OptionError
+from symid.fit.frf.misfit import FrfEstimator, weak_lines_missed
 from symid.fit.options import check_bool, scale_by_name, without_known
 from symid.fit.registry import check_model, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
@@ -426,6 +427,12 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     # summary still says it, beside the NEXT line that matters more (a new user's room at misfit 0.82 was warned)
     if ambiguity is not None and (result.success or result.cost <= 1e-2):
         warnings.warn(ambiguity, IdentifiabilityWarning, stacklevel=2)
+    if isinstance(estimator, FrfEstimator) and estimator.line_weights is None \
+            and np.all(np.isfinite(result.theta_vector)):
+        weak = weak_lines_missed(model, estimator.data, result.theta_vector)
+        if weak is not None:
+            result = dataclasses.replace(result, options={**result.options, "weak_lines_missed": weak})
+            warnings.warn(weak, DataWarning, stacklevel=2)
     if noise_std is not None and result.uncertainty is not None:
         # the declared noise judges the fit (noise floor): a residual improbably smaller than it says the noise_std
         # is too large, and then a wrong model fits (a new user's k2 5 % off, noise_std 3 times the noise's: success,
