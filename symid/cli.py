@@ -499,8 +499,9 @@ def _modes_line(model, theta, time_unit: str | None) -> str:
     unit = time_unit or "s"
     items = []
     zero = np.abs(poles) <= 1e-12 * max(float(np.max(np.abs(poles))), 1e-300) if poles.size else poles
-    if np.count_nonzero(zero) > 1:  # integrators (a rigid-body mode, positions no output sees): one item
-        items.append(f"{np.count_nonzero(zero)} poles at 0")
+    if np.count_nonzero(zero):  # integrators (a rigid-body mode, positions no output sees): one item, shown as 0
+        count = np.count_nonzero(zero)  # (a new user's drivetrain read "real pole 1.359e-11 /s", positive)
+        items.append(f"{count} pole{'s' if count > 1 else ''} at 0")
         poles = poles[~zero]
     for p in sorted(poles, key=abs):
         if p.imag > 0:

@@ -687,3 +687,13 @@ def test_compare_leaves_out_a_method_that_refuses_and_keeps_the_others(tmp_path,
     assert "note: left out, scr:" in said and "    oe        1/1" in said
     assert main(["compare", str(tmp_path / "mass.py"), *data, "--methods", "scr"]) == 2
     assert "every method refused the model or data" in capsys.readouterr().err
+
+
+def test_the_modes_line_shows_one_rigid_body_pole_as_zero():
+    """A new user's drivetrain (nothing to the ground but a bearing's friction) read "real pole 1.359e-11 /s",
+    positive, as if unstable: a single pole at 0 to rounding is "1 pole at 0"."""
+    from symid.cli import _modes_line
+
+    m, c = si.parameters("m c", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[0]], B=[[1]], C=[[1]])
+    assert _modes_line(model, [2.0, 3.0], "s") == "modes of the estimate: 1 pole at 0; real pole -1.5 /s"

@@ -47,6 +47,7 @@ def frf():
     ("scr", {"tol": "x"}, "tol must be a number"),
     ("ipopt", {"scale": [1.0, 2.0]}, r"scale must be a positive number or 6 positive numbers.*shape \(2,\)"),
     ("ipopt", {"scale": [1, 1, 1, 0, 1, 1]}, r"scale\[3\] = 0.0"),
+    ("ipopt", {"scale": {"m1": 1, "m2": 1, "c1": 1, "c2": 1, "k1": -10.0, "k2": 1}}, r"scale k1 = -10.0"),
     ("scr", {"backend": "mosek"}, "backend must be one of 'admm', 'cvxpy'; got 'mosek'"),
     ("scr", {"aux_init": "models"}, "did you mean 'model'"),
     ("ipopt", {"hessian": "bfgs"}, "hessian must be one of"),

@@ -9,6 +9,7 @@ lists the valid ones.
 from __future__ import annotations
 
 import difflib
+import math
 import numbers
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
@@ -205,6 +206,9 @@ def scale_by_name(options: Mapping[str, Any], parameter_names: Sequence[str]) ->
         out = [float(v) for v in out]
     except (TypeError, ValueError):
         raise OptionError(f"scale must hold numbers; got {value!r}") from None
+    for n, v in zip(names, out, strict=True):  # named here: check_scale later knows positions only
+        if not (math.isfinite(v) and v > 0):
+            raise OptionError(f"scale {n} = {v!r}; every entry must be a positive finite number")
     return {**options, "scale": out}
 
 

@@ -257,7 +257,9 @@ def _b_d_x0(io: IOData, A: np.ndarray, C: np.ndarray, feedthrough: bool, *, u: n
         raise DataError(f"N4SID's estimate of A is unstable: pole z = {z:.6g} (|z| = {rho:.6g} > 1) grows the "
                         f"simulation by 10^{growth:.0f} over the {N} samples, so B, D and x0 cannot be fitted; the "
                         "data do not support a stable model of this order: lower the order, change the horizon, "
-                        "decimate an oversampled record, or check the record (drift, an unstable or closed loop)")
+                        "decimate an oversampled record, or check the record (drift, an unstable or closed loop); "
+                        "a system with a rigid-body mode or an integrator has a pole at z = 1, which N4SID can "
+                        "place just outside the unit circle: harmless when the fit itself succeeds")
     M = _markov(A, C, N)  # (N, p, n)
     # rows_B[k, :, c, :] = Σ_{j<k} M_j u_{k-1-j}[c]  (zero at k = 0)
     conv = scipy.signal.fftconvolve(M.reshape(N, 1, p * n), u[:, :, None], axes=0)[: N - 1]  # (N-1, m, p*n)

@@ -179,9 +179,9 @@ class AutoOutputError(OutputError):
         if first is not None and self._bb_response.frf is not None and first.success and math.isfinite(floor):
             plain = self._plain_misfit(first.theta)
             if plain <= floor:
-                return None, (f"no black-box start sought: the pass from the start predicts the samples as well as "
-                              f"the N4SID black box of the model's order (misfit {plain:.2e}, the black box's "
-                              f"{floor:.2e})")
+                return None, (f"no black-box start sought: the pass from the start predicts the samples at least as "
+                              f"well as the N4SID black box of the model's order (misfit {plain:.2e}, the black "
+                              f"box's {floor:.2e})")
         if self._verbose_passes:
             print("auto: fitting the model to an N4SID black box's response", flush=True)
         found = black_box_start(self.model, self.data, start, scale=self.scale, time_limit=limit,
