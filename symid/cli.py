@@ -816,8 +816,9 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--known", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="parameters whose values are known: substituted into the model before estimation")
     g.add_argument("--scale", nargs="+", action="extend", metavar="NAME=VALUE",
-                   help="typical magnitude of every free parameter (or one number for all), for the methods "
-                        "that take scale= (the unknowns become θ / scale)")
+                   help="typical magnitude of free parameters (or one number for all; names the model file's "
+                        "scale lacks must be given, the others keep it), for the methods that take scale= (the "
+                        "unknowns become θ / scale)")
     g.add_argument("--bounds", nargs="+", action="extend", metavar="NAME=LOW:HIGH",
                    help="plausible ranges (either end may be empty, an open side; a parameter's range here "
                         "replaces the model file's for it, both ends): the start must lie inside; the methods "
@@ -851,8 +852,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--known", nargs="+", action="extend", metavar="NAME=VALUE",
                    help="parameters whose values are known: substituted into the model before estimation")
     p.add_argument("--scale", nargs="+", action="extend", metavar="NAME=VALUE",
-                   help="typical magnitude of every free parameter (or one number for all), for the methods "
-                        "that take scale=")
+                   help="typical magnitude of free parameters (or one number for all; names the model file's "
+                        "scale lacks must be given, the others keep it), for the methods that take scale=")
     p.add_argument("--bounds", nargs="+", action="extend", metavar="NAME=LOW:HIGH",
                    help="plausible ranges, for the methods that take bounds= (the start must lie inside)")
     _add_method_options(p.add_argument_group(

@@ -164,8 +164,9 @@ class ModelFile:
                 where: str = "the command line") -> ModelFile:
         """The same declarations with some replaced or extended (the command line's ``--known``, ``--x0`` ...).
 
-        ``known`` and ``bounds`` extend the file's (given names win); ``scale`` replaces it;
-        ``start`` replaces it for the names it gives, the others keep the file's start, else
+        ``known`` and ``bounds`` extend the file's (given names win); ``scale`` replaces it
+        when one number, and by name extends it (given names win; a name the file's scale
+        lacks must then be given); ``start`` replaces it for the names it gives, the others keep the file's start, else
         their scale, else the centre of their finite bounds. A parameter newly known leaves
         the file's start, scale and bounds.
 
@@ -185,7 +186,10 @@ class ModelFile:
 
         known_ = {**self.known, **_known_values(known or {}, self.model, f"{where}: known")}
         free = [n for n in self.model.parameter_names if n not in known_]
-        if scale is not None:
+        if isinstance(scale, Mapping):  # by name: the names given win, the others keep the file's (as start)
+            scale_ = _scale_values({**{n: v for n, v in self.scale.items() if n in free}, **scale}, free, known_,
+                                   where)
+        elif scale is not None:
             scale_ = _scale_values(scale, free, known_, where)
         else:
             scale_ = {n: v for n, v in self.scale.items() if n in free} if all(n in self.scale for n in free) else {}

@@ -391,3 +391,23 @@ def test_a_known_value_outside_the_model_files_bounds_is_said(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", si.DataWarning)
         assert spec.updated(known={"k": 50.0}).known == {"k": 50.0}
+
+
+def test_a_scale_by_name_extends_the_files_scale(tmp_path):
+    """A new user's `--scale J1=2e-4` against a file whose scale names every parameter was refused ("scale lacks
+    J2, ..."), where `--x0` extends the file's start: a scale by name now extends the file's (the names given win);
+    a name the file's scale lacks must still be given, and one number still replaces it."""
+    (tmp_path / "m.py").write_text(
+        "import symid as si\n"
+        "m, k = si.parameters('m k', positive=True)\n"
+        "model = si.SecondOrderModel(M=[[m]], V=[[0.1]], K=[[k]], B=[[1]], C=[[1]])\n"
+        "scale = {'m': 1.0, 'k': 100.0}\n")
+    spec = si.load_model(str(tmp_path / "m.py"))
+    assert spec.updated(scale={"m": 2.0}).scale == {"m": 2.0, "k": 100.0}
+    assert spec.updated(scale=3.0).scale == {"m": 3.0, "k": 3.0}
+    (tmp_path / "n.py").write_text(
+        "import symid as si\n"
+        "m, k = si.parameters('m k', positive=True)\n"
+        "model = si.SecondOrderModel(M=[[m]], V=[[0.1]], K=[[k]], B=[[1]], C=[[1]])\n")
+    with pytest.raises(si.ModelError, match="scale lacks k"):
+        si.load_model(str(tmp_path / "n.py")).updated(scale={"m": 2.0})
