@@ -89,7 +89,8 @@ import sympy as sp
 from symid.errors import ModelError, OptionError
 from symid.structural.summary import free_parameters, model_kind, model_matrices
 
-__all__ = ["ChainParts", "Ladder", "chain_parts", "impedance", "invert", "ladder_of", "peel", "proves_global", "series"]
+__all__ = ["ChainParts", "Ladder", "chain_parts", "impedance", "invert", "ladder_of", "peel", "proves_global", "series",
+           "values_at"]
 
 _S = sp.Symbol("s")
 _SHIFT = {"position": 0, "velocity": 1, "acceleration": 2}
@@ -350,6 +351,19 @@ def _value(v: sp.Expr, subs: Mapping) -> sp.Rational:
     return sp.Rational(subs.get(v, v))
 
 
+def values_at(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequence[object]
+              ) -> tuple[dict, list, list, list]:
+    """The chain's values at θ* = ``star``: (θ* by symbol, masses, edges, grounds) in ``ladder``'s node order, and
+    an :class:`~symid.errors.OptionError` when ``star`` has not one value per free parameter."""
+    params = free_parameters(model, known)
+    if len(star) != len(params):
+        raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
+    subs = {p: sp.Rational(v) for p, v in zip(params, star, strict=True)}
+    return (subs, [_value(v, subs) for v in ladder.masses],
+            [tuple(_value(v, subs) for v in pair) for pair in ladder.edges],
+            [tuple(_value(v, subs) for v in pair) for pair in ladder.grounds])
+
+
 def invert(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequence[object]) -> bool:
     """Whether the continued-fraction inversion recovers every element at θ* = ``star`` (module notes).
 
@@ -368,13 +382,7 @@ def invert(ladder: Ladder, model, known: Mapping[str, object] | None, star: Sequ
     >>> invert(ladder_of(chain), chain, None, [3, 5, sp.Rational(1, 2), 7, 11, 2])
     True
     """
-    params = free_parameters(model, known)
-    if len(star) != len(params):
-        raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
-    subs = {p: sp.Rational(v) for p, v in zip(params, star, strict=True)}
-    m = [_value(v, subs) for v in ladder.masses]
-    e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
-    g = [tuple(_value(v, subs) for v in pair) for pair in ladder.grounds]
+    subs, m, e, g = values_at(ladder, model, known, star)
     slots = [*m, *(x for pair in e for x in pair), *(x for pair in g for x in pair)]
     present = [*ladder.masses, *(x for pair in ladder.edges for x in pair),
                *(x for pair in ladder.grounds for x in pair)]

@@ -92,9 +92,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from symid.errors import OptionError
-from symid.structural.ladder import _RF, _S, Ladder, _matches_model, _value, chain_parts
-from symid.structural.summary import free_parameters
+from symid.structural.ladder import _RF, _S, Ladder, _matches_model, chain_parts, values_at
 
 __all__ = ["DPS", "FAIL", "PASS", "adjacent_of", "case_margins", "invert_adjacent"]
 
@@ -242,13 +240,8 @@ def case_margins(ladder: Ladder, model, known: Mapping[str, object] | None, star
 def _setup(ladder: Ladder, model, known, star) -> tuple[sp.Poly, sp.Poly, list, int, bool, list] | None:
     """P, N, θ* as [c, k, m] per node from node 0 (no c, k at node 0 of a free chain; checked against the model's
     response), the number of masses, whether the chain is free and which values of θ* are known, or None."""
-    params = free_parameters(model, known)
-    if len(star) != len(params):
-        raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
-    subs = {p: sp.Rational(v) for p, v in zip(params, star, strict=True)}
-    m = [_value(v, subs) for v in ladder.masses]
-    e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
-    g = _value(ladder.grounds[0][0], subs), _value(ladder.grounds[0][1], subs)
+    subs, m, e, grounds = values_at(ladder, model, known, star)
+    g = grounds[0]
     free = ladder.grounds[0] == (0, 0)
     if any(x == 0 for x in (*m, *(x for pair in e for x in pair), *(() if free else g))):
         return None  # an element of the structure is 0 at θ*: not a generic point

@@ -45,10 +45,8 @@ from dataclasses import dataclass
 import mpmath
 import sympy as sp
 
-from symid.errors import OptionError
-from symid.structural.ladder import _RF, _S, Ladder, _lin, _matches_model, _value, impedance, peel, series
+from symid.structural.ladder import _RF, _S, Ladder, _lin, _matches_model, impedance, peel, series, values_at
 from symid.structural.pole_split import DPS, possible_splits, split_residuals
-from symid.structural.summary import free_parameters
 
 __all__ = ["invert_interior", "split_margins"]
 
@@ -173,18 +171,12 @@ class _Setup:
 def _setup(ladder: Ladder, model, known, star) -> _Setup | None:
     """θ*'s values, the two sides, their impedances and D (checked against the model), or None when the
     structure or θ* is outside the cases of the module notes."""
-    params = free_parameters(model, known)
-    if len(star) != len(params):
-        raise OptionError(f"star has {len(star)} values for {len(params)} free parameters")
     n, at = len(ladder.masses), ladder.at
     if not 0 < at < n - 1 or ladder.grounds[at] != (0, 0):
         return None
     if any(x == 0 for x in (*ladder.edges[at - 1], *ladder.edges[at])):
         return None  # an element at the driven mass without a damper or a spring: condition 2 does not apply
-    subs = {p: sp.Rational(v) for p, v in zip(params, star, strict=True)}
-    m = [_value(v, subs) for v in ladder.masses]
-    e = [tuple(_value(v, subs) for v in pair) for pair in ladder.edges]
-    g = [tuple(_value(v, subs) for v in pair) for pair in ladder.grounds]
+    subs, m, e, g = values_at(ladder, model, known, star)
     present = [*ladder.masses, *(x for pair in ladder.edges for x in pair),
                *(x for pair in ladder.grounds for x in pair)]
     slots = [*m, *(x for pair in e for x in pair), *(x for pair in g for x in pair)]
