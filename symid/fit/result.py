@@ -453,6 +453,8 @@ class IdentificationResult:
             sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
             lines.append(f"ON BOUNDS: {sides}; the fit is accepted, but the uncertainty's note says whether the data "
                          f"pull the estimate beyond them (then widen those bounds if the physics allows)")
+        if self.options.get("weak_lines_missed"):  # a fit the success rule cannot judge there (symid.fit.frf.misfit)
+            lines.append(f"WEAK LINES MISSED: {self.options['weak_lines_missed']}")
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")
