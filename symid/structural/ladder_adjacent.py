@@ -497,9 +497,12 @@ def _solutions(Pm: list, Nm: list, n: int, mp: mpmath.MPContext, misses: list | 
         real_z0 = abs(z0.imag) <= real * abs(z0)
         if real_z0:
             z0 = mp.mpc(z0.real)
-        E = _add(_mul(_scale(_mul(Pm, _phi_poly(Nm, z0, mp)), z0**2), [1, z0]),
-                 _scale(_mul(_phi_poly(Pm, z0, mp), Nm), -1))
-        E, _ = _divmod(E, [1, 2 * z0, 0])  # the fixed points 0 and −2 z₀ of φ
+        first = _mul(_scale(_mul(Pm, _phi_poly(Nm, z0, mp)), z0**2), [1, z0])
+        second = _scale(_mul(_phi_poly(Pm, z0, mp), Nm), -1)
+        E, _ = _divmod(_add(first, second), [1, 2 * z0, 0])  # the fixed points 0 and −2 z₀ of φ
+        if mp.fsum(abs(x) for x in E) <= mp.mpf(10) ** (-mp.dps // 2) * mp.fsum(abs(x) for x in first + second):
+            undecided = True  # E ≡ 0 to rounding: every σ a candidate, no finite list of cases
+            continue
         tiny = mp.mpf(10) ** (-mp.dps // 2) * mp.fsum(abs(x) for x in E)
         while len(E) > 1 and abs(E[0]) < tiny:
             E = E[1:]  # the leading coefficient cancels (degree 4n − 5), to rounding
