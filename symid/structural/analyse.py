@@ -204,7 +204,7 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         :mod:`~symid.structural.ladder_interior` at an interior one) proves every
         parameter global in well under a second, whatever the engine; nor does one driven
         next to its free end and measured there (:mod:`~symid.structural.ladder_adjacent`,
-        up to 0.3 s at 6 masses, about 4 s at 8).
+        at most 0.3 s a point up to 6 masses, 1.2–1.5 s at 8).
         The report is the same either way (``engine`` in it says which ran; the floats of
         ``solutions`` agree to rounding). sympy's count over ℚ is exact; msolve's over ℚ
         is multi-modular with a probabilistic stopping criterion (Monte Carlo, as the

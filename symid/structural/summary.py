@@ -544,6 +544,10 @@ def _matrices_summary(mats: dict[str, sp.Matrix], mkind: str, params) -> tuple[l
     n = mats["M" if mkind == "second-order" else "A"].shape[0]
     if B.shape != (n, n) or C.shape != (n, n) or B.det() == 0 or C.det() == 0:
         return None
+    if mkind == "second-order":  # M invertible at a point, so not identically singular (else the usual error)
+        point = {q: sp.Rational(3 + 2 * i, 1 + (i % 3)) for i, q in enumerate(params)}
+        if mats["M"].xreplace(point).det() == 0:
+            return None
     entries, labels = [], []
     for key in ("MVK" if mkind == "second-order" else "AD"):
         for i in range(mats[key].shape[0]):
@@ -681,8 +685,8 @@ def _tf_summary(mats, mkind, output, params):
         dcoef = _coeffs_in_s(detP, si, 2 * n)
         lead = dcoef[2 * n]
         if lead == Rs.zero:
-            raise ModelError("det M(θ) is identically zero; the second-order model is degenerate (a mass given as 0 "
-                         "in known=?)")
+            raise ModelError("det M(θ) is identically zero; the second-order model is degenerate (a mass given "
+                             "as 0 in known=?)")
         shift = {"position": 0, "velocity": 1, "acceleration": 2}[output]
         nums = {}
         Bl, Cl = B.to_list(), C.to_list()
