@@ -399,3 +399,10 @@ def test_a_white_residual_over_ten_percent_is_said_to_look_like_noise():
     smooth = np.cumsum(white, axis=0)  # a random walk: structured
     test = fit_test(0.032, n_data=2000, n_parameters=3, residuals=smooth, noise_floor=None)
     assert not test.fits and "white" not in test.text and next_step(test.text).startswith("far from a fit")
+
+
+def test_a_degree_sign_is_deg():
+    """A new user's `T [°C]` against the model file's output unit `degC` was warned about as a unit mismatch."""
+    from symid.fit.identify import _same_unit
+
+    assert _same_unit("°C", "degC") and _same_unit("°", "deg") and not _same_unit("°C", "degF")

@@ -78,9 +78,10 @@ def _nearest(others: list[dict[str, float]] | None, theta: np.ndarray, unc: Any)
 
 
 def _same_unit(a: str, b: str) -> bool:
-    """Two spellings of one unit: equal but for spaces, µ written u (``mg / h`` is ``mg/h``, ``µg`` is ``ug``) and
-    the case of an angle's name (``DEG`` is ``deg``); otherwise case counts (``Mg`` is not ``mg``)."""
-    norm = [re.sub(r"\s+", "", x).replace("µ", "u").replace("μ", "u") for x in (a, b)]
+    """Two spellings of one unit: equal but for spaces, µ written u (``mg / h`` is ``mg/h``, ``µg`` is ``ug``), the
+    degree sign written deg (``°C`` is ``degC``, ``°`` is ``deg``) and the case of an angle's name (``DEG`` is
+    ``deg``); otherwise case counts (``Mg`` is not ``mg``)."""
+    norm = [re.sub(r"\s+", "", x).replace("µ", "u").replace("μ", "u").replace("°", "deg") for x in (a, b)]
     return norm[0] == norm[1] or (norm[0].lower() == norm[1].lower() and norm[0].lower() in _CASELESS)
 
 

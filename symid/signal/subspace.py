@@ -189,8 +189,9 @@ def _constant_inputs(u: np.ndarray) -> list[int]:
         raise DataError(f"inputs {', '.join(map(str, out))} are all constant: their effects cannot be told apart; "
                         "keep one constant (offset) input")
     if len(out) == u.shape[1]:
-        raise DataError("every input is constant (not persistently exciting): the record holds no excitation to "
-                        "identify a model from")
+        raise DataError("every input is constant (not persistently exciting): N4SID, which does not assume the "
+                        "record starts at rest, cannot identify a model from it (an output-error fit from rest "
+                        "still can: a step response)")
     return out
 
 
