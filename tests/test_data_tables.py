@@ -561,3 +561,20 @@ def test_a_gap_in_an_equally_spaced_record_names_its_lines_and_size(tmp_path):
         IOData.from_table(path, columns={"time": "t_h", "input": "P", "output": "Ta"}, units={"time": "h"})
     assert TimeSeries.from_table(path, columns={"time": "t_h", "input": "P", "output": "Ta"},
                                  units={"time": "h"}).n_samples == 190
+
+
+def test_a_units_comment_may_name_a_column_without_its_unit_suffix(tmp_path):
+    """A new user's "# units: t [min], q [W], T [degC]" over the header "t_min,q_W,T_degC": the time's unit was
+    matched but the input's was not, so W against the model's kW went unchecked (g 1000 times off, success). The
+    comment's names now match a column by its name without the unit it ends in, as for the time; a name that is no
+    column either way is said."""
+    rows = "0,0,0\n1,1,0.1\n2,1,0.2\n3,0,0.25\n4,0,0.2\n"
+    (tmp_path / "a.csv").write_text("# units: t [min], q [W], T [degC]\nt_min,q_W,T_degC\n" + rows)
+    rec = si.read_data(tmp_path / "a.csv", columns={"time": "t_min", "input": "q_W", "output": "T_degC"},
+                       units={"time": "min"})
+    assert rec.stated_units["input"] == (("q_W", "W"),) and rec.stated_units["output"] == (("T_degC", "degC"),)
+    (tmp_path / "b.csv").write_text("# units: t [min], q [kW], T [degC]\ntime_min,power,temp\n" + rows)
+    with pytest.warns(si.DataWarning, match=r"the units comment names 't', 'q', 'T', which are no columns"):
+        rec = si.read_data(tmp_path / "b.csv", columns={"time": "time_min", "input": "power", "output": "temp"},
+                           units={"time": "min"})
+    assert rec.stated_units["input"] == (("power", None),)

@@ -411,6 +411,10 @@ def _name_unit(name: str) -> str | None:
     return m.group(1) if m else None
 
 
+_UNIT_SUFFIX = re.compile(r"^(.+?)\s*(?:\[[^\[\]]*\]|\([^()]*\)|_[^_\s\[\]()]+)\s*$")
+"""A column's name and a unit it ends in (``q_W``, ``h2 [mm]``, ``T (degC)``): group 1 the name without it."""
+
+
 def _column_units(src: _Csv) -> dict[str, str]:
     """:func:`stated_column_units` of a file already read."""
     out: dict[str, str] = {}
@@ -749,7 +753,22 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
             record = IOData(u, y, step, time_unit=target)
     if isinstance(src, _Csv):  # the columns read and the units the file states for them (a CSV column: a channel)
         stated = _column_units(src)
-        units: dict = {role: tuple((n, stated.get(n) or _name_unit(n)) for n in names)
+        # a comment may name a column without the unit its name ends in ("q [W]" over "q_W"), as it may the time
+        # column's ("t [min]" over "t_min"): a new user's input in W was not checked against the model's kW
+        stem = {n: m.group(1) for n in src.names if (m := _UNIT_SUFFIX.match(n))}
+        stray = [n for n in stated if n not in src.names and n not in stem.values() and n not in _UNIT_DIMENSION]
+        if stray:
+            warnings.warn(f"{src.where}: the units comment names {', '.join(map(repr, stray))}, which "
+                          f"{'is no column' if len(stray) == 1 else 'are no columns'} of the file (its columns: "
+                          f"{', '.join(src.names)}): the unit stated there is not checked against the model's; "
+                          "name the columns as in the header", DataWarning, stacklevel=3)
+        for n in (*inputs, *outputs):
+            said, named = stated.get(n) or stated.get(stem.get(n, n)), _name_unit(n)
+            if said and named and said != named:
+                warnings.warn(f"{src.where}: column {n!r} is named in {named} but the units comment states {said} "
+                              "for it: the comment's is checked against the model's; make them agree",
+                              DataWarning, stacklevel=3)
+        units: dict = {role: tuple((n, stated.get(n) or stated.get(stem.get(n, n)) or _name_unit(n)) for n in names)
                        for role, names in (("input", inputs), ("output", outputs))}
         units["file"] = src.where  # which file says so, for messages about several
         object.__setattr__(record, "stated_units", units)  # on the object read: metadata, not a field
