@@ -11,6 +11,21 @@ import pytest
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
 
+@pytest.fixture
+def groebner(monkeypatch):
+    """The global step with every chain inversion turned off (``proves_global`` says nothing): the reference the
+    inversions of :mod:`symid.structural.ladder` and its neighbours are checked against. A function of a model."""
+    import symid.structural.global_ as gg
+    from symid.structural.msolve import msolve_binary
+
+    def run(model):
+        with monkeypatch.context() as patch:
+            patch.setattr(gg, "proves_global", lambda *a, **k: "")
+            return gg.generic_global(model, rank=len(model.parameters), msolve=msolve_binary())
+
+    return run
+
+
 @pytest.fixture(scope="session")
 def families():
     """``benchmarks/identifiability_models.py``: the model families of the identifiability benchmark (issue 17)."""
