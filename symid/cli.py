@@ -204,8 +204,10 @@ def _read_data(args: argparse.Namespace, command: str, files: list[str] | None =
     else:
         columns = _pairs(args.columns, "--columns", command, repeatable=("input", "output"))
         units = _pairs(args.units, "--units", command)
+        # the record's time unit is the model's: --time-unit, else the model file's time_unit, else seconds
+        time_unit = args.time_unit or getattr(args, "model_time_unit", None) or "s"
         records = [read_data(f, columns=columns, units=units or None, dt=args.dt, kind=args.kind,
-                             time_unit=args.time_unit, delimiter="\t" if args.delimiter == "tab" else args.delimiter)
+                             time_unit=time_unit, delimiter="\t" if args.delimiter == "tab" else args.delimiter)
                    for f in files]
     if len(records) == 1:
         return records[0]
@@ -222,6 +224,7 @@ def _entry_and_data(args: argparse.Namespace, command: str):
     from symid.zoo import ZooEntry, load_model
 
     entry = load_model(args.model)
+    args.model_time_unit = getattr(entry, "time_unit", None)
     if args.data:
         data = _read_data(args, command)
         source = ", ".join(_data_files(args))
@@ -399,11 +402,15 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     if time_unit is not None:  # the rates are per this unit: say it, and how to keep the file's own
         stated = (dict(_pairs(args.units, "--units", "identify")) if getattr(args, "units", None) else {}).get("time")
         keep = (f" (the file's times, in {stated}, were converted; --time-unit {stated} keeps them)"
+                if stated and stated.strip().lower() != time_unit.lower() and spec.time_unit is None else
+                f" (the file's times, in {stated}, were converted to the model file's time_unit)"
                 if stated and stated.strip().lower() != time_unit.lower() else "")
-        _say(args, f"time unit: {time_unit}, the record's and the estimates' (rates per {time_unit}){keep}")
         given = [w for w, v in (("known values", spec.known), ("start", spec.start), ("scale", spec.scale),
                                 ("bounds", spec.bounds)) if v]
-        if time_unit != "s" and given:  # a value written per second would be off by the factor, silently
+        unstated = (f"; the model file states no time_unit, so its values ({', '.join(given)}) are taken per "
+                    f"{time_unit}" if given and spec.time_unit is None else "")
+        _say(args, f"time unit: {time_unit}, the record's and the estimates' (rates per {time_unit}{unstated}){keep}")
+        if time_unit != "s" and given and spec.time_unit is None:  # a value written per second would be off
             _show_text_warning(args, f"the {', '.join(given)} of the model file and the command line are taken as "
                                      f"they are, in the model's time unit {time_unit}: symid converts none of them, "
                                      f"so a rate written per second is off by the factor between s and "
@@ -737,8 +744,9 @@ def _add_data_arguments(p: argparse.ArgumentParser, default: str) -> None:
                         "time=s|ms|us|min|h|d")
     g.add_argument("--dt", type=_positive_seconds, metavar="DT",
                    help="sample time of a table without a time column (in the time unit of --units)")
-    g.add_argument("--time-unit", dest="time_unit", default="s", metavar="UNIT",
-                   help="time unit of the record built, i.e. of the model (default: s)")
+    g.add_argument("--time-unit", dest="time_unit", default=None, metavar="UNIT",
+                   help="time unit of the record built, i.e. of the model (default: the model file's time_unit, "
+                        "else s)")
     g.add_argument("--kind", choices=("FrequencyData", "IOData", "TimeSeries"),
                    help="what the table holds (default: FrequencyData with a frequency column, else IOData, "
                         "equally spaced samples; give TimeSeries for unevenly spaced times or outputs not "

@@ -17,6 +17,7 @@ about its parameters::
     title = "Two masses on springs, force on mass 2, position of mass 1"
     input_units, output_units = "N", "m"             # for plot labels: H in m/N
     initial_state = "estimate"                       # time series: records that do not start at rest
+    time_unit = "s"                                  # the time unit the model's rates are written in
 
 Only ``model`` is required (any name works when the file defines exactly one model;
 with several, the one to use must be called ``model``). The other names are optional
@@ -65,7 +66,7 @@ EXAMPLE = ('    k, c = si.parameters("k c", positive=True)              # after 
 
 _MODEL_TYPES = (StateSpaceModel, SecondOrderModel)
 _OPTIONAL = ("known", "start", "scale", "bounds", "title", "source", "notes", "input_units", "output_units",
-             "initial_state")
+             "initial_state", "time_unit")
 
 
 def _model_error(where: str, what: str) -> ModelError:
@@ -111,6 +112,14 @@ class ModelFile:
         ``symid identify`` passes it on (a method that takes no initial state is told so); in
         Python give it yourself, ``si.identify(spec.free_model(), io,
         initial_state=spec.initial_state)``. ``None`` when not given.
+    time_unit : str or None
+        The time unit the model's rates, and the file's ``known``, ``start``, ``scale`` and
+        ``bounds``, are written in (``"s"``, ``"min"``, ``"h"``, ...; canonical name).
+        ``symid identify`` reads a table's times into it (unless ``--time-unit`` says
+        otherwise), and :func:`symid.identify` warns when a record's ``time_unit``, or a
+        frequency response's rad/s, is another unit: symid converts no rate, so a factor
+        between them would go into the estimates unsaid. ``None`` when not given (the CLI
+        then reads records in seconds).
     path : str or None
         The file it was read from (``None`` for a model built in Python).
 
@@ -141,6 +150,7 @@ class ModelFile:
     input_units: tuple[str, ...] = ()
     output_units: tuple[str, ...] = ()
     initial_state: str | None = None
+    time_unit: str | None = None
     path: str | None = None
 
     def free_model(self, known: Mapping[str, float] | None = None) -> Any:
@@ -270,6 +280,8 @@ class ModelFile:
             lines.append(f"units: inputs {', '.join(self.input_units)}; outputs {', '.join(self.output_units)}")
         if self.initial_state:
             lines.append(f"initial state: {self.initial_state}")
+        if self.time_unit:
+            lines.append(f"time unit: {self.time_unit} (rates per {self.time_unit})")
         return lines
 
     def summary(self) -> str:
@@ -293,7 +305,7 @@ class ModelFile:
                 "known": dict(self.known), "start": None if self.start is None else dict(self.start),
                 "scale": dict(self.scale), "bounds": {k: list(v) for k, v in self.bounds.items()},
                 "input_units": list(self.input_units), "output_units": list(self.output_units),
-                "initial_state": self.initial_state}
+                "initial_state": self.initial_state, "time_unit": self.time_unit}
 
 
 def substitute_known(model: Any, known: Mapping[str, float]) -> Any:
@@ -460,10 +472,17 @@ def from_module(module: ModuleType, *, name: str, where: str, path: str | None =
     if initial is not None and (not isinstance(initial, str) or initial not in ("estimate", "zero")):
         raise ModelError(f"{where}: initial_state is 'estimate' (records that do not start at rest) or 'zero'; got "
                          f"{initial!r}")
+    time_unit = _time_unit(declared.get("time_unit"), where)
+    io_units: dict[str, tuple[str, ...]] = {}
     if units_in:  # what the data files' stated units are compared with (si.identify)
-        model.io_units = {"input": tuple(units_in), "output": tuple(units_out)}
+        io_units.update(input=tuple(units_in), output=tuple(units_out))
+    if time_unit is not None:  # and the records' time unit
+        io_units["time"] = (time_unit,)
+    if io_units:
+        model.io_units = io_units
     common = dict(name=name, model=model, known=known, start=start, scale=scale, bounds=bounds,
-                  input_units=units_in, output_units=units_out, initial_state=initial, path=path, **texts)
+                  input_units=units_in, output_units=units_out, initial_state=initial, time_unit=time_unit,
+                  path=path, **texts)
     zoo_names = [k for k in ("truth", "make_data") if k in names]
     if not zoo_names:
         return ModelFile(**common)
@@ -622,6 +641,19 @@ def _bounds_values(value: Any, free: list[str], known: Mapping[str, float], wher
             raise ModelError(f"{where}: bounds {k} = ({lo:g}, {hi:g}); the low end must be below the high end")
         out[k] = (lo, hi)
     return out
+
+
+def _time_unit(value: Any, where: str) -> str | None:
+    """The canonical name of a model file's ``time_unit`` (None when not given), or a ModelError naming it."""
+    if value is None:
+        return None
+    from symid.data.units import canonical_unit
+    from symid.errors import DataError
+
+    try:
+        return canonical_unit(value, "time", "time_unit")
+    except DataError as exc:
+        raise ModelError(f"{where}: {exc}") from None
 
 
 def _units(value: Any, n: int, what: str, where: str) -> tuple[str, ...]:

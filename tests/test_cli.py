@@ -443,7 +443,9 @@ def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
     captured = capsys.readouterr()
     doc = json.loads(captured.out)
     assert code == 0 and doc["result"]["cost_kind"].startswith("weighted relative output misfit")
-    assert doc["time_unit"] == "h" and "time unit: h, the record's and the estimates' (rates per h)" in captured.err
+    assert doc["time_unit"] == "h"
+    assert ("time unit: h, the record's and the estimates' (rates per h; the model file states no time_unit, so "
+            "its values (start) are taken per h)") in captured.err
     main(["identify", str(tmp_path / "pk.py"), "--data", str(tmp_path / "pk.csv"), "--columns", "time=t",
           "input=dose", "output=conc", "--units", "time=h", "--time-unit", "h", "--kind", "TimeSeries",
           "--out", str(tmp_path / "out")])
@@ -452,6 +454,36 @@ def test_an_error_model_reaches_a_time_series_fit(tmp_path, capsys):
     assert "time unit: h\n" in (tmp_path / "out" / "summary.txt").read_text()
     assert doc["result"]["options"]["variance"] == {"proportional": 0.02, "additive": 0.01, "weights": "prediction"}
     np.testing.assert_allclose([doc["result"]["theta"]["k"], doc["result"]["theta"]["q"]], [0.3, 0.05], rtol=1e-6)
+
+
+def test_a_model_files_time_unit_is_the_records(tmp_path, capsys):
+    """A new user's stirred tank with rates per minute in the model file, fitted on a log in seconds: every rate
+    came out 60 times off with success=True, and `time_unit = "min"` in the file was passed over in silence. The
+    file's time_unit is now the unit the table's times are read into (reference: the rates the record was
+    simulated with, per minute; exact data, so the fit recovers them to its tolerance), and a record read in
+    another unit (--time-unit s) is warned about."""
+    (tmp_path / "tank.py").write_text(
+        "import symid as si\n"
+        "a, b = si.parameters('a b', positive=True)\n"
+        "model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])\n"
+        "start = {'a': 0.3, 'b': 1.0}\n"
+        "time_unit = 'min'\n")
+    a, b = si.parameters("a b", positive=True)
+    u = np.where(np.arange(240) % 80 < 40, 1.0, -1.0)
+    io = si.simulate_io(si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]]), {"a": 0.6, "b": 1.8}, u, 5.0 / 60.0)
+    rows = "\n".join(f"{5.0 * i},{u[i]},{float(io.y[i, 0])!r}" for i in range(240))
+    (tmp_path / "log.csv").write_text(f"t,u,y\n{rows}\n")
+    args = ["identify", str(tmp_path / "tank.py"), "--data", str(tmp_path / "log.csv"), "--columns", "time=t",
+            "input=u", "output=y", "--units", "time=s"]
+    assert main([*args, "--json"]) == 0
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out)
+    assert doc["time_unit"] == "min" and "the file's times, in s, were converted to the model file's time_unit" \
+        in captured.err
+    np.testing.assert_allclose([doc["result"]["theta"]["a"], doc["result"]["theta"]["b"]], [0.6, 1.8], rtol=1e-6)
+    main([*args, "--time-unit", "s", "--max-iter", "1"])
+    assert "the model file's time unit is min (its rates are per min), but the record's is s" \
+        in capsys.readouterr().err
 
 
 def _infusion_files(tmp_path, records: dict[str, int]) -> None:

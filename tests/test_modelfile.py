@@ -375,6 +375,41 @@ def test_a_unit_per_second_against_a_record_in_milliseconds_warns():
                    "axis) is ms" in t for t in said) == warned, said
 
 
+def test_a_model_files_time_unit_is_read_and_compared_with_the_records(tmp_path):
+    """`time_unit = "min"` in a model file was ignored (a new user's rates per minute, record in seconds: every
+    rate 60 times off, success=True). It is read (canonical name, in the summary and to_dict), a unit symid does not
+    know is refused naming it, and si.identify warns when a record's time unit, or a frequency response's rad/s,
+    is another; the same unit says nothing."""
+    import warnings
+
+    import numpy as np
+
+    text = ("import symid as si\n"
+            "a, b = si.parameters('a b', positive=True)\n"
+            "model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])\n"
+            "time_unit = {!r}\n")
+    (tmp_path / "tank.py").write_text(text.format("minutes"))
+    spec = si.load_model(tmp_path / "tank.py")
+    assert spec.time_unit == "min" and spec.to_dict()["time_unit"] == "min"
+    assert "time unit: min (rates per min)" in spec.summary()
+    (tmp_path / "bad.py").write_text(text.format("fortnight"))
+    with pytest.raises(si.ModelError, match=r"bad.py': time_unit: unknown unit 'fortnight'"):
+        si.load_model(tmp_path / "bad.py")
+    model = spec.free_model()
+    u = np.where(np.arange(60) < 30, 1.0, 0.0)
+    omega = np.array([0.1, 1.0, 10.0])
+    frf = si.FrequencyData(omega, (1.8 / (1j * omega + 0.6)).reshape(-1, 1, 1))
+    for data, warned in ((si.IOData(u, u, 5.0, time_unit="s"), "the record's is s"),
+                         (si.IOData(u, u, 5.0 / 60, time_unit="min"), None),
+                         (frf, "the frequencies are in rad/s: give ω in rad/min")):
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            si.identify(model, data, x0={"a": 1.0, "b": 1.0}, identifiability_check=False, max_iter=1)
+        said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)
+                and "the model file's time unit is min" in str(w.message)]
+        assert (said[0] if said else None) is None if warned is None else warned in said[0], said
+
+
 def test_a_known_value_outside_the_model_files_bounds_is_said(tmp_path):
     """A new user's `--known k2=5` against the model file's bounds k2 in [10, 1000]: nothing said, and the fit's
     advice named another parameter's bound."""

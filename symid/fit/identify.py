@@ -91,7 +91,8 @@ _CASELESS = frozenset({"deg", "rad", "degree", "degrees", "radian", "radians"})
 def unit_mismatches(model: Any, data: Any) -> list[str]:
     """What a data file's stated input and output units (``data.stated_units``) say against the model's declared
     ones (``model.io_units``, from a model file): one sentence per channel whose units differ; [] when either
-    side states none.
+    side states none. A model file's ``time_unit`` (``model.io_units["time"]``) is compared with a record's
+    ``time_unit`` and with the rad/s of a frequency response or spectra.
 
     symid converts neither, so a factor between them goes into the estimates without a word: a new user's
     encoder angles in degrees fitted a model in radians with ``success=True`` and every inertia off by π/180.
@@ -122,6 +123,18 @@ def unit_mismatches(model: Any, data: Any) -> list[str]:
                     if text not in out:
                         out.append(text)
         time_unit = getattr(record, "time_unit", None) if hasattr(record, "t") else None
+        model_time = (declared.get("time") or (None,))[0]
+        on_omega = time_unit is None and type(record).__name__ in ("FrequencyData", "SpectralData")
+        if model_time is not None and (time_unit or ("s" if on_omega else model_time)) != model_time:
+            # a new user's rates per minute on a record read in seconds: success=True, every rate 60 times off
+            text = (f"the model file's time unit is {model_time} (its rates are per {model_time}), but the "
+                    + (f"record's is {time_unit}: read the record in {model_time} (time_unit={model_time!r}; "
+                       f"--time-unit {model_time})" if not on_omega else
+                       f"frequencies are in rad/s: give ω in rad/{model_time} (times the seconds in one {model_time})")
+                    + f" or write the model's rates per {time_unit or 's'}: symid converts no rate, so a factor "
+                      f"between them goes into the estimates")
+            if text not in out:
+                out.append(text)
         for role in ("input", "output"):
             for want in declared.get(role, ()):
                 per = _per_time(want)
