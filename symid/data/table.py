@@ -394,7 +394,7 @@ def stated_column_units(path: Any, delimiter: str = ",") -> dict[str, str]:
     return _column_units(_Csv(path, delimiter))
 
 
-_NAME_UNIT = re.compile(r"^.*\S\s*[\[(]\s*([^\[\]()]*[A-Za-zµμ°%][^\[\]()]*?)\s*[\])]\s*$")
+_BRACKETED_UNIT = re.compile(r"^.*\S\s*[\[(]\s*([^\[\]()]*[A-Za-zµμ°%][^\[\]()]*?)\s*[\])]\s*$")
 """A unit at the end of a column's own name: ``h2 [mm]``, ``T (degC)``."""
 
 
@@ -407,7 +407,7 @@ def _name_unit(name: str) -> str | None:
     >>> _name_unit("h2 [mm]"), _name_unit("T (degC)"), _name_unit("u[1]"), _name_unit("h2")
     ('mm', 'degC', None, None)
     """
-    m = _NAME_UNIT.match(str(name))
+    m = _BRACKETED_UNIT.match(str(name))
     return m.group(1) if m else None
 
 
