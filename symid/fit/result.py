@@ -73,7 +73,18 @@ _IN_TIME = {  # the whiteness advice for residuals ordered in time (measured sam
 
 def _offset_advice(offset: Mapping[str, Any]) -> str:
     """The NEXT line for a time-series misfit that a free initial state or a constant offset explains
-    (:meth:`symid.fit.timeseries.oe.OutputError.initial_offset`)."""
+    (:meth:`symid.fit.timeseries.oe.OutputError.initial_offset`).
+
+    Examples
+    --------
+    >>> from symid.fit.result import _offset_advice
+    >>> _offset_advice({"kind": "offset", "record": 0, "output": 0, "mean": 0.1, "misfit": 4.8e-4,
+    ...                 "after": 4.0e-4})[:67]
+    'the residual is in part (17% of the misfit) a constant offset (outp'
+    >>> _offset_advice({"kind": "offset", "record": 0, "output": 0, "mean": 0.1, "misfit": 4.8e-4,
+    ...                 "after": 1e-5})[:45]
+    'the residual is mostly a constant offset (out'
+    """
     where = f"record {offset['record']}, " if offset["record"] else ""
     drop = ("" if offset.get("after") is None else
             f"this estimate's misfit would fall from {offset['misfit']:.3g} to {offset['after']:.3g}")
@@ -94,7 +105,11 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
                 f"temperatures, positions), subtract the operating point from the inputs and outputs (deviation "
                 f"variables), or model it: a constant input (a column of ones) whose gain is a parameter, with the "
                 f"initial state estimated (guide: records around an operating point)")
-    return (f"the residual is mostly a constant offset ({where}output {offset['output']}: mean residual "
+    share = (None if offset.get("after") is None or not offset.get("misfit") else
+             1.0 - float(offset["after"]) / float(offset["misfit"]))
+    # "mostly" only where the offset explains most of the misfit (a new user's record: 16 % of it was "mostly")
+    amount = "mostly" if share is None or share >= 0.5 else f"in part ({share:.0%} of the misfit)"
+    return (f"the residual is {amount} a constant offset ({where}output {offset['output']}: mean residual "
             f"{offset['mean']:.6g}; with each output's mean residual removed {drop}): the record lies around an "
             f"operating point. Subtract the operating point from the inputs and outputs (deviation variables), or "
             f"model it: a constant input (a column of ones) whose gain is a parameter, with the initial state "
