@@ -354,7 +354,7 @@ def _run_identify(identify, model, data, args, x0, opts: dict, from_file: set[st
     while True:
         try:
             starts = f"{args.starts} start{'s' if args.starts > 1 else ''}"
-            with Heartbeat(f"{args.method}, {starts}", after=10.0, every=20.0):
+            with Heartbeat(f"{args.method}, {starts}"):
                 return identify(model, data, method=args.method, x0=x0, starts=args.starts, seed=args.seed,
                                 polish=args.polish, progress=args.starts > 1, **opts), opts  # (own heartbeat)
         except OptionError as exc:

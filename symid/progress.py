@@ -9,7 +9,7 @@ from typing import TypeVar
 
 from tqdm import tqdm
 
-__all__ = ["HEARTBEAT_S", "Heartbeat", "progress_bar"]
+__all__ = ["HEARTBEAT_AFTER_S", "HEARTBEAT_EVERY_S", "HEARTBEAT_S", "Heartbeat", "progress_bar"]
 
 T = TypeVar("T")
 
@@ -17,6 +17,14 @@ T = TypeVar("T")
 HEARTBEAT_S = 30.0
 """Off a terminal and a notebook, with ``enabled=None``: a line on standard error at most this often (none
 before it): a long run in a batch job or a redirected script says how far it is."""
+
+
+HEARTBEAT_AFTER_S = 10.0
+"""A :class:`Heartbeat`'s first line comes after this many seconds of a run (by default): the command line's and
+``si.identify``'s one start alike (a new user's single SCR start in Python was silent for 30 s)."""
+
+HEARTBEAT_EVERY_S = 20.0
+"""A :class:`Heartbeat`'s later lines come this often (by default)."""
 
 
 def _interactive() -> bool:
@@ -53,14 +61,15 @@ def progress_bar(items: Iterable[T], *, desc: str, enabled: bool | None = None, 
 class Heartbeat:
     """A line on standard error every ``every`` seconds once a run has taken ``after``: ``with Heartbeat("lm, 1
     start"):`` around work that shows no bar (one start) says it is alive, "symid: still estimating (lm, 1
-    start): 60 s so far"; ``enabled=False`` says nothing. A new user's single start ran 77 s without a word."""
+    start): 30 s so far"; ``enabled=False`` says nothing. A new user's single start ran 77 s without a word.
+    Defaults: :data:`HEARTBEAT_AFTER_S`, :data:`HEARTBEAT_EVERY_S`."""
 
     def __init__(self, what: str, *, after: float | None = None, every: float | None = None, enabled: bool = True):
         import threading
 
         self.what, self.enabled = what, enabled
-        self.after = HEARTBEAT_S if after is None else after
-        self.every = HEARTBEAT_S if every is None else every
+        self.after = HEARTBEAT_AFTER_S if after is None else after
+        self.every = HEARTBEAT_EVERY_S if every is None else every
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._beat, daemon=True)
 

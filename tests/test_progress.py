@@ -21,7 +21,8 @@ def test_a_long_run_off_a_terminal_says_how_far_it_is(monkeypatch, capsys):
 
 def test_one_long_start_says_it_is_alive(monkeypatch, capsys):
     """A new user's single start ran 77 s in Python without a word (the bar is for several starts). identify's
-    default now says every HEARTBEAT_S seconds that it is still estimating; progress=False says nothing."""
+    default now says after HEARTBEAT_AFTER_S seconds (10, as the command line) that it is still estimating;
+    progress=False says nothing."""
     import time
 
     import numpy as np
@@ -40,7 +41,7 @@ def test_one_long_start_says_it_is_alive(monkeypatch, capsys):
         return real_run(self, x0)
 
     monkeypatch.setattr(AutoFRF, "run", slow)
-    monkeypatch.setattr(prog, "HEARTBEAT_S", 0.1)
+    monkeypatch.setattr(prog, "HEARTBEAT_AFTER_S", 0.1)
     si.identify(model, frf, x0=[2.0, 0.5, 3.0], identifiability_check=False)
     assert "symid: still estimating (auto, 1 start): 0 s so far" in capsys.readouterr().err
     si.identify(model, frf, x0=[2.0, 0.5, 3.0], identifiability_check=False, progress=False)

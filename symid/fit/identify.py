@@ -239,7 +239,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         method without one.
     progress : bool, optional
         Show a progress bar over the starts (default: when there is more than one start
-        and standard error is a terminal).
+        and standard error is a terminal or a notebook's; elsewhere a line at most every
+        30 s; one start says "still estimating" after 10 s, then every 20 s). ``False``:
+        nothing.
     identifiability_check : bool
         Before estimating, run the cheap local identifiability test and emit an
         :class:`~symid.IdentifiabilityWarning` naming the parameters that no data of
@@ -359,7 +361,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         options_used["identifiability_check_s"] = check_s
     outcomes: list[StartOutcome] = []
     try:
-        # one start shows no bar: by default a line every 30 s says a long one is alive
+        # one start shows no bar: by default a line after 10 s, then every 20 s, says a long one is alive
         with Heartbeat(f"{estimator.method}, 1 start", enabled=progress is None and len(x0s) == 1):
             for x in progress_bar(x0s, desc=f"{estimator.method} starts", enabled=progress):
                 outcomes.append(estimator.run(x))
