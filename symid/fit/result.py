@@ -61,13 +61,17 @@ _FRF_ONLY = {  # advice that only a frequency response can follow, and what to s
 }
 
 
-_IN_TIME = {  # the whiteness advice for residuals ordered in time (measured samples) rather than frequency
+_IN_TIME = {  # the advice for residuals ordered in time (measured samples) rather than frequency
     "smooth across frequency": "smooth in time",
     "noise that grows with |H|": "noise that is not white (coloured, or growing with the signal)",
     # a new user's quarter car, its road input measured at 500 Hz and fitted as held: misfit 11 times the noise's,
     # parameters 3-12 % off, and no word of the hold
     "the data's units)": "the data's units, and the input between samples: one measured (sampled, band-limited) "
                          "rather than held by a DAC needs hold='bandlimited')",
+    # a new user's concentrations with 10 % proportional noise, 12 samples: the noise level alone said nothing of
+    # noise that grows with the value
+    "give noise_floor= (0.01 for 10 % noise)": "give noise_floor= (0.01 for 10 % noise), or the noise's error "
+                                               "model (variance={\"proportional\": 0.1} for 10 % of each value)",
 }
 
 
@@ -132,6 +136,9 @@ def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
     ...     "the residual is smooth in time")
     True
     >>> "hold='bandlimited'" in next_step("structured residual (lag-1 statistic 5.1 > 3)", frf=False, time=True)
+    True
+    >>> 'variance={"proportional": 0.1}' in next_step("misfit 2.84e-02 > 0.01 (over 10 % rms) and no noise floor "
+    ...                                                "given", frf=False, time=True)
     True
     """
     for key, advice in _NEXT_STEPS:
@@ -454,13 +461,16 @@ class IdentificationResult:
         if not self.success:
             if self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
-            elif (offset := self.options.get("initial_offset")) is not None:
-                lines.append("NEXT: " + _offset_advice(offset))
-            elif self.on_bounds:
+            elif self.on_bounds:  # before the signs of an offset, which then follow: a new user's concentrations
+                # in ug/L against a model in mg/L, every parameter on a bound, were told of the initial state alone
                 sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
                 lines.append(f"NEXT: the estimate sits on its bounds ({sides}) and does not fit: the data want values "
                              f"beyond them; widen those bounds if the physics allows, else check the model's "
                              f"structure and the data's units")
+                if (offset := self.options.get("initial_offset")) is not None:
+                    lines.append("NEXT (also): " + _offset_advice(offset))
+            elif (offset := self.options.get("initial_offset")) is not None:
+                lines.append("NEXT: " + _offset_advice(offset))
             elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
                                       time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")

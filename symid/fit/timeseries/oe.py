@@ -761,11 +761,14 @@ class OutputError(Estimator, FisherInformation):
 
     @staticmethod
     def _first_sample_gap(rows: list, misfit: float) -> dict[str, Any] | None:
-        """:meth:`initial_offset`'s last test: the first measured output beyond a fifth of that output's range over
-        the record (and 1e-9 of its largest value) from the model's."""
+        """:meth:`initial_offset`'s last test: the first measured output, at the record's first time, beyond a fifth
+        of that output's range over the record (and 1e-9 of its largest value) from the model's."""
         for e, (r, s, o, *_) in enumerate(rows):
             first = np.flatnonzero(np.all(o, axis=1))
-            if not first.size or not np.all(np.isfinite(s[first[0]])):
+            if not first.size or not np.all(np.isfinite(s[first[0]])) or r.t[first[0]] != r.t[0]:
+                # measured later than the record starts, the model's output there is its response to the input
+                # so far, not its initial state (a new user's infusion records, an empty cell at t = 0: a noisy
+                # first sample 0.5 h in was called "the record does not start where the model does")
                 continue
             k = int(first[0])
             y = np.where(o, r.y, np.nan)
