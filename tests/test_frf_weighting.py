@@ -232,8 +232,8 @@ def test_scr_variance_given_or_from_the_data_and_none_as_before():
     (np.zeros(40), r"variance must be finite and > 0 .* entry \(0, 0, 0\)"),
     (-np.ones(40), r"variance must be finite and > 0"),
     (np.where(np.arange(40) == 7, np.nan, 1e-4), r"entry \(7, 0, 0\) .* is nan"),
-    ("wrong", r"variance must be 'data', None or an array"),
-    ({"a": 1}, r"variance must be 'data', None or an array of real noise variances; got dict"),
+    ("wrong", r"variance must be 'data', 'relative', None or an array"),
+    ({"a": 1}, r"variance must be 'data', 'relative', None or an array of real noise variances; got dict"),
 ])
 def test_bad_variance_is_an_option_error(cls, variance, match):
     model, truth, w = one_mass()
@@ -409,3 +409,54 @@ def test_a_fit_that_misses_weak_lines_is_warned_about():
         res = si.identify(model, frf, method="ipopt", x0=typical, seed=0,
                           variance=(0.01 * np.abs(np.asarray(frf.H))) ** 2)
     assert "weak_lines_missed" not in res.options
+
+
+def _wide_one_mass(noise: str | None, seed: int = 0):
+    """One mass (m, c, k) = (1, 0.1, 1) over 0.1–100 rad/s (|H| over 5 decades), 60 lines, 2 % noise relative to
+    each value or of one level (2 % of the rms |H|) on every line."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    exact = si.simulate_frf(model, [1.0, 0.1, 1.0], np.logspace(-1, 2, 60))
+    if noise == "relative":
+        return model, si.simulate_frf(model, [1.0, 0.1, 1.0], exact.w, noise=0.02, seed=seed)
+    if noise == "additive":
+        H = np.asarray(exact.H)
+        rng = np.random.default_rng(seed)
+        e = (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape)) / np.sqrt(2)
+        return model, si.FrequencyData(exact.w, H + 0.02 * np.sqrt(np.mean(np.abs(H) ** 2)) * e)
+    return model, exact
+
+
+@pytest.mark.parametrize("method", ["lm", "auto", "ipopt", "scr"])
+def test_variance_relative_weighs_each_line_by_its_level(method):
+    """variance="relative" is the fit weighted by σ ∝ |H| at any level: the same estimate as variance=(ε·|H|)² for
+    any ε (the weights are scaled to mean 1), said in the options; a zero value of H cannot be weighed so and is
+    refused by name."""
+    model, frf = _wide_one_mass("relative")
+    kw = dict(method=method, x0=[1.2, 0.12, 0.9], identifiability_check=False)
+    rel = si.identify(model, frf, variance="relative", **kw)
+    given = si.identify(model, frf, variance=(0.02 * np.abs(np.asarray(frf.H))) ** 2, **kw)
+    assert rel.options["variance"] == "relative" and given.options["variance"] == "given"
+    np.testing.assert_allclose(rel.theta_vector, given.theta_vector, rtol=1e-6)
+    H = np.asarray(frf.H).copy()
+    H[3] = 0.0
+    with pytest.raises(si.OptionError, match=r"variance='relative' .* entry \(3, 0, 0\) .* is 0"):
+        si.identify(model, si.FrequencyData(frf.w, H), variance="relative", **kw)
+
+
+def test_a_fit_of_relative_noise_over_decades_names_variance_relative():
+    """A new user's load angle (|H| over 5 decades, 2 % noise relative to each value): the equally weighted fit put
+    the motor inertia on its bound, and nothing said that weighing the lines by their level (the maximum-likelihood
+    fit for such noise) was the cure. The summary now says so when the residual is likelier relative noise than
+    noise of one level and |H| spans more than a decade; not for noise of one level, an exact fit, or a fit weighted
+    by the noise already."""
+    model, frf = _wide_one_mass("relative")
+    res = si.identify(model, frf, method="lm", x0=[1.2, 0.12, 0.9], identifiability_check=False, variance=None)
+    note = res.options["relative_noise"]
+    assert 1.5 < note["level"] < 2.5 and note["decades"] > 4
+    assert "NOTE: the residual looks like noise relative to |H|" in res.summary()
+    assert "variance='relative'" in res.summary()
+    for data, kw in ((_wide_one_mass("additive")[1], {}), (_wide_one_mass(None)[1], {}),
+                     (frf, {"variance": "relative"})):
+        other = si.identify(model, data, method="lm", x0=[1.2, 0.12, 0.9], identifiability_check=False, **kw)
+        assert "relative_noise" not in other.options and "NOTE: the residual looks like" not in other.summary()

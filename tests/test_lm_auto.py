@@ -145,7 +145,7 @@ def test_verbose_prints_one_line_per_pass(capsys):
     ({"bands": 0}, "bands"),
     ({"time_limit": 0}, "time_limit"),
     ({"callback": 3}, "callback must be callable"),
-    ({"variance": "wrong"}, "variance must be 'data', None or an array"),
+    ({"variance": "wrong"}, "variance must be 'data', 'relative', None or an array"),
     ({"variance": np.zeros(60)}, r"finite and > 0"),
     ({"maxiter": 3}, "no option 'maxiter'"),
 ])

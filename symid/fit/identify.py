@@ -12,11 +12,12 @@ from typing import Any
 import numpy as np
 
 from symid.errors import DataWarning, IdentifiabilityWarning, OptionError
-from symid.fit.frf.misfit import FrfEstimator, weak_lines_missed
+from symid.fit.frf.misfit import FrfEstimator, relative_noise_note, weak_lines_missed
 from symid.fit.options import check_bool, scale_by_name, without_known
 from symid.fit.registry import check_model, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
 from symid.fit.starts import draw_starts
+from symid.fit.success import EXACT_FIT
 from symid.fit.uncertainty import FisherInformation
 from symid.interrupt import Interrupted
 from symid.progress import Heartbeat, progress_bar
@@ -449,6 +450,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if weak is not None:
             result = dataclasses.replace(result, options={**result.options, "weak_lines_missed": weak})
             warnings.warn(weak, DataWarning, stacklevel=2)
+        relative = None if result.cost <= EXACT_FIT else relative_noise_note(model, estimator.data,
+                                                                               result.theta_vector)
+        if relative is not None:  # said in the summary (a new user's load angle over 7 decades: Jm on its bound)
+            result = dataclasses.replace(result, options={**result.options, "relative_noise": relative})
     if noise_std is not None and result.uncertainty is not None:
         # the declared noise judges the fit (noise floor): a residual improbably smaller than it says the noise_std
         # is too large, and then a wrong model fits (a new user's k2 5 % off, noise_std 3 times the noise's: success,

@@ -476,10 +476,21 @@ class IdentificationResult:
                 lines.append(f"NEXT: {advice}")
         if self.success and self.on_bounds:
             sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
-            lines.append(f"ON BOUNDS: {sides}; the fit is accepted, but the uncertainty's note says whether the data "
-                         f"pull the estimate beyond them (then widen those bounds if the physics allows)")
+            unc = self.uncertainty
+            if unc is not None and "bounds" in (unc.note or ""):
+                pull = "the uncertainty's note (below) says whether the data pull the estimate beyond them"
+            else:  # no finite covariance (a near-singular Fisher information), or no uncertainty: nothing to say it
+                pull = ("nothing here says whether the data pull the estimate beyond them (the Fisher information "
+                        "gives no finite covariance there): make a parameter known, or check the model and the units")
+            lines.append(f"ON BOUNDS: {sides}; the fit is accepted, but {pull} (and if they do, widen those bounds "
+                         f"if the physics allows)")
         if self.options.get("weak_lines_missed"):  # a fit the success rule cannot judge there (symid.fit.frf.misfit)
             lines.append(f"WEAK LINES MISSED: {self.options['weak_lines_missed']}")
+        if (relative := self.options.get("relative_noise")) is not None:
+            lines.append(f"NOTE: the residual looks like noise relative to |H| ({relative['level']:.3g} %, likelier "
+                         f"than noise of one level on every line), and |H| spans {relative['decades']:.1f} decades: "
+                         f"with equal weights the largest lines decide. variance='relative' weighs every line by its "
+                         f"own level, the maximum-likelihood fit for such noise")
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")

@@ -210,7 +210,7 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         """Per frequency, the matrix Wᵢ that multiplies the (flattened) equations of ωᵢ in the noise-weighted
         solve at θ: block-diagonal, S^-½ for every column (sensors) or row (actuators) of the equation error
         (class text); ``None`` without a variance."""
-        var = self.line_variance
+        var = self.variance_shape  # the noise up to one factor, which leaves the weighted solve unchanged
         if var is None:
             return None
         th = np.asarray(theta, dtype=float)
@@ -302,7 +302,7 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         J, r0, solves, status, asked = self._J, self._r0, 1, "solved", False
         start = np.zeros(self.model.n_parameters) if x0 is None else np.asarray(x0, dtype=float)
         msg = f"linear least squares ({self.case} case)"
-        if self.line_variance is not None:
+        if self.variance_shape is not None:
             theta, J, r0, solves, status = self._gls(theta, report, deadline)
             msg = (f"linear least squares ({self.case} case), noise-weighted: generalised least squares on the "
                    f"equation error, {solves} solves")

@@ -299,9 +299,10 @@ class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
     def _noise_weighted(self, lam: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """The relaxation weights times the noise weight of every line, gᵢ / σ̄ᵢ for the Γ families and hᵢ / σ̄ᵢ
         for the Ψ ones (scaled to mean 1; class text); unchanged without a variance."""
-        if self.line_variance is None:
+        var = self.variance_shape
+        if var is None:
             return lam
-        sbar = np.sqrt(np.mean(self.line_variance.reshape(self.w.size, -1), axis=1))
+        sbar = np.sqrt(np.mean(var.reshape(self.w.size, -1), axis=1))
         out = {}
         for key, v in lam.items():
             q = (self._psi_scale if key.startswith("psi") else self._aux_scale) / sbar
