@@ -81,3 +81,19 @@ def test_a_method_that_cannot_take_the_data_is_refused_before_any_runs(monkeypat
     with pytest.raises(ModelError, match="srivc"):
         si.compare(model, io, methods=("oe", "srivc"), starts=2)
     assert runs == []
+
+
+def test_compare_takes_typical_values_for_every_method_that_takes_them():
+    """A new user's si.compare(..., scale=...) was a bare TypeError (si.identify takes scale=); the typical values
+    now go to every compared method that takes scale= (ls takes none), a method's own options winning, and serve
+    the random starts."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    truth = {"m": 2.0, "c": 0.5, "k": 300.0}
+    frf = si.simulate_frf(model, truth, np.linspace(5.0, 20.0, 20))
+    typical = {"m": 1.0, "c": 1.0, "k": 100.0}
+    cmp = si.compare(model, frf, methods=("auto", "ls", "ipopt"), starts=2, seed=0, truth=truth, scale=typical,
+                     options={"ipopt": {"scale": {"m": 3.0, "c": 1.0, "k": 100.0}}})
+    got = {s.method: s.result.options.get("scale") for s in cmp.stats}
+    assert got == {"auto": [1.0, 1.0, 100.0], "ls": None, "ipopt": [3.0, 1.0, 100.0]}
+    assert cmp["auto"].n_success == 2

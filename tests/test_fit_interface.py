@@ -406,3 +406,19 @@ def test_a_degree_sign_is_deg():
     from symid.fit.identify import _same_unit
 
     assert _same_unit("°C", "degC") and _same_unit("°", "deg") and not _same_unit("°C", "degF")
+
+
+def test_a_structurally_unidentifiable_fit_says_so_in_its_summary():
+    """A new user's sensor gain on a free-free chain: every parameter 25 000 times off with success=True, and the
+    structural verdict (known before the fit) was a warning on standard error only, not in summary.txt or
+    result.json. The summary and the options now carry it (reference: H = bc/(s + a) determines a and bc only)."""
+    a, b, c = si.parameters("a b c", positive=True)
+    model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[c]])
+    frf = si.simulate_frf(model, [1.0, 2.0, 3.0], np.logspace(-1, 1, 20))
+    with pytest.warns(si.IdentifiabilityWarning, match="b, c are not locally identifiable"):
+        res = si.identify(model, frf, x0=[1.0, 1.0, 1.0])
+    assert res.success and res.options["not_identifiable"] == {"parameters": ["b", "c"], "from_rest_only": False}
+    assert "NOT IDENTIFIABLE (structure): b, c cannot be determined" in res.summary()
+    assert res.to_dict()["options"]["not_identifiable"]["parameters"] == ["b", "c"]
+    quiet = si.identify(model, frf, x0=[1.0, 1.0, 1.0], identifiability_check=False)
+    assert "not_identifiable" not in quiet.options

@@ -193,12 +193,21 @@ class Comparison:
         return self.table()
 
 
+def _takes(kind: str, method: str, option: str) -> bool:
+    """Whether ``method`` of the data kind ``kind`` takes the keyword ``option`` (any of its estimators)."""
+    from symid.fit.catalog import estimator_classes
+
+    label = "black box / I/O" if kind == "black box" else kind
+    return any(option in cls.option_names() for k, m, cls in estimator_classes()
+               if k == label and m.split(" ")[0] == method)
+
+
 def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr", "ipopt"), *,
             starts: int | Sequence[Any] = 10, seed: int | None = 0, truth: Any = None, x0: Any = None,
             param_tol: float = 1e-3, param_error: str = "largest", progress: bool | None = None,
             options: dict[str, dict[str, Any]] | None = None,
             noise_floor: float | None = None, log: RunLog | None = None, executor: Executor | None = None,
-            draws: str | None = None) -> Comparison:
+            draws: str | None = None, scale: Any = None) -> Comparison:
     """Run several methods from identical starts and tabulate success and time.
 
     Parameters
@@ -244,8 +253,13 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         one file. A log written with other starts is refused.
     draws : {"scale", "normal"}, optional
         How the random starts are drawn, as in :func:`symid.identify`; with ``"scale"``,
-        the typical values are the first compared method's ``scale=`` option, else the
-        data's (frequency responses; time series through their frequency response).
+        the typical values are ``scale``, else the first compared method's ``scale=``
+        option, else the data's (frequency responses; time series through their frequency
+        response).
+    scale : float, sequence or dict, optional
+        Typical values of the parameters, as :func:`symid.identify`'s ``scale=``: given to
+        every compared method that takes ``scale=`` (a method's own ``options`` win) and
+        used for the random starts.
     executor : concurrent.futures.Executor, optional
         Run the starts of each method as tasks of this executor: a
         ``concurrent.futures.ProcessPoolExecutor`` on one machine, or a Dask cluster's
@@ -300,11 +314,18 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
         raise ModelError(f"options are keyed by method, e.g. options={{'ipopt': {{'time_limit': 10}}}} (a "
                          f"'+polish' method takes its base method's options); these keys are not methods "
                          f"compared here ({', '.join(methods)}): {', '.join(sorted(map(str, unknown)))}")
+    if scale is not None:  # shared typical values (a new user's compare(..., scale=...) was a bare TypeError)
+        scale = without_known(scale, known)
+        for base in {m.removesuffix("+polish") for m in methods}:
+            if _takes(kind.name, base, "scale") and not (isinstance(options.get(base), dict)
+                                                          and options[base].get("scale") is not None):
+                options[base] = {**(options.get(base) or {}), "scale": scale}
     param_tol = check_float("param_tol", param_tol, low=0, strict_low=True)
     error_of = _ERRORS[check_choice("param_error", param_error, tuple(_ERRORS))]
     truth_vec = None if truth is None else model.theta_vector(truth)
-    scale = next((scale_by_name(o, model.parameter_names)["scale"] for o in options.values()
-                  if isinstance(o, dict) and o.get("scale") is not None), None)
+    scale = (scale_by_name({"scale": scale}, model.parameter_names)["scale"] if scale is not None else
+             next((scale_by_name(o, model.parameter_names)["scale"] for o in options.values()
+                   if isinstance(o, dict) and o.get("scale") is not None), None))
     x0s = _start_list(model, data, starts, seed, x0, draws, scale)
     if log is not None and not isinstance(log, RunLog):
         raise ModelError(f"log must be a symid.runlog.RunLog; got {type(log).__name__}")

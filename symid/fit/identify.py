@@ -407,6 +407,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         offset = estimator.initial_offset(result.theta_vector)
         if offset is not None:
             extra["initial_offset"] = offset
+    if not_local:  # said in the summary too (the warning alone went to a terminal, not to summary.txt)
+        extra["not_identifiable"] = {"parameters": list(not_local),
+                                     "from_rest_only": getattr(model, "initial_state_kind", "zero") in ("known",
+                                                                                                       "affine")}
     if identifiability_check and not not_local and result.success:
         from symid.structural.analyse import several_solutions
 

@@ -491,6 +491,14 @@ class IdentificationResult:
                          f"than noise of one level on every line), and |H| spans {relative['decades']:.1f} decades: "
                          f"with equal weights the largest lines decide. variance='relative' weighs every line by its "
                          f"own level, the maximum-likelihood fit for such noise")
+        if (bad := self.options.get("not_identifiable")) is not None:
+            names = ", ".join(bad["parameters"])
+            lines.append(f"NOT IDENTIFIABLE (structure): {names} cannot be determined from "
+                         + ("the input-output map from rest (the model's nonzero initial state may determine them: "
+                            "check their standard errors)" if bad.get("from_rest_only") else
+                            "data of this kind: infinitely many values fit equally well, and these estimates are "
+                            "one of them. Fix some of them (known values) or reparameterise; "
+                            "si.identifiability(model) lists the combinations the data determine"))
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")
