@@ -401,10 +401,13 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     time_unit = _record_time_unit(data)
     if time_unit is not None:  # the rates are per this unit: say it, and how to keep the file's own
         stated = (dict(_pairs(args.units, "--units", "identify")) if getattr(args, "units", None) else {}).get("time")
-        keep = (f" (the file's times, in {stated}, were converted; --time-unit {stated} keeps them)"
-                if stated and stated.strip().lower() != time_unit.lower() and spec.time_unit is None else
-                f" (the file's times, in {stated}, were converted to the model file's time_unit)"
-                if stated and stated.strip().lower() != time_unit.lower() else "")
+        converted = bool(stated) and stated.strip().lower() != time_unit.lower()
+        keep = ("" if not converted else
+                f" (the file's times, in {stated}, were converted to {time_unit}, as --time-unit asks)"
+                if args.time_unit else
+                f" (the file's times, in {stated}, were converted to the model file's time_unit, {time_unit})"
+                if spec.time_unit else
+                f" (the file's times, in {stated}, were converted; --time-unit {stated} keeps them)")
         given = [w for w, v in (("known values", spec.known), ("start", spec.start), ("scale", spec.scale),
                                 ("bounds", spec.bounds)) if v]
         unstated = (f"; the model file states no time_unit, so its values ({', '.join(given)}) are taken per "

@@ -478,12 +478,13 @@ def test_a_model_files_time_unit_is_the_records(tmp_path, capsys):
     assert main([*args, "--json"]) == 0
     captured = capsys.readouterr()
     doc = json.loads(captured.out)
-    assert doc["time_unit"] == "min" and "the file's times, in s, were converted to the model file's time_unit" \
-        in captured.err
+    assert doc["time_unit"] == "min" and "the file's times, in s, were converted to the model file's time_unit, " \
+        "min" in captured.err
     np.testing.assert_allclose([doc["result"]["theta"]["a"], doc["result"]["theta"]["b"]], [0.6, 1.8], rtol=1e-6)
-    main([*args, "--time-unit", "s", "--max-iter", "1"])
-    assert "the model file's time unit is min (its rates are per min), but the record's is s" \
-        in capsys.readouterr().err
+    main([*args, "--time-unit", "h", "--max-iter", "1"])
+    said = capsys.readouterr()
+    assert "the model file's time unit is min (its rates are per min), but the record's is h" in said.err
+    assert "the file's times, in s, were converted to h, as --time-unit asks" in said.out
 
 
 def _infusion_files(tmp_path, records: dict[str, int]) -> None:

@@ -408,6 +408,10 @@ def test_a_model_files_time_unit_is_read_and_compared_with_the_records(tmp_path)
         said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)
                 and "the model file's time unit is min" in str(w.message)]
         assert (said[0] if said else None) is None if warned is None else warned in said[0], said
+    # the result says what its rates are per (a new user's Python result in minutes said it nowhere)
+    res = si.identify(model, si.IOData(u, u, 5.0 / 60, time_unit="min"), x0={"a": 1.0, "b": 1.0},
+                      identifiability_check=False, max_iter=1)
+    assert res.options["time_unit"] == "min" and "rates per min (the record's time unit)" in res.summary()
 
 
 def test_a_known_value_outside_the_model_files_bounds_is_said(tmp_path):

@@ -407,6 +407,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         offset = estimator.initial_offset(result.theta_vector)
         if offset is not None:
             extra["initial_offset"] = offset
+    records = data if isinstance(data, (list, tuple)) else [data]
+    if hasattr(records[0], "t") and getattr(records[0], "time_unit", None):  # what the rates are per
+        extra["time_unit"] = records[0].time_unit
     if not_local:  # said in the summary too (the warning alone went to a terminal, not to summary.txt)
         extra["not_identifiable"] = {"parameters": list(not_local),
                                      "from_rest_only": getattr(model, "initial_state_kind", "zero") in ("known",
