@@ -190,7 +190,9 @@ def affine_map(matrix: sp.Matrix, parameters: Sequence[sp.Symbol], name: str) ->
                 raise NonAffineError(
                     f"matrix {name}, entry ({i}, {j}) = {expr} is not affine in the parameters: it is nonlinear "
                     f"in {names}. symid needs every entry to be affine, X(θ) = X0 + Σ θi Xi. "
-                    f"Hint: {_hint(expr, involved)}.{_descriptor_hint(name, expr, involved)}",
+                    f"Hint: {_hint(expr, involved)}.{_descriptor_hint(name, expr, involved)} A value you know "
+                    f"(a gain, a mass) is a number in the matrix, not a parameter: known= is applied to a model "
+                    f"already built, so it cannot make an entry affine.",
                     matrix=name, entry=(i, j), expression=str(expr),
                     parameters=tuple(str(p) for p in involved))
             c0 = expr.xreplace({p: 0 for p in present}) if present else expr
