@@ -166,7 +166,15 @@ def black_box_response(model: Any, data: Any) -> BlackBoxResponse:
     from symid.fit.similarity.data import model_has_feedthrough
 
     if not isinstance(data, IOData):
-        return BlackBoxResponse(None, "no black-box start: N4SID takes one uniformly sampled record (IOData)")
+        # one record of equally spaced times with every output measured is an IOData read as a TimeSeries (a new
+        # user's heater log from from_table was told "N4SID takes one uniformly sampled record")
+        dt = getattr(data, "uniform_dt", None)
+        if dt is None or not np.all(np.isfinite(np.asarray(data.y))):
+            several = isinstance(data, (list, tuple))
+            return BlackBoxResponse(None, "no black-box start: N4SID takes one record of equally spaced samples with "
+                                          "every output measured" + (f"; these are {len(data)} records" if several
+                                                                     else ""))
+        data = IOData(data.u, data.y, dt, time_unit=data.time_unit)
     try:
         dss, misfit = _best_black_box(data, model.n_states, model_has_feedthrough(model))
         _, poles = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, np.zeros(0))
