@@ -43,8 +43,9 @@ order:
    A white verdict also needs a test that could have said otherwise: the statistic is at
    most √(k·nₑ) (:func:`whiteness_reach`; nₑ products carry the sum, k = 2 for complex
    residuals), so where that reach is below ``WHITENESS_POWER`` = 6 (twice the limit)
-   the residual is too short to tell from noise: the fit then counts only when the black
-   box below backs it or, with none, when one Gauss–Newton step finds it a minimum of the
+   the test cannot judge the residual (too few values, or a few large ones, carry it): the
+   fit then counts only when the black box below backs it or, with none, when one
+   Gauss–Newton step finds it a minimum of the
    misfit (the step above); with neither it is refused. A local minimum passes that step
    too, so the fit text says the test was weak and asks for ``noise_floor=``. For a
    residual of independent noise the reach is about 0.64·√N for N real values and
@@ -141,7 +142,7 @@ class FitTest:
     ----------
     fits : bool
     rule : str
-        ``"exact"``, ``"noise floor"``, ``"whiteness"``, ``"weak whiteness"`` (a white residual too short for
+        ``"exact"``, ``"noise floor"``, ``"whiteness"``, ``"weak whiteness"`` (a white residual too weakly tested for
         the test to have refused it, backed by a black box or one Gauss–Newton step), ``"local step"``,
         ``"black box"`` or ``"none"`` (which test decided).
     text : str
@@ -446,10 +447,11 @@ def _fit_test(cost: float, *, n_data: int, n_parameters: int, residuals: np.ndar
                                                f"floor given{white}")
         reach = whiteness_reach(residuals)
         if ok and reach < WHITENESS_POWER:  # a verdict a black box or a Gauss–Newton step must back (fit_test)
-            return FitTest(True, "weak whiteness", f"misfit {cost:.2e} with a residual too short to tell from noise "
-                                                   f"(lag-1 statistic {z:.1f}, at most {reach:.1f} for any residual "
-                                                   f"of these sizes, below {WHITENESS_POWER:g}); no noise floor "
-                                                   f"given")
+            # "too short" read oddly for 400 values (a new user's): a few large values carry the statistic
+            return FitTest(True, "weak whiteness", f"misfit {cost:.2e} with a residual the whiteness test cannot "
+                                                   f"judge (a few large values carry it: the lag-1 statistic, "
+                                                   f"{z:.1f}, reaches at most {reach:.1f} for residuals of these "
+                                                   f"sizes, below {WHITENESS_POWER:g}); no noise floor given")
         return FitTest(ok, "whiteness", f"misfit {cost:.2e} with {'white' if ok else 'structured'} residual "
                                         f"(lag-1 statistic {z:.1f} {'≤' if ok else '>'} {WHITENESS_LIMIT:g}); "
                                         f"no noise floor given")
