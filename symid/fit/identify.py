@@ -457,9 +457,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if weak is not None:
             result = dataclasses.replace(result, options={**result.options, "weak_lines_missed": weak})
             warnings.warn(weak, DataWarning, stacklevel=2)
-        relative = None if result.cost <= EXACT_FIT else relative_noise_note(model, estimator.data,
-                                                                               result.theta_vector)
-        if relative is not None:  # said in the summary (a new user's load angle over 7 decades: Jm on its bound)
+        # a fit's residual is noise, a failed one's is not (the note would say nothing true of it)
+        relative = (None if result.cost <= EXACT_FIT or not result.success else
+                    relative_noise_note(model, estimator.data, result.theta_vector))
+        if relative is not None:  # said in the summary (a new user's load angle over 5 decades: Jm on its bound)
             result = dataclasses.replace(result, options={**result.options, "relative_noise": relative})
     if noise_std is not None and result.uncertainty is not None:
         # the declared noise judges the fit (noise floor): a residual improbably smaller than it says the noise_std

@@ -31,7 +31,35 @@ import scipy.linalg
 from symid.fit.sensitivity import frf_sensitivity
 from symid.fit.uncertainty import FisherInformation, Uncertainty, broadcast_noise
 
-__all__ = ["FrfFisher"]
+__all__ = ["FrfFisher", "residual_noise_model"]
+
+
+def residual_noise_model(H: np.ndarray, Hm: np.ndarray) -> str | None:
+    """Whether the residual H − Hm is likelier ``"additive"`` noise (one level per output on every line) or
+    ``"relative"`` noise (a level per output times |Hm|): the Gaussian likelihoods, each level at its maximum,
+    compared; None where either is undefined (a zero or non-finite value).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.frf.fisher import residual_noise_model
+    >>> Hm = np.logspace(0, -4, 50).reshape(-1, 1, 1)
+    >>> e = np.random.default_rng(0).standard_normal(Hm.shape)
+    >>> residual_noise_model(Hm * (1 + 0.01 * e), Hm), residual_noise_model(Hm + 1e-3 * e, Hm)
+    ('relative', 'additive')
+    """
+    r2, m2 = np.abs(H - Hm) ** 2, np.abs(Hm) ** 2
+    if not (np.all(np.isfinite(r2)) and np.all(m2 > 0) and np.all(np.isfinite(m2))):
+        return None
+    nll_add = nll_rel = 0.0
+    for j in range(H.shape[1]):  # per output: N log(mean r²/s²) + Σ log s² (s = 1 or |H|)
+        rj, mj = r2[:, j].ravel(), m2[:, j].ravel()
+        add, rel = float(np.mean(rj)), float(np.mean(rj / mj))
+        if not (add > 0 and rel > 0):
+            return None
+        nll_add += rj.size * np.log(add)
+        nll_rel += rj.size * np.log(rel) + float(np.sum(np.log(mj)))
+    return "additive" if nll_add < nll_rel else "relative"
 
 _MINIMISERS = ("ipopt", "lm", "auto")
 
@@ -106,18 +134,7 @@ class FrfFisher(FisherInformation):
             Hm = np.asarray(self.model.frequency_response(theta, self.data.w))
         except Exception:  # a model that cannot be evaluated there: the default shape
             return False
-        r2, m2 = np.abs(H - Hm) ** 2, np.abs(Hm) ** 2
-        if not (np.all(np.isfinite(r2)) and np.all(m2 > 0) and np.all(np.isfinite(m2))):
-            return False
-        nll_add = nll_rel = 0.0
-        for j in range(H.shape[1]):  # per output: N log(mean r²/s²) + Σ log s² (s = 1 or |H|)
-            rj, mj = r2[:, j].ravel(), m2[:, j].ravel()
-            add, rel = float(np.mean(rj)), float(np.mean(rj / mj))
-            if not (add > 0 and rel > 0):
-                return False
-            nll_add += rj.size * np.log(add)
-            nll_rel += rj.size * np.log(rel) + float(np.sum(np.log(mj)))
-        return bool(nll_add < nll_rel)
+        return residual_noise_model(H, Hm) == "additive"
 
     def noise_shape(self, theta: Any) -> np.ndarray:
         """|H(ωᵢ, θ)| / (√2 ‖H‖) per part for relative noise; 1 / (√2 ‖H‖) for additive noise

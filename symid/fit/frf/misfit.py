@@ -9,7 +9,7 @@ import numpy as np
 
 from symid.errors import DataError, ModelError, OptionError
 from symid.fit.base import Estimator
-from symid.fit.frf.fisher import FrfFisher
+from symid.fit.frf.fisher import FrfFisher, residual_noise_model
 
 __all__ = ["RELATIVE_NOTE_DECADES", "FrfEstimator", "NoiseWeighted", "check_frf", "estimated_variance_factor",
            "estimated_variance_inflation", "frf_variance", "frf_weights", "misfit_residuals", "relative_misfit",
@@ -305,7 +305,8 @@ when some entry's |H| spans more than this many decades over the lines (there th
 def relative_noise_note(model: Any, data: Any, theta: Any) -> dict[str, float] | None:
     """``{"level": %, "decades": d}`` when the residual of an equally weighted fit at θ is likelier relative noise
     (a level per output times |H(ωᵢ, θ)|) than additive noise (one level per output), as the uncertainty's noise
-    model decides, and some entry's |H| spans more than :data:`RELATIVE_NOTE_DECADES` decades; else None.
+    model decides (:func:`~symid.fit.frf.fisher.residual_noise_model`), and some entry's |H| spans more than
+    :data:`RELATIVE_NOTE_DECADES` decades; else None.
 
     With relative noise the maximum-likelihood fit weighs every line by its own level (``variance="relative"``);
     equal weights let the largest lines decide. Measured on the population benchmark's problems at 1 % relative
@@ -331,18 +332,9 @@ def relative_noise_note(model: Any, data: Any, theta: Any) -> dict[str, float] |
     decades = float(np.max(np.log10(np.max(np.abs(H), axis=0) / np.min(np.abs(H), axis=0))))
     if not decades > RELATIVE_NOTE_DECADES:
         return None
-    r2, m2 = np.abs(H - Hm) ** 2, np.abs(Hm) ** 2
-    nll_add = nll_rel = 0.0
-    for j in range(H.shape[1]):  # per output, each level at its maximum-likelihood value (as FrfFisher decides)
-        rj, mj = r2[:, j].ravel(), m2[:, j].ravel()
-        add, rel = float(np.mean(rj)), float(np.mean(rj / mj))
-        if not (add > 0 and rel > 0):
-            return None
-        nll_add += rj.size * np.log(add)
-        nll_rel += rj.size * np.log(rel) + float(np.sum(np.log(mj)))
-    if not nll_rel < nll_add:
+    if residual_noise_model(H, Hm) != "relative":
         return None
-    return {"level": 100.0 * float(np.sqrt(np.mean(r2 / m2))), "decades": decades}
+    return {"level": 100.0 * float(np.sqrt(np.mean(np.abs(H - Hm) ** 2 / np.abs(Hm) ** 2))), "decades": decades}
 
 
 class FrfEstimator(Estimator, FrfFisher):
