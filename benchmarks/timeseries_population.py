@@ -22,6 +22,12 @@ IPOPT and by trf, the lower misfit: ``REFERENCES``; or, not proven global, a mis
 most 1.001 times its misfit). A method that refuses the problem (an error naming why)
 fails it.
 
+``--input multisine`` drives the records with a band-limited input instead (:data:`INPUTS`), and the method
+label ``auto-decimate`` is ``auto`` with ``black_box_decimation=True`` (the two side by side measure it)::
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/timeseries_population.py --input multisine \
+        --sizes 2,3,5 --starts 2 --methods auto,auto-decimate --out timeseries_multisine.json
+
 Run (about 25 minutes on 2 cores)::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/timeseries_population.py [--workers 2]
@@ -52,7 +58,8 @@ from symid.runlog import write_json_atomic
 CLASSES = ("chain", "gains", "compartment", "state_space")
 METHODS = ("scr", "oe", "auto")
 VARIANTS = {"oe-trf": ("oe", {"solver": "trf"}), "auto-trf": ("auto", {"solver": "trf"}),
-            "oe-ipopt": ("oe", {"solver": "ipopt"}), "auto-ipopt": ("auto", {"solver": "ipopt"})}
+            "oe-ipopt": ("oe", {"solver": "ipopt"}), "auto-ipopt": ("auto", {"solver": "ipopt"}),
+            "auto-decimate": ("auto", {"black_box_decimation": True})}
 """Method labels beyond symid's own: (method, options)."""
 REFERENCES = ("oe-ipopt", "oe-trf")
 """The 1 % reference is the lower misfit of output error started at the truth by IPOPT (issue 14's definition) and by
@@ -73,21 +80,35 @@ KINDS = ("informed", "uninformed")
 TIME_LIMIT = 60.0
 
 
-def records(p: Any, noise: float, seed: int = 0) -> Any:
-    """The problem's input/output record (module docstring)."""
+INPUTS = ("white", "multisine")
+"""The input of the records: white Gaussian (the default), or a multisine of equal lines with random phases from the
+record's lowest frequency to 0.4 of the Nyquist frequency (a band-limited input, as a shaker's), unit rms."""
+
+
+def records(p: Any, noise: float, seed: int = 0, kind: str = "white") -> Any:
+    """The problem's input/output record (module docstring; ``kind``: :data:`INPUTS`)."""
     lam = np.abs(np.linalg.eigvals(p.model.state_space(p.truth).A))
     lam = lam[lam > 0]
     dt = 2 * math.pi / (10 * lam.max())
     n = int(min(4000, max(500, 20 * 2 * math.pi / lam.min() / dt)))
-    u = np.random.default_rng([seed, 7]).standard_normal(n)
+    rng = np.random.default_rng([seed, 7])
+    if kind == "multisine":
+        spectrum = np.zeros(n // 2 + 1, complex)
+        top = int(0.4 * (n // 2))
+        spectrum[1:top + 1] = np.exp(2j * math.pi * rng.random(top))
+        u = np.fft.irfft(spectrum, n)
+        u /= np.sqrt(np.mean(u**2))
+    else:
+        u = rng.standard_normal(n)
     return si.simulate_io(p.model, p.truth, u, dt, noise=noise or None, seed=seed + 1)
 
 
 def fit(cls: str, n: int, draw: int, noise: float, method: str | None, x0: list[float] | None, *,
-        time_limit: float = TIME_LIMIT, seed: int | None = None, draws: str | None = None) -> dict[str, Any]:
+        time_limit: float = TIME_LIMIT, seed: int | None = None, draws: str | None = None,
+        inputs: str = "white") -> dict[str, Any]:
     """One ``si.identify`` on the problem's record (``method=None``: the default), as a JSON-able record."""
     p = make_problem(cls, n, 0, check=False, draw=draw)
-    io = records(p, noise)
+    io = records(p, noise, kind=inputs)
     method, options = VARIANTS.get(method, (method, {}))  # type: ignore[arg-type]
     t0 = time.perf_counter()
     try:
@@ -120,8 +141,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", default="2,3")
     ap.add_argument("--starts", type=int, default=1, help="starts of each kind (default %(default)s)")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--methods", default=",".join(METHODS), help="default %(default)s; also oe-trf, auto-trf")
+    ap.add_argument("--methods", default=",".join(METHODS),
+                    help="default %(default)s; also oe-trf, auto-trf, auto-decimate")
     ap.add_argument("--out", default="timeseries_population.json", help="file name in benchmarks/results/")
+    ap.add_argument("--input", default="white", choices=INPUTS, help="the records' input (default %(default)s)")
     args = ap.parse_args(argv)
     sizes = [int(v) for v in args.sizes.split(",") if v]
     methods = [m for m in args.methods.split(",") if m]
@@ -139,12 +162,13 @@ def main(argv: list[str] | None = None) -> int:
                 if noise:
                     for ref_method in REFERENCES:
                         jobs[(p.name, noise, "reference", 0, ref_method)] = pool.submit(
-                            fit, p.cls, p.n_size, p.info["draw"], noise, ref_method, p.truth.tolist())
+                            fit, p.cls, p.n_size, p.info["draw"], noise, ref_method, p.truth.tolist(),
+                            inputs=args.input)
                 for kind in KINDS:
                     for i, x0 in enumerate(p.starts(kind, args.starts, seed=0)):
                         for m in methods:
                             jobs[(p.name, noise, kind, i, m)] = pool.submit(
-                                fit, p.cls, p.n_size, p.info["draw"], noise, m, x0.tolist())
+                                fit, p.cls, p.n_size, p.info["draw"], noise, m, x0.tolist(), inputs=args.input)
         results = {k: f.result() for k, f in jobs.items()}
     rows = []
     by = {p.name: p for p in problems}
@@ -185,6 +209,7 @@ def main(argv: list[str] | None = None) -> int:
     out = RESULTS / args.out
     write_json_atomic(out, {"benchmark": "timeseries_population", "command": "benchmarks/timeseries_population.py",
                             "git_commit": git_commit(), "sizes": sizes, "starts_per_kind": args.starts,
+                            "input": args.input,
                             "methods": methods, "time_limit": TIME_LIMIT, "table": table, "rows": rows,
                             "problems": {p.name: {"identifiability": p.info["identifiability"],
                                                   "global": bool(p.info.get("global"))} for p in problems},

@@ -72,7 +72,7 @@ import scipy.signal
 from symid.data import BlackBox, IOData
 from symid.errors import DataError
 
-__all__ = ["DiscreteStateSpace", "n4sid"]
+__all__ = ["DiscreteStateSpace", "fit_input_matrices", "n4sid"]
 
 #: A singular value below this fraction of the largest is treated as zero: the data do
 #: not hold that many states.
@@ -288,6 +288,49 @@ def _b_d_x0(io: IOData, A: np.ndarray, C: np.ndarray, feedthrough: bool, *, u: n
         D = sol[pos:pos + p * m].reshape(p, m)
         pos += p * m
     return B, D, sol[pos:]
+
+
+def fit_input_matrices(io: IOData, A: Any, C: Any, *, feedthrough: bool = True) -> DiscreteStateSpace:
+    """The discrete-time model with A and C given and B, D and x0 fitted to the record by least squares (the last
+    step of :func:`n4sid`, the output being linear in them), at the record's sample time.
+
+    Parameters
+    ----------
+    io : IOData
+    A, C : array_like
+        (n, n) and (p, n), at the sample time ``io.dt``.
+    feedthrough : bool
+        Fit D too (else D = 0).
+
+    Returns
+    -------
+    DiscreteStateSpace
+        With ``x0`` the fitted initial state.
+
+    Raises
+    ------
+    DataError
+        On an A whose simulation over the record would overflow (a pole far outside the unit circle), or a least
+        squares that fails.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.signal.subspace import fit_input_matrices
+    >>> u = np.random.default_rng(0).standard_normal(200)
+    >>> x, y = 0.0, []
+    >>> for uk in u:  # x[k+1] = 0.9 x[k] + 0.5 u[k], y = x + 0.1 u
+    ...     y.append(x + 0.1 * uk)
+    ...     x = 0.9 * x + 0.5 * uk
+    >>> bb = fit_input_matrices(si.IOData(u, y, 1.0), [[0.9]], [[1.0]])
+    >>> np.round([bb.B[0, 0], bb.D[0, 0]], 6).tolist()
+    [0.5, 0.1]
+    """
+    A = np.atleast_2d(np.asarray(A, dtype=float))
+    C = np.atleast_2d(np.asarray(C, dtype=float))
+    B, D, x0 = _b_d_x0(io, A, C, feedthrough)
+    return DiscreteStateSpace(A, B, C, D, float(io.dt), x0=np.asarray(x0, dtype=float))
 
 
 def n4sid(io: IOData, order: int, *, horizon: int | None = None, feedthrough: bool = True,
