@@ -34,7 +34,7 @@ method through a black box:
    ``benchmarks/results/timeseries_multisine.json``, 17 min) ``auto`` met the success rule
    from 18 of 24 informed and 15 of 24 uninformed noisy starts with it, against 21 and 17 without:
    on chains its start led to near-fits the rule accepts a little above the least-squares
-   misfit (a 2-mass chain's second mass at 1e-5 of the truth, misfit 0.4 % above), every
+   misfit (a 2-mass chain's second mass at 1e-5 against 1.35, misfit 0.4 % above), every
    other class alike; noise-free starts alike (23 and 22 of 24). A new user's 4-storey
    frame (multisine to 0.4 of Nyquist, 2 % noise, 12 parameters, no start given) needs it:
    90 s and m1 4e7 times off without, a fit in 15 s within 1.7 % with. A poor black box
