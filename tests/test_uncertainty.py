@@ -376,3 +376,15 @@ def test_the_weakest_direction_is_shown_in_relative_changes():
     assert abs(unc.weakest["Kt"]) > 0.99  # in absolute units the largest parameter takes the direction
     line = next(x for x in unc.summary().splitlines() if "NEAR-SINGULAR" in x)
     assert all(f"·δ{n}/{n}" in line for n in ("J", "b", "Kt")) and "(relative changes)" in line
+
+
+def test_an_interval_is_found_by_the_parameters_name():
+    """A new user could index the intervals by position only; unc.interval(name) gives one by name (the same row),
+    and a name the estimate has not is a named error listing its parameters."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    frf = si.simulate_frf(model, [2.0, 0.5, 3.0], np.linspace(0.5, 2.0, 40), noise=0.01, seed=0)
+    unc = si.identify(model, frf, x0=[2.0, 0.5, 3.0], identifiability_check=False).uncertainty
+    assert unc.interval("c") == tuple(float(v) for v in unc.intervals[1])
+    with pytest.raises(si.DataError, match=r"'k2' is not a parameter of this estimate; its parameters are m, c, k"):
+        unc.interval("k2")

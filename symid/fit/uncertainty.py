@@ -166,6 +166,33 @@ class Uncertainty:
         with np.errstate(divide="ignore", invalid="ignore"):
             return self.covariance / np.outer(se, se)
 
+    def interval(self, name: str) -> tuple[float, float]:
+        """The 95 % confidence interval (low, high) of the parameter called ``name`` (NaN where the intervals are
+        withheld: ``note`` says why).
+
+        Raises
+        ------
+        DataError
+            When ``name`` is no parameter of the estimate (the message lists them).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import symid as si
+        >>> m, c, k = si.parameters("m c k", positive=True)
+        >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+        >>> frf = si.simulate_frf(model, [2.0, 0.5, 3.0], np.linspace(0.5, 2.0, 40), noise=0.01, seed=0)
+        >>> unc = si.identify(model, frf, x0=[2.0, 0.5, 3.0], identifiability_check=False).uncertainty
+        >>> low, high = unc.interval("k")
+        >>> bool(low < 3.0 < high)
+        True
+        """
+        if name not in self.parameter_names:
+            raise DataError(f"{name!r} is not a parameter of this estimate; its parameters are "
+                            f"{', '.join(self.parameter_names)}")
+        low, high = self.intervals[self.parameter_names.index(name)]
+        return float(low), float(high)
+
     def summary(self) -> str:
         """One line per fact, for :meth:`IdentificationResult.summary`."""
         if self.noise_source == "given":
