@@ -399,6 +399,10 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     spec = _spec(entry, args, "identify")
     _say(args, f"model: {spec.name}   data: {source}")
     time_unit = _record_time_unit(data)
+    if time_unit is None and args.time_unit:  # a new user's --time-unit min on a frequency response: ignored unsaid
+        _show_text_warning(args, f"--time-unit {args.time_unit} sets the time unit of a time-series record; these "
+                                 f"data are no time series (frequencies are read in rad/s), so it plays no part and "
+                                 f"the estimates' rates are per second")
     if time_unit is not None:  # the rates are per this unit: say it, and how to keep the file's own
         stated = (dict(_pairs(args.units, "--units", "identify")) if getattr(args, "units", None) else {}).get("time")
         converted = bool(stated) and stated.strip().lower() != time_unit.lower()

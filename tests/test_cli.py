@@ -487,6 +487,20 @@ def test_a_model_files_time_unit_is_the_records(tmp_path, capsys):
     assert "the file's times, in s, were converted to h, as --time-unit asks" in said.out
 
 
+def test_time_unit_on_a_frequency_response_is_said_to_play_no_part(tmp_path, capsys):
+    """A new user's `--time-unit min` on a frequency-response table was ignored without a word (the estimates per
+    second): it is now said."""
+    frf = si.simulate_frf(si.load_model("mass_damper_2dof").model, si.load_model("mass_damper_2dof").truth,
+                          np.linspace(0.2, 3.0, 30))
+    H = np.asarray(frf.H)[:, 0, 0]
+    rows = "\n".join(f"{w!r},{h.real!r},{h.imag!r}" for w, h in zip(frf.w.tolist(), H.tolist(), strict=True))
+    (tmp_path / "frf.csv").write_text(f"w,re,im\n{rows}\n")
+    main(["identify", "mass_damper_2dof", "--data", str(tmp_path / "frf.csv"), "--columns", "frequency=w", "real=re",
+          "imag=im", "--units", "frequency=rad/s", "--time-unit", "min", "--max-iter", "1"])
+    assert "--time-unit min sets the time unit of a time-series record; these data are no time series" \
+        in capsys.readouterr().err
+
+
 def _infusion_files(tmp_path, records: dict[str, int]) -> None:
     """pk.py (one compartment, elimination ke, q = 1/V) and, per file name and noise seed, 48 h of two 500 mg/h
     infusions sampled every 15 min with 15 % proportional noise on the concentration (ke = 0.2, q = 0.025)."""

@@ -74,13 +74,16 @@ def frf_weights(data: Any, variance: Any = "data") -> np.ndarray | None:
     """
     H = np.asarray(data.H)
     if isinstance(variance, str) and variance == "relative":
-        zero = np.argwhere(np.abs(H) == 0)
-        if zero.size:
-            idx = tuple(int(i) for i in zero[0])
+        with np.errstate(divide="ignore", over="ignore"):
+            wts = 1.0 / np.abs(H) ** 2
+        # a zero, or a value so small that 1/|H|² overflows (a new user's 1e-300: NaN misfits, no reason given)
+        bad = np.argwhere(~np.isfinite(wts) | ~np.isfinite(wts / np.sum(wts[np.isfinite(wts)])))
+        if bad.size:
+            idx = tuple(int(i) for i in bad[0])
             raise OptionError(f"variance='relative' weighs each value of H by 1/|H|², but entry {idx} (frequency "
-                              f"{float(np.asarray(data.w)[idx[0]]):g} rad/s) is 0; give the noise variances as an "
-                              f"array, or variance=None for equal weights")
-        wts = 1.0 / np.abs(H) ** 2
+                              f"{float(np.asarray(data.w)[idx[0]]):g} rad/s) is {abs(complex(H[idx])):.3g} in "
+                              f"magnitude, too small to weigh so; give the noise variances as an array, or "
+                              f"variance=None for equal weights")
         return wts / float(np.mean(wts))
     if isinstance(variance, str):
         if variance != "data":
