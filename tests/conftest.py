@@ -62,3 +62,31 @@ def motor(tmp_path):
         return "\n".join(f"{a:.2f},{c},{float(d)!r}" for a, c, d in zip(t, u, y, strict=True))
 
     return path, rows
+
+
+@pytest.fixture
+def free_chain():
+    """A builder of chains of n masses joined by n − 1 spring-damper elements with nothing to the ground:
+    ``free_chain(n, force, sensor)`` puts the force on mass ``force`` and measures the position of mass ``sensor``
+    (0-based)."""
+    import sympy as sp
+
+    import symid as si
+
+    def build(n: int, force: int, sensor: int):
+        m = si.parameters(" ".join(f"m{i + 1}" for i in range(n)), positive=True)
+        c = si.parameters(" ".join(f"c{i + 1}" for i in range(n - 1)), positive=True)
+        k = si.parameters(" ".join(f"k{i + 1}" for i in range(n - 1)), positive=True)
+        c, k = (c,) if n == 2 else c, (k,) if n == 2 else k
+        V, K = sp.zeros(n, n), sp.zeros(n, n)
+        for X, v in ((V, c), (K, k)):
+            for i, x in enumerate(v):  # element i joins masses i and i + 1
+                X[i, i] += x
+                X[i + 1, i + 1] += x
+                X[i, i + 1] -= x
+                X[i + 1, i] -= x
+        B, C = sp.zeros(n, 1), sp.zeros(1, n)
+        B[force], C[sensor] = 1, 1
+        return si.SecondOrderModel(M=sp.diag(*m), V=V, K=K, B=B, C=C)
+
+    return build

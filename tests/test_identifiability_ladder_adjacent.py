@@ -64,29 +64,11 @@ def test_every_size_is_proven_at_theta_star_and_theta_2(n, families):
         assert proves_global(model, None, star) == "adjacent"
 
 
-def _free_chain(n: int):
-    """n masses joined by n − 1 spring-damper elements, nothing to the ground, the force on mass n − 1 and the
-    position of mass n measured."""
-    m = si.parameters(" ".join(f"m{i + 1}" for i in range(n)), positive=True)
-    c = si.parameters(" ".join(f"c{i + 1}" for i in range(n - 1)), positive=True)
-    k = si.parameters(" ".join(f"k{i + 1}" for i in range(n - 1)), positive=True)
-    V, K = sp.zeros(n, n), sp.zeros(n, n)
-    for X, v in ((V, c), (K, k)):
-        for i, x in enumerate(v):  # element i joins masses i and i + 1
-            X[i, i] += x
-            X[i + 1, i + 1] += x
-            X[i, i + 1] -= x
-            X[i + 1, i] -= x
-    B, C = sp.zeros(n, 1), sp.zeros(1, n)
-    B[n - 2], C[n - 1] = 1, 1
-    return si.SecondOrderModel(M=sp.diag(*m), V=V, K=K, B=B, C=C)
-
-
 @pytest.mark.parametrize(("n", "count"), [(3, 3), (4, 1)])
-def test_free_chains_agree_with_the_groebner_step(n, count, groebner):
+def test_free_chains_agree_with_the_groebner_step(n, count, groebner, free_chain):
     """Free at both ends: 3 masses have 3 complex solutions (the case analysis finds more than θ* and claims
     nothing), 4 masses one (proven by the case analysis)."""
-    model = _free_chain(n)
+    model = free_chain(n, n - 2, n - 1)
     assert adjacent_of(model) is not None
     fast = generic_global(model, rank=len(model.parameters), msolve=MSOLVE)
     ref = groebner(model)
@@ -98,10 +80,10 @@ def test_free_chains_agree_with_the_groebner_step(n, count, groebner):
 
 
 @pytest.mark.parametrize("known", [{"m1": 2}, {"k2": 5}])
-def test_a_known_value_leaves_one_of_the_free_chains_solutions(known, monkeypatch):
+def test_a_known_value_leaves_one_of_the_free_chains_solutions(known, monkeypatch, free_chain):
     """The free 3-mass chain's 3 solutions (whole structure) are filtered by the known value: only θ*'s has it
     (Gröbner on the model with the known value: 1)."""
-    model = _free_chain(3)
+    model = free_chain(3, 1, 2)
     rep = si.identifiability(model, known=known)
     with monkeypatch.context() as mpatch:
         mpatch.setattr(gg, "proves_global", lambda *a, **k: "")
@@ -110,8 +92,8 @@ def test_a_known_value_leaves_one_of_the_free_chains_solutions(known, monkeypatc
     assert rep.engine == "ladder" and rep.verdict == "global" and rep.n_solutions_complex == 1
 
 
-def test_a_free_chain_of_six_masses_is_proven_at_theta_star_and_theta_2():
-    model = _free_chain(6)
+def test_a_free_chain_of_six_masses_is_proven_at_theta_star_and_theta_2(free_chain):
+    model = free_chain(6, 4, 5)
     for draw in (0, 500):
         assert proves_global(model, None, star_and_summary(model, seed=3, draw=draw)[1]) == "adjacent"
 

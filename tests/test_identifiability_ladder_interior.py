@@ -26,28 +26,10 @@ from symid.structural.summary import model_matrices
 MSOLVE = msolve_binary()
 
 
-def _free_chain(n: int, at: int):
-    """n masses joined by n − 1 spring-damper elements, nothing to the ground, force and sensor at mass ``at``."""
-    m = si.parameters(" ".join(f"m{i + 1}" for i in range(n)), positive=True)
-    c = si.parameters(" ".join(f"c{i + 1}" for i in range(n - 1)), positive=True)
-    k = si.parameters(" ".join(f"k{i + 1}" for i in range(n - 1)), positive=True)
-    c, k = (c,) if n == 2 else c, (k,) if n == 2 else k
-    V, K = sp.zeros(n, n), sp.zeros(n, n)
-    for X, v in ((V, c), (K, k)):
-        for i, x in enumerate(v):  # element i joins masses i and i + 1
-            X[i, i] += x
-            X[i + 1, i + 1] += x
-            X[i, i + 1] -= x
-            X[i + 1, i] -= x
-    B = sp.zeros(n, 1)
-    B[at] = 1
-    return si.SecondOrderModel(M=sp.diag(*m), V=V, K=K, B=B, C=B.T)
-
-
 @pytest.mark.parametrize("name", ["chain_mid-3-mm", "chain_mid-4-mm", "chain_mid-4-mm-velocity", "free-4-1"])
-def test_the_inversion_agrees_with_the_groebner_step(name, groebner, families):
+def test_the_inversion_agrees_with_the_groebner_step(name, groebner, families, free_chain):
     if name.startswith("free"):
-        model = _free_chain(4, 1)
+        model = free_chain(4, 1, 1)
     else:
         model = families.build(name.removesuffix("-velocity"))
         if name.endswith("velocity"):
@@ -63,10 +45,10 @@ def test_the_inversion_agrees_with_the_groebner_step(name, groebner, families):
     assert fast.confirmed and fast.theta_confirm
 
 
-def test_a_mirror_symmetric_chain_is_left_to_the_groebner_step(groebner):
+def test_a_mirror_symmetric_chain_is_left_to_the_groebner_step(groebner, free_chain):
     """Free at both ends, one mass on either side of the driven one: swapping the sides is a second solution
     (Gröbner: 2), so two splits pass and the inversion claims nothing."""
-    model = _free_chain(3, 1)
+    model = free_chain(3, 1, 1)
     star = star_and_summary(model)[1]
     lad = ladder_of(model, driven_anywhere=True)
     assert lad is not None and lad.at == 1
@@ -143,48 +125,48 @@ def _with_known(model, values: dict):
 
 
 @pytest.mark.parametrize(("known", "count"), [({"m1": 2}, 1), ({"k1": 5}, 1), ({"m1": 1, "m3": 1}, 2)])
-def test_the_swapped_sides_of_a_free_chain_are_excluded_by_a_known_value(known, count, groebner):
+def test_the_swapped_sides_of_a_free_chain_are_excluded_by_a_known_value(known, count, groebner, free_chain):
     """Free at both ends, one mass either side: the swapped split passes the split test, and is a solution iff the
     known values allow the mirror image (m1 = 2 known: no, Gröbner 1; m1 = m3 = 1 known: yes, Gröbner 2). Found by a
     new user: such 5-mass chains timed out in the Gröbner step."""
-    model = _with_known(_free_chain(3, 1), known)
+    model = _with_known(free_chain(3, 1, 1), known)
     star = star_and_summary(model)[1]
     assert groebner(model).n_complex == count
     assert proves_global(model, None, star) == ("interior" if count == 1 else "")
 
 
-def test_a_free_five_mass_chain_with_a_known_mass_is_proven():
-    model = _with_known(_free_chain(5, 2), {"m1": 2})
+def test_a_free_five_mass_chain_with_a_known_mass_is_proven(free_chain):
+    model = _with_known(free_chain(5, 2, 2), {"m1": 2})
     lad = ladder_of(model, driven_anywhere=True)
     assert lad is not None and lad.at == 2
     for draw in (0, 500):
         assert invert_interior(lad, model, None, star_and_summary(model, seed=3, draw=draw)[1])
-    assert not invert_interior(ladder_of(_free_chain(5, 2), driven_anywhere=True), _free_chain(5, 2), None,
-                               star_and_summary(_free_chain(5, 2))[1])  # the mirror image is a second solution
+    assert not invert_interior(ladder_of(free_chain(5, 2, 2), driven_anywhere=True), free_chain(5, 2, 2), None,
+                               star_and_summary(free_chain(5, 2, 2))[1])  # the mirror image is a second solution
 
 
 @pytest.mark.parametrize(("known", "count"), [({"c1": 0, "m1": 1, "m5": 1, "k1": 2, "k4": 2}, 1),
                                               ({"c1": 0, "c4": 0, "m1": 1, "m5": 1, "k1": 2, "k4": 2}, 2)])
-def test_the_swapped_sides_are_excluded_by_an_element_on_one_side_only(known, count, groebner):
+def test_the_swapped_sides_are_excluded_by_an_element_on_one_side_only(known, count, groebner, free_chain):
     """A free 5-mass chain driven at the middle whose known values are mirror-symmetric: without the outer damper on
     the left only (c1 = 0), the mirror image would need a damper there, so only θ* (Gröbner: 1); without both outer
     dampers the sides can swap (Gröbner: 2). Found by a new user: the first kind took 24 s in the Gröbner step."""
-    model = _with_known(_free_chain(5, 2), known)
+    model = _with_known(free_chain(5, 2, 2), known)
     star = star_and_summary(model)[1]
     assert groebner(model).n_complex == count
     assert proves_global(model, None, star) == ("interior" if count == 1 else "")
 
 
-def test_a_side_with_an_element_without_spring():
+def test_a_side_with_an_element_without_spring(free_chain):
     """A free 5-mass chain driven at the middle whose outer right element is a damper alone (k4 = 0): that side has
     one pole fewer (c m s² / (m s + c)), read from its structure; before, the inversion declined and the report
     timed out after 60 s in the Gröbner step. With known values that let Gröbner finish: the same count (1)."""
-    model = _with_known(_free_chain(5, 2), {"k4": 0})
+    model = _with_known(free_chain(5, 2, 2), {"k4": 0})
     assert proves_global(model, None, star_and_summary(model)[1]) == "interior"
     known = _with_known(model, {"m1": 1, "m5": 1, "c1": 3})
     assert proves_global(known, None, star_and_summary(known)[1]) == "interior"
 
 
-def test_a_side_with_an_element_without_spring_agrees_with_groebner(groebner):
-    model = _with_known(_free_chain(5, 2), {"k4": 0, "m1": 1, "m5": 1, "c1": 3})
+def test_a_side_with_an_element_without_spring_agrees_with_groebner(groebner, free_chain):
+    model = _with_known(free_chain(5, 2, 2), {"k4": 0, "m1": 1, "m5": 1, "c1": 3})
     assert groebner(model).n_complex == 1

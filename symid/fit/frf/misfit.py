@@ -76,15 +76,15 @@ def frf_weights(data: Any, variance: Any = "data") -> np.ndarray | None:
     if isinstance(variance, str) and variance == "relative":
         with np.errstate(divide="ignore", over="ignore"):
             wts = 1.0 / np.abs(H) ** 2
-        # a zero, or a value so small that 1/|H|² overflows (a new user's 1e-300: NaN misfits, no reason given)
-        bad = np.argwhere(~np.isfinite(wts) | ~np.isfinite(wts / np.sum(wts[np.isfinite(wts)])))
-        if bad.size:
-            idx = tuple(int(i) for i in bad[0])
+            total = float(np.sum(wts))
+        # a zero, or values so small that 1/|H|² or its sum overflows (a new user's 1e-300: NaN misfits, no reason)
+        if not np.isfinite(total):
+            idx = tuple(int(i) for i in np.unravel_index(int(np.argmin(np.abs(H))), H.shape))
             raise OptionError(f"variance='relative' weighs each value of H by 1/|H|², but entry {idx} (frequency "
                               f"{float(np.asarray(data.w)[idx[0]]):g} rad/s) is {abs(complex(H[idx])):.3g} in "
                               f"magnitude, too small to weigh so; give the noise variances as an array, or "
                               f"variance=None for equal weights")
-        return wts / float(np.mean(wts))
+        return wts / (total / wts.size)
     if isinstance(variance, str):
         if variance != "data":
             raise OptionError(f"variance must be 'data', 'relative', None or an array of noise variances; got "
