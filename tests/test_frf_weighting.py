@@ -438,6 +438,10 @@ def test_variance_relative_weighs_each_line_by_its_level(method):
     given = si.identify(model, frf, variance=(0.02 * np.abs(np.asarray(frf.H))) ** 2, **kw)
     assert rel.options["variance"] == "relative" and given.options["variance"] == "given"
     np.testing.assert_allclose(rel.theta_vector, given.theta_vector, rtol=1e-6)
+    # the cost is the mean relative misfit, and named so (a new user read it under the unweighted misfit's name)
+    Hm = model.frequency_response(rel.theta_vector, frf.w)
+    np.testing.assert_allclose(rel.cost, np.mean(np.abs(frf.H - Hm) ** 2 / np.abs(frf.H) ** 2), rtol=1e-9)
+    assert rel.cost_kind.startswith("mean relative FRF misfit") and given.cost_kind.startswith("noise-weighted")
     H = np.asarray(frf.H).copy()
     for tiny in (0.0, 1e-300):  # 1/|H|² overflows for the second (a new user's: NaN misfits, no reason given)
         H[3] = tiny

@@ -340,6 +340,12 @@ def relative_noise_note(model: Any, data: Any, theta: Any) -> dict[str, float] |
     return {"level": 100.0 * float(np.sqrt(np.mean(np.abs(H - Hm) ** 2 / np.abs(Hm) ** 2))), "decades": decades}
 
 
+RELATIVE_COST_KIND = "mean relative FRF misfit (1/N) Σ |Hᵢ − H(ωᵢ, θ)|² / |Hᵢ|² over the N entries of H"
+"""The misfit's name with ``variance="relative"`` (every entry weighed by 1/|Hᵢ|²)."""
+WEIGHTED_COST_KIND = "noise-weighted relative FRF misfit Σ wᵢ|Hᵢ − H(ωᵢ, θ)|² / Σ wᵢ|Hᵢ|², wᵢ = 1/σᵢ²"
+"""The misfit's name when the noise variance of every entry weighs it."""
+
+
 class FrfEstimator(Estimator, FrfFisher):
     """Base of the frequency-response methods: their data misfit (relative, squared), and its Fisher
     information for the uncertainty of θ̂ (:mod:`symid.fit.frf.fisher`)."""
@@ -462,6 +468,11 @@ class NoiseWeighted:
         """Weights and variance from the ``variance`` option; returns its label for ``options``."""
         self.line_weights = frf_weights(self.data, variance)
         self.line_variance = frf_variance(self.data, variance) if self.line_weights is not None else None
+        # the misfit is then the weighted one, and named so (a new user read the mean relative misfit of
+        # variance="relative" under the equally weighted misfit's name)
+        self.cost_kind = (type(self).cost_kind if self.line_weights is None else  # type: ignore[misc]
+                          RELATIVE_COST_KIND if isinstance(variance, str) and variance == "relative" else
+                          WEIGHTED_COST_KIND)
         self._variance_floor = None
         self.estimated_variance_dof = None
         if self.line_variance is not None:
