@@ -346,3 +346,17 @@ def test_absolute_noise_has_the_given_standard_deviation_per_output():
     for bad, match in ((-1.0, ">= 0"), ([0.1, 0.2, 0.3], "one per output"), (np.nan, "finite")):
         with pytest.raises(DataError, match=match):
             si.simulate_io(model, {"a": 1.0, "b": 2.0}, u[:5], 0.1, noise_std=bad)
+
+
+def test_simulate_io_labels_the_record_in_the_models_time_unit():
+    """A model file's rates per hour gave records labelled in seconds (simulate_io had no time unit), so fitting them
+    back warned of a mismatch; now the record carries the model's unit, and another unit is refused."""
+    a = si.parameters("a", positive=True)
+    model = si.StateSpaceModel(A=[[-a]], B=[[a]], C=[[1]])
+    assert si.simulate_io(model, {"a": 0.5}, np.ones(4), dt=0.1).time_unit == "s"
+    assert si.simulate_io(model, {"a": 0.5}, np.ones(4), dt=0.1, time_unit="min").time_unit == "min"
+    model.io_units = {"time": ("h",)}  # as a model file with time_unit = "h" sets it
+    io = si.simulate_io(model, {"a": 0.5}, np.ones(4), dt=0.25)
+    assert io.time_unit == "h" and io.dt == 0.25
+    with pytest.raises(DataError, match=r"time_unit='s', but the model's rates are per h"):
+        si.simulate_io(model, {"a": 0.5}, np.ones(4), dt=900.0, time_unit="s")

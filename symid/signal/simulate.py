@@ -334,7 +334,8 @@ def _model_initial_state(model: Any, theta: Any, n: int) -> np.ndarray:
 
 
 def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any = None,
-                noise: float | None = None, noise_std: Any = None, seed: Seed = None) -> IOData:
+                noise: float | None = None, noise_std: Any = None, seed: Seed = None,
+                time_unit: str | None = None) -> IOData:
     """Sampled response of a model to a zero-order-hold input (exact discretisation).
 
     The first-order form ``x' = A x + B u, y = C x + D u`` (``model.state_space(θ)``)
@@ -354,7 +355,7 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
     u : array_like, shape (N, m) or (N,)
         Input samples, one row per sample; the 1-D form only for a single-input model.
     dt : float
-        Sample time in seconds, > 0.
+        Sample time, > 0, in ``time_unit``: the unit the model's rates are per.
     x0 : array_like, shape (n,), optional
         Initial state of the first-order form. By default the model's own
         (``StateSpaceModel(..., x0=...)`` at θ; zero when the model gives none); a
@@ -370,11 +371,17 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
         sensor of known resolution adds (0.05 K on a thermometer).
     seed : int or numpy.random.Generator, optional
         Seed of :func:`numpy.random.default_rng`.
+    time_unit : str, optional
+        The record's time unit (``"s"``, ``"ms"``, ``"min"``, ``"h"``, …), which must be the
+        one the model's rates are per. Default: the model's own (a model file's
+        ``time_unit``, ``model.io_units["time"]``), else seconds; another unit than the
+        model's is a DataError (the record would be fitted back with rates off by the
+        ratio).
 
     Returns
     -------
     IOData
-        ``u`` (as given, shape (N, m)), ``y`` of shape (N, p) and ``dt``.
+        ``u`` (as given, shape (N, m)), ``y`` of shape (N, p), ``dt`` and ``time_unit``.
 
     Raises
     ------
@@ -397,6 +404,7 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
     n, m = B.shape
     u_ = _input_series(u, m)
     dt_ = checks.check_positive_scalar(dt, "dt")
+    unit = _record_time_unit(model, time_unit)
     level, rng = _noise_level(noise), _generator(seed)
     if x0 is None:
         x = _model_initial_state(sys, th, n)
@@ -418,7 +426,7 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
         y = X @ C.T + u_ @ D.T
     if not np.all(np.isfinite(y)):
         k = int(np.argwhere(~np.isfinite(y))[0][0])
-        raise DataError(f"the simulated output overflows at sample {k} (t = {k * dt_:g} s); "
+        raise DataError(f"the simulated output overflows at sample {k} (t = {k * dt_:g} {unit}); "
                         f"is the system unstable? (max Re λ(A) = {np.linalg.eigvals(A).real.max():.3g})")
     if level > 0:
         y = y + level * np.std(y, axis=0) * rng.standard_normal(y.shape)
@@ -431,4 +439,20 @@ def simulate_io(model: Model, theta: Theta | None, u: Any, dt: float, *, x0: Any
         if np.any(std < 0):
             raise DataError(f"noise_std must be >= 0 (a standard deviation in the output's units); got {std.tolist()}")
         y = y + std.reshape(-1)[None, :] * rng.standard_normal(y.shape)
-    return IOData(u_, y, dt_)
+    return IOData(u_, y, dt_, time_unit=unit)
+
+
+def _record_time_unit(model: Any, time_unit: str | None) -> str:
+    """The time unit of a simulated record: ``time_unit`` (canonical), else the model's own, else seconds; a unit
+    other than the model's is a DataError."""
+    from symid.data.units import canonical_unit
+
+    declared = (getattr(model, "io_units", None) or {}).get("time")
+    own = canonical_unit(declared[0], "time", "the model's time_unit") if declared else None
+    if time_unit is None:
+        return own or "s"
+    unit = canonical_unit(time_unit, "time", "time_unit")
+    if own is not None and unit != own:
+        raise DataError(f"time_unit={time_unit!r}, but the model's rates are per {own} (its time_unit): a record in "
+                        f"{unit} would be fitted back with every rate off by the ratio; give dt in {own}")
+    return unit
