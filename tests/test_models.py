@@ -467,3 +467,21 @@ def test_summary_and_repr_mention_parameters():
     text = model.summary()
     assert "m1, m2, c1, c2, k1, k2" in text and "M =" in text
     assert "2 DOF" in repr(model)
+
+
+def test_a_mass_matrix_singular_for_every_theta_is_refused_when_the_model_is_built():
+    """A new user's thermal network C T' + G T = P written with M = 0 was accepted, and identify ran 11 passes to
+    "cost inf"; a mass matrix singular at every θ (det M ≡ 0) is now a ModelError naming the first-order form."""
+    c1, c2, g = si.parameters("c1 c2 g", positive=True)
+    with pytest.raises(si.ModelError, match=r"M\(θ\) is singular for every θ \(every entry is 0\).*output='velocity'"):
+        si.SecondOrderModel(M=[[0, 0], [0, 0]], V=[[c1, 0], [0, c2]], K=[[g, -g], [-g, g]], B=[[1], [0]],
+                            C=[[0, 1]])
+    with pytest.raises(si.ModelError, match=r"rank 1 of 2"):  # a massless node: M = diag(c1, 0)
+        si.SecondOrderModel(M=[[c1, 0], [0, 0]], V=[[1, 0], [0, 1]], K=[[g, -g], [-g, g]], B=[[1], [0]], C=[[0, 1]])
+    with pytest.raises(si.ModelError, match=r"a mass given as 0 among the known values"):
+        si.SecondOrderModel(M=[[c1, 0], [0, c2]], V=[[1, 0], [0, 1]], K=[[g, -g], [-g, g]], B=[[1], [0]],
+                            C=[[0, 1]]).with_known({"c2": 0.0})
+    # the first-order form the message names works: x = q' with M = C, V = G, K = 0
+    model = si.SecondOrderModel(M=[[c1, 0], [0, c2]], V=[[g, -g], [-g, g]], K=[[0, 0], [0, 0]], B=[[1], [0]],
+                                C=[[0, 1]], output="velocity")
+    assert model.n_states == 4

@@ -87,7 +87,27 @@ class SecondOrderModel(ParametricModel):
         C_ = as_symbolic_matrix(C, "C", shape=(None, n))
         self.output = output
         self._setup([("M", M_), ("V", V_), ("K", K_), ("B", B_), ("C", C_)], parameters, name)
+        self._refuse_singular_mass()
         _warn_if_not_symmetric(self._symbolic)
+
+    def _refuse_singular_mass(self) -> None:
+        """A ModelError when M(θ) is singular for every θ: singular at two random points (its determinant, a
+        polynomial in θ, vanishes identically). No θ could then be simulated or fitted (a new user's thermal network
+        C T' + G T = P, written with M = 0, ran 11 passes to "cost inf")."""
+        rng = np.random.default_rng(0)
+        n = self.n_dof
+        for _ in range(2):
+            M = np.asarray(self._maps["M"](np.exp(rng.uniform(-1.0, 1.0, self.n_parameters))), dtype=float)
+            sv = np.linalg.svd(M, compute_uv=False)
+            if sv[0] > 0 and sv[-1] > 1e-10 * sv[0]:
+                return
+        rank = 0 if sv[0] == 0 else int(np.sum(sv > 1e-10 * sv[0]))
+        what = "every entry is 0" if rank == 0 else f"rank {rank} of {n} at random values"
+        raise ModelError(f"M(θ) is singular for every θ ({what}): the second-order model cannot be put in first-order "
+                         f"form. A first-order system E x' + F x = B u (a thermal network C T' + G T = P) is "
+                         f"SecondOrderModel(M=E, V=F, K=0, B=B, C=C, output='velocity') (x is then q'), or a "
+                         f"StateSpaceModel; a massless node (or a mass given as 0 among the known values) needs a "
+                         f"mass, or its equation eliminated")
 
     @property
     def n_dof(self) -> int:
