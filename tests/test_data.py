@@ -95,7 +95,9 @@ INVALID = [
     ("IO u 3-D", lambda: IOData(U[:, :, None], Y, 0.1), "u must have shape (N, m)"),
     ("IO y 3-D", lambda: IOData(U, Y[:, :, None], 0.1), "y must have shape (N, p)"),
     ("IO one sample", lambda: IOData(U[:1], Y[:1], 0.1), "at least 2 samples"),
-    ("IO row instead of column", lambda: IOData(np.ones((1, 50)), np.ones((1, 50)), 0.1), "got N = 1"),
+    # a new user's row of 50 values was told only "got N = 1": now named as one channel written as a row
+    ("IO row instead of column", lambda: IOData(np.ones((1, 50)), np.ones((1, 50)), 0.1),
+     "u has shape (1, 50): 50 channels but only 1 sample; arrays are (samples, channels)"),
     ("IO transposed", lambda: IOData(U.T, Y.T[:2], 0.1), "u has shape (2, 50): 50 channels but only 2 samples"),
     ("IO y transposed", lambda: IOData(U[:3], Y.T, 0.1), "y has shape (3, 50): 50 channels but only 3 samples"),
     ("IO complex u", lambda: IOData(U + 1j, Y, 0.1), "u must be real"),

@@ -105,6 +105,26 @@ def test_io_record_from_dt_and_several_channels():
     assert io.n_inputs == 2 and io.dt == 30.0  # 0.5 min
 
 
+def test_even_times_written_with_few_digits_are_an_even_grid(tmp_path):
+    """A new user's 10-minute samples in hours written by "%.6g" (119.667 for 119.66667) were refused as 0.004 of a
+    sample off the grid; times within the rounding of their printed digits are read as the even grid they are, and
+    jitter beyond that rounding is still refused."""
+    t = np.arange(720) / 6.0  # hours
+    u, y = np.ones(720), np.linspace(0.0, 1.0, 720)
+    cols = {"time": "t_h", "input": "P", "output": "T"}
+    for fmt in ("%.6g", "%.3f"):  # significant digits, fixed decimals
+        path = tmp_path / "room.csv"
+        np.savetxt(path, np.column_stack([t, u, y]), delimiter=",", header="t_h,P,T", comments="", fmt=fmt)
+        io = IOData.from_table(path, columns=cols, units={"time": "h"}, time_unit="h")
+        assert io.n_samples == 720
+        np.testing.assert_allclose(io.dt, 1 / 6, rtol=1e-7)  # the grid fitted to 720 times rounded to 5e-4 h
+    jittered = t + 0.004 / 6 * np.sin(np.arange(720))  # up to 0.4 % of a sample, written at full precision
+    path = tmp_path / "jitter.csv"
+    np.savetxt(path, np.column_stack([jittered, u, y]), delimiter=",", header="t_h,P,T", comments="", fmt="%.17g")
+    with pytest.raises(si.DataError, match=r"not equally spaced"):
+        IOData.from_table(path, columns=cols, units={"time": "h"})
+
+
 def test_uneven_times_are_refused_for_iodata_and_read_as_time_series():
     table = {"t": [0.0, 0.5, 1.0, 2.0, 4.0], "u": np.zeros(5), "c": [1.0, 0.8, 0.6, 0.4, 0.2]}
     cols = {"time": "t", "input": "u", "output": "c"}

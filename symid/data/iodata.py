@@ -103,6 +103,13 @@ class IOData(DataContainer):
             raise DataError(f"u and y must have the same number of samples N: u has {u_.shape[0]} "
                             f"(shape {checks.shape_text(u_.shape)}), y has {y_.shape[0]} "
                             f"(shape {checks.shape_text(y_.shape)})")
+        for label, arr in (("u", u_), ("y", y_)):
+            # one row of as many values in both: a signal each, written as a row (one sample of several channels
+            # would be too short either way)
+            if arr.shape[0] == 1 and u_.shape[1] == y_.shape[1] >= 2:
+                raise DataError(f"{label} has shape {checks.shape_text(arr.shape)}: {arr.shape[1]} channels but only "
+                                f"{arr.shape[0]} sample; arrays are (samples, channels), one row per sample "
+                                f"(pass {label}.T, or a 1-D array, if you have one row per channel)")
         if u_.shape[0] < 2:
             raise DataError(f"u and y must hold at least 2 samples (rows); got N = {u_.shape[0]}")
         for label, arr in (("u", u_), ("y", y_)):
@@ -176,8 +183,9 @@ class IOData(DataContainer):
         Returns
         -------
         IOData
-            Times that are not equally spaced (beyond 0.1 % of a sample of jitter) are
-            refused: read them with :meth:`TimeSeries.from_table
+            Times that are not equally spaced (beyond 0.1 % of a sample of jitter, or
+            beyond the rounding of the digits they are written with, up to 10 % of a
+            sample) are refused: read them with :meth:`TimeSeries.from_table
             <symid.data.TimeSeries.from_table>`.
 
         Raises

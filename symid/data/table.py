@@ -749,7 +749,7 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
                 step = checks.check_positive_scalar(dt, "dt") * factor
             else:
                 _check_gaps(raw, src, roles["time"], declared["time"])
-                step = _uniform_step(t, src.where)
+                step = _uniform_step(raw, src.where) * factor  # the times as written: their digits are rounding
             record = IOData(u, y, step, time_unit=target)
     if isinstance(src, _Csv):  # the columns read and the units the file states for them (a CSV column: a channel)
         stated = _column_units(src)
@@ -825,8 +825,33 @@ def _check_gaps(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) -> Non
                     "split the record at the gap instead)")
 
 
+PRINTED_JITTER = 0.1
+"""Times written with few digits (a logger's 119.667 h for 119.6667) are read as an even grid when every time is
+within half a unit of its last printed digit of the grid, and that is at most this fraction of a sample."""
+
+
+def _printed_half_unit(t: np.ndarray) -> list[np.ndarray]:
+    """Half a unit of the last digit each time was written with, under the two ways tables are written: a fixed
+    number of decimals (``%.3f``) and of significant digits (``%.6g``); the fewest digits that reproduce every time
+    (read from at most 2000 of them), one array per way."""
+    sample = t if t.size <= 2000 else t[np.linspace(0, t.size - 1, 2000).astype(int)]
+    out = []
+    for q in range(16):  # decimals
+        if all(float(f"{v:.{q}f}") == v for v in sample):
+            out.append(np.full(t.size, 0.5 * 10.0 ** -q))
+            break
+    for d in range(1, 17):  # significant digits
+        if all(float(f"{v:.{d}g}") == v for v in sample):
+            with np.errstate(divide="ignore"):
+                exponent = np.floor(np.log10(np.where(t != 0, np.abs(t), 1.0)))
+            out.append(0.5 * 10.0 ** (exponent - d + 1))
+            break
+    return out
+
+
 def _uniform_step(t: np.ndarray, where: str) -> float:
-    """The sample time of equally spaced times: jitter up to 0.1 % of a sample is rounding, more is refused."""
+    """The sample time of equally spaced times: jitter up to 0.1 % of a sample is rounding, and so is up to half a
+    unit of the times' last printed digit (:data:`PRINTED_JITTER`); more is refused."""
     if t.size < 2:
         raise DataError(f"{where}: a record needs at least 2 samples; got {t.size}")
     step = (t[-1] - t[0]) / (t.size - 1)
@@ -834,6 +859,16 @@ def _uniform_step(t: np.ndarray, where: str) -> float:
         raise DataError(f"{where}: the times do not increase (first {t[0]:g}, last {t[-1]:g})")
     dev = np.abs(t - (t[0] + step * np.arange(t.size)))
     k = int(np.argmax(dev))
+    if dev[k] > 1e-3 * step and dev[k] <= PRINTED_JITTER * step:
+        # a new user's 10-minute samples in hours, written with 6 digits (119.667), were 0.004 of a sample off the
+        # grid: the grid fitted to every time (its ends are rounded too) is within the rounding of each, twice half
+        # a unit of the last digit at most (its own, and the grid's)
+        idx = np.arange(t.size, dtype=float)
+        slope, offset = np.polyfit(idx, t, 1)
+        fitted = np.abs(t - (offset + slope * idx))
+        if slope > 0 and any(np.all(fitted <= 2 * half * (1 + 1e-9) + 4 * np.spacing(np.abs(t)))
+                             for half in _printed_half_unit(t)):
+            return float(slope)
     if dev[k] > 1e-3 * step:
         raise DataError(f"{where}: the samples are not equally spaced: sample {k} is at {t[k]:.9g}, "
                         f"{dev[k] / step:.3g} sample times away from an even grid of step {step:.6g}; read "
