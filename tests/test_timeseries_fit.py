@@ -572,3 +572,18 @@ def test_a_noisy_record_measured_after_its_start_is_not_told_to_estimate_the_ini
     assert not micro.success and micro.on_bounds
     assert "NEXT: the estimate sits on its bounds" in micro.summary()
     assert "NEXT (also): the record does not start where the model does" in micro.summary()  # a share it explains
+
+
+def test_a_zero_input_from_rest_is_refused_as_carrying_nothing():
+    """A new user's record with a zero input and a model starting at rest ran 11 passes to misfit 1 and was told to
+    give noise_floor=; its output is 0 for every θ, so it is a DataError saying so. From an estimated initial state
+    the same record is a free response, and is fitted."""
+    a = si.parameters("a", positive=True)
+    model = si.StateSpaceModel(A=[[-a]], B=[[1]], C=[[1]])
+    y = np.random.default_rng(0).normal(size=50)
+    with pytest.raises(si.DataError, match=r"every input is zero .* output is 0 for every θ"):
+        si.identify(model, si.IOData(np.zeros(50), y, 0.1), x0=[1.0], identifiability_check=False)
+    free = si.IOData(np.zeros(50), 2.0 * np.exp(-0.7 * 0.1 * np.arange(50)), 0.1)
+    res = si.identify(model, free, x0=[1.0], initial_state="estimate", identifiability_check=False)
+    assert res.success
+    np.testing.assert_allclose(res.theta["a"], 0.7, rtol=1e-6)  # exact free response, e^{-0.7 t}

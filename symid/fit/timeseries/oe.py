@@ -439,6 +439,14 @@ class OutputError(Estimator, FisherInformation):
                                  for r, o in zip(self.records, self._observed, strict=True))
         if self._x0_mode == "known":
             self._x0_known = _known_states(self._x0_known, model.n_states, len(self.records))
+        at_rest = self._x0_mode == "zero" or (self._x0_mode == "known" and not any(np.any(x) for x in self._x0_known))
+        if at_rest and not any(np.any(r.u) for r in self.records):
+            # a new user's zero input ran 11 passes to misfit 1, told to give noise_floor=
+            raise DataError("every input is zero throughout the record" + ("s" if len(self.records) > 1 else "") +
+                            " and the model starts at rest (initial state 0): its output is 0 for every θ, so the "
+                            "samples say nothing of the parameters; give the input that drove the system, or, for a "
+                            "free response from a state that is not 0, initial_state='estimate' (or the model's "
+                            "own x0)")
         self.model, self.data = model, data
         l = model.n_parameters
         self.scale = None if scale is None else check_scale("scale", scale, l)
