@@ -115,6 +115,9 @@ def test_non_affine_entry_is_named(entry, involved):
     # with its sign, the ratio is suggested positive (a new user's hint read `r = -ks/ms` for positive symbols)
     ("-c/m", "introduce a new parameter for the whole ratio (for example `r = c/m`) and write the entry as its "
              "negative (-r)"),
+    # a sum of reciprocals: one per parameter (a new user's two resistances were told one parameter for the sum)
+    ("1/R01 + 1/R12", "introduce a reciprocal parameter for each (`R01inv = 1/R01`, `R12inv = 1/R12`: a "
+                      "conductance for a resistance)"),
 ])
 def test_non_affine_hint(entry, hint):
     with pytest.raises(si.NonAffineError) as info:

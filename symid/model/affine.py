@@ -93,6 +93,14 @@ def _hint(expr: sp.Expr, involved: Sequence[sp.Symbol]) -> str:
         inv = sp.Symbol(f"{den}inv")
         if _is_affine(expr.subs(den, 1 / inv), [*(set(involved) - {den}), inv]):  # 1/m, 1 + 2/m
             return f"introduce a new parameter such as `{inv} = 1/{den}` and write the entry in it"
+    if len(involved) > 1:
+        # a sum of reciprocals (1/R01 + 1/R12: conductances of resistances in series with a node): one reciprocal
+        # parameter per symbol keeps them apart (a new user was told r = 1/R01 + 1/R12, one parameter for the sum)
+        invs = {p: sp.Symbol(f"{p}inv") for p in involved}
+        if _is_affine(expr.subs({p: 1 / q for p, q in invs.items()}), list(invs.values())):
+            new = ", ".join(f"`{q} = 1/{p}`" for p, q in invs.items())
+            return (f"introduce a reciprocal parameter for each ({new}: a conductance for a resistance) and write "
+                    f"the entry in them")
     # a ratio written with its sign (-k/m in A) is suggested without it: the new parameter can then be declared
     # positive like the physical ones, and the entry is -r (a new user's hint read r = -ks/ms)
     neg = expr.could_extract_minus_sign()
