@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--starts", type=int, default=1, help="starts of each kind (default %(default)s)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--methods", default=",".join(METHODS),
-                    help="default %(default)s; also oe-trf, auto-trf, auto-decimate")
+                    help="default %(default)s; also " + ", ".join(VARIANTS))
     ap.add_argument("--out", default="timeseries_population.json", help="file name in benchmarks/results/")
     ap.add_argument("--input", default="white", choices=INPUTS, help="the records' input (default %(default)s)")
     args = ap.parse_args(argv)
