@@ -388,3 +388,35 @@ def test_an_interval_is_found_by_the_parameters_name():
     assert unc.interval("c") == tuple(float(v) for v in unc.intervals[1])
     with pytest.raises(si.DataError, match=r"'k2' is not a parameter of this estimate; its parameters are m, c, k"):
         unc.interval("k2")
+
+
+def _ladder() -> si.SecondOrderModel:
+    """A new user's two-section LC ladder (L in mH, C in µF, R in Ω; E x' = F x + G u in second-order form), with R1
+    and L1 known: resonances at 1280 and 4211 Hz."""
+    L1, C1, L2, C2, R1, R2 = si.parameters("L1 C1 L2 C2 R1 R2", positive=True)
+    E = [[1e-3 * L1, 0, 0, 0], [0, 1e-6 * C1, 0, 0], [0, 0, 1e-3 * L2, 0], [0, 0, 0, 1e-6 * C2]]
+    F = [[-R1, -1, 0, 0], [1, 0, -1, 0], [0, 1, -R2, -1], [0, 0, 1, 0]]
+    model = si.SecondOrderModel(M=E, V=[[-f for f in row] for row in F], K=[[0] * 4 for _ in range(4)],
+                                B=[[1], [0], [0], [0]], C=[[0, 0, 0, 1]], output="velocity")
+    return model.with_known({"R1": 10.0, "L1": 10.0})
+
+
+def test_a_fit_the_data_pull_beyond_its_bounds_is_not_a_success():
+    """A new user's frequency response in Hz read as rad/s: the fit put R2 on its positivity bound (1e-5 Ω for 22)
+    at a misfit the whiteness rule accepted, success True and exit 0. The least-squares estimate lies 12 standard
+    errors beyond the bound, far more than noise explains (χ²(4) at 1e-6: 5.8), so the model within its bounds does
+    not fit: success False, the fit line and NEXT say so. Read in rad/s, the same data fit (truth: the values
+    simulated, 1 % noise)."""
+    model = _ladder()
+    truth = {"C1": 1.0, "L2": 4.7, "C2": 0.47, "R2": 22.0}
+    f = np.logspace(2, np.log10(2e4), 150)
+    frf = si.simulate_frf(model, truth, 2 * np.pi * f, noise=0.01, seed=3)
+    start = {"C1": 2.0, "L2": 2.0, "C2": 1.0, "R2": 10.0}
+    right = si.identify(model, frf, x0=start, scale=start, identifiability_check=False)
+    assert right.success and right.uncertainty.bounds_rejected() is None
+    np.testing.assert_allclose(right.theta_vector, model.theta_vector(truth), rtol=0.02)
+    wrong = si.identify(model, si.FrequencyData(f, frf.H), x0=start, scale=start, identifiability_check=False)
+    assert not wrong.success and not wrong.best_start.success
+    assert wrong.fit.startswith("pulled beyond the bounds: the data pull R2")
+    assert set(wrong.uncertainty.beyond_bounds) == {"R2"} and wrong.uncertainty.shift > 5.78
+    assert "a frequency in Hz read as rad/s" in wrong.summary().split("NEXT: ")[1]

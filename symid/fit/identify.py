@@ -379,8 +379,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     if (isinstance(estimator, FisherInformation) and np.all(np.isfinite(result.theta_vector))
             and np.isfinite(result.cost)):  # not where the model cannot be evaluated (e.g. a mass on its bound 0)
         # declared by the estimator (symid.fit.uncertainty): covariance of θ̂ at the best estimate
-        result = dataclasses.replace(result, uncertainty=estimator.uncertainty(
-            result.theta_vector, model.parameter_names, noise_std=noise_std))
+        result = _bounds_reject(dataclasses.replace(result, uncertainty=estimator.uncertainty(
+            result.theta_vector, model.parameter_names, noise_std=noise_std)))
     if polisher is not None:
         from symid.fit.polish import polish_outcome
 
@@ -393,8 +393,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                                                     options={"polish": polisher.method})
         if (isinstance(polisher, FisherInformation) and np.all(np.isfinite(polished.theta_vector))
                 and np.isfinite(polished.cost)):
-            polished = dataclasses.replace(polished, uncertainty=polisher.uncertainty(
-                polished.theta_vector, model.parameter_names, noise_std=noise_std))
+            polished = _bounds_reject(dataclasses.replace(polished, uncertainty=polisher.uncertainty(
+                polished.theta_vector, model.parameter_names, noise_std=noise_std)))
         result = dataclasses.replace(result, polished=polished)
     extra: dict[str, Any] = {}
     if (result.options.get("initial_state") == "estimate" and hasattr(estimator, "initial_states")
@@ -470,6 +470,22 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if text is not None:
             warnings.warn(text, DataWarning, stacklevel=2)
     return result
+
+
+def _bounds_reject(result: IdentificationResult) -> IdentificationResult:
+    """A fit whose uncertainty says the data reject the bounds it sits on (:meth:`Uncertainty.bounds_rejected`) does
+    not fit the data: ``success`` False, and the fit line says why (a new user's frequency response in Hz read as
+    rad/s was a success with a resistance pulled 12 standard errors below 0)."""
+    unc = result.uncertainty
+    reason = unc.bounds_rejected() if result.success and unc is not None else None
+    if reason is None:
+        return result
+    fit = f"pulled beyond the bounds: {reason}"
+    starts = list(result.starts)
+    best = result.best_start
+    k = next(i for i, s in enumerate(starts) if s is best)
+    starts[k] = dataclasses.replace(starts[k], success=False, fit=fit)
+    return dataclasses.replace(result, success=False, fit=fit, starts=tuple(starts))
 
 
 def _known_outside(known: Mapping[str, float], bounds: Any) -> list[str]:

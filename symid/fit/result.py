@@ -24,6 +24,9 @@ def _relative_difference(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 _NEXT_STEPS = (
+    ("pulled beyond the bounds", "the data want values beyond the bounds the estimate sits on (the fit line names "
+                                 "them): check the data's units first (a frequency in Hz read as rad/s, a time in ms "
+                                 "read as s) and the model's structure; widen the bounds only if the physics allows"),
     ("not physical", "the estimate breaks what the model declares (the fit line says what): try other starts "
                      "(starts=20) or bounds that keep it admissible"),
     ("black box", "a model of this order fits the data far better than this estimate, which is a local minimum or "

@@ -59,6 +59,7 @@ probed for); :func:`symid.identify` then fills ``result.uncertainty``.
 from __future__ import annotations
 
 import abc
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -66,8 +67,8 @@ import numpy as np
 
 from symid.errors import DataError
 
-__all__ = ["BOUND_PULL_LIMIT", "NEAR_SINGULAR", "POSITIVITY_ZERO", "ROUNDING_SHIFT", "SHIFT_LIMIT", "FisherInformation",
-           "Uncertainty", "broadcast_noise", "fisher_uncertainty"]
+__all__ = ["BOUND_PULL_LIMIT", "BOUND_REJECT", "NEAR_SINGULAR", "POSITIVITY_ZERO", "ROUNDING_SHIFT", "SHIFT_LIMIT",
+           "FisherInformation", "Uncertainty", "broadcast_noise", "fisher_uncertainty"]
 
 NEAR_SINGULAR = 1e-8
 """Smallest/largest eigenvalue of the correlation-scaled Fisher information below which it is near-singular."""
@@ -91,6 +92,10 @@ estimate for the other parameters' intervals to be given (:func:`_with_shift`): 
 POSITIVITY_ZERO = 1e-3
 """A parameter declared positive within this fraction of its own standard error of 0 sits on the bound 0 that
 keeps it positive, for the intervals (:func:`_with_shift`): the data cannot tell it from 0."""
+
+BOUND_REJECT = 1e-6
+"""The probability, with the model right and the truth within its bounds, that a fit on its bounds is said not to fit
+(:meth:`Uncertainty.bounds_rejected`)."""
 
 _Z975 = 1.959963984540054  # the 0.975 quantile of the standard normal
 
@@ -141,6 +146,12 @@ class Uncertainty:
         noise, a parameter held at its bound). Above ``SHIFT_LIMIT`` the intervals
         (centred on θ̂) would not hold and are NaN, and ``note`` says why. ``None`` for a
         method whose sensitivity to the noise is known (``estimate_sensitivity``).
+    beyond_bounds : dict of str to float or None
+        The parameters on a bound that the data pull beyond it by more than ``BOUND_PULL_LIMIT``
+        of their own standard errors (or with the others then not at their least-squares
+        estimate), with how far the Gauss–Newton step takes each, in its standard errors
+        (signed); None when there is none. :meth:`bounds_rejected` says whether the data
+        reject the bounds.
     """
 
     parameter_names: tuple[str, ...]
@@ -158,6 +169,43 @@ class Uncertainty:
     note: str = ""
     shift: float | None = None
     weakest_relative: dict[str, float] | None = None
+    beyond_bounds: dict[str, float] | None = None
+
+    def bounds_rejected(self) -> str | None:
+        """Why the data reject the model within its bounds at θ̂, or None.
+
+        ``shift``² is then the score statistic of the active bounds (the squared length of the residual's
+        projection on the sensitivities, in noise units: how much the misfit would fall, to first order, just
+        beyond them); with the model right and the truth within the bounds it exceeds ``χ²(l)`` at 1 − 10⁻⁶
+        (:data:`BOUND_REJECT`, l parameters) once in a million records. Beyond that the estimate does not fit the
+        data: the model within its bounds cannot explain them (a frequency response in Hz read as rad/s pulled a
+        resistance 12 standard errors below 0), or the solver stopped on a bound short of the fit.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from symid.fit.uncertainty import Uncertainty
+        >>> unc = Uncertainty(("R", "L"), np.eye(2), np.ones(2), np.full((2, 2), np.nan), np.ones(1), 100, 1.0,
+        ...                   False, {}, shift=12.4, beyond_bounds={"R": -12.0})
+        >>> unc.bounds_rejected().startswith("the data pull R 12 standard errors beyond its bound")
+        True
+        >>> Uncertainty(("R", "L"), np.eye(2), np.ones(2), np.zeros((2, 2)), np.ones(1), 100, 1.0, False, {},
+        ...             shift=4.0, beyond_bounds={"R": -4.0}).bounds_rejected() is None
+        True
+        """
+        if not self.beyond_bounds or self.shift is None or not np.isfinite(self.shift):
+            return None
+        from scipy.stats import chi2
+
+        limit = float(np.sqrt(chi2.isf(BOUND_REJECT, len(self.parameter_names))))
+        if self.shift <= limit:
+            return None
+        pulls = ", ".join(f"{name} {abs(z):.3g} standard errors" for name, z in self.beyond_bounds.items())
+        which = "its bound" if len(self.beyond_bounds) == 1 else "their bounds"
+        return (f"the data pull {pulls} beyond {which} (the least-squares estimate lies {self.shift:.3g} standard "
+                f"errors away, more than noise explains: {limit:.3g} at probability {BOUND_REJECT:g}), so within "
+                f"the bounds the model does not fit these data: check the model and the data's units (a frequency "
+                f"in Hz read as rad/s, a time in ms read as s), or widen the bounds if the physics allows")
 
     @property
     def correlation(self) -> np.ndarray:
@@ -395,6 +443,8 @@ def _with_shift(unc: Uncertainty, r: np.ndarray, J: np.ndarray, sides: np.ndarra
                 f"(they allow the held parameters to move, so they are wider, not narrower, than with them fixed)")
         return dataclasses.replace(unc, shift=shift, note=note, intervals=intervals)
     if pushed:
+        beyond = {unc.parameter_names[k]: float(delta[k] / se[k]) if se[k] > 0 else math.inf for k in pushed}
+        unc = dataclasses.replace(unc, beyond_bounds=beyond)
         names = ", ".join(f"{unc.parameter_names[k]} ({side(k)})" for k in pushed)
         note = (f"{unc.note + '. ' if unc.note else ''}θ̂ sits on its bounds where the data pull it beyond them: "
                 f"{names}; the least-squares estimate of these data lies {shift:.3g} standard errors away, outside "
