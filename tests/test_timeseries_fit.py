@@ -587,3 +587,25 @@ def test_a_zero_input_from_rest_is_refused_as_carrying_nothing():
     res = si.identify(model, free, x0=[1.0], initial_state="estimate", identifiability_check=False)
     assert res.success
     np.testing.assert_allclose(res.theta["a"], 0.7, rtol=1e-6)  # exact free response, e^{-0.7 t}
+
+
+def test_a_fit_far_from_the_users_start_names_the_units():
+    """A new user's record in seconds labelled in hours fitted with success, every rate 3600 times off the model
+    file's start, and nothing said; a fit whose parameters lie (in the median) more than 100 times from the user's
+    own start says so, in a DataWarning and the summary, naming the time unit. The same record rightly labelled
+    fits at the start's values (truth a = 0.5, b = 2 per hour) and says nothing."""
+    a, b = si.parameters("a b", positive=True)
+    model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])
+    u = np.repeat([0.0, 1.0, 0.0, 1.0], 30)
+    io = si.simulate_io(model, {"a": 0.5, "b": 2.0}, u, dt=0.1)  # dt in hours
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        right = si.identify(model, io, x0=[0.5, 2.0], identifiability_check=False)
+    assert right.success and "far_from_start" not in right.options
+    wrong = si.IOData(io.u, io.y, 360.0, time_unit="h")  # the seconds' values, labelled in hours
+    with pytest.warns(si.DataWarning, match=r"far from your start \(x0\): 2 of 2 parameters .* s read as h"):
+        res = si.identify(model, wrong, x0=[0.5, 2.0], identifiability_check=False)
+    assert res.success
+    np.testing.assert_allclose(res.theta_vector, [0.5 / 3600, 2.0 / 3600], rtol=1e-6)
+    assert res.options["far_from_start"]["median_factor"] == pytest.approx(3600, rel=1e-6)
+    assert "NOTE: the estimate fits, but lies far from your start" in res.summary()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 import time
 import warnings
@@ -226,7 +227,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         On time series the draws are ``"scale"`` too by default when there are typical
         values: ``scale=``, else those read off the records' frequency response
         (:func:`symid.fit.timeseries.scale.typical_scale`: Welch H1, then the same
-        dimensional analysis; none for non-uniform samples or a zero input).
+        dimensional analysis; none for non-uniform samples or a zero input), and on spectra
+        (:func:`symid.fit.spectra.scale.typical_scale`: the response level Φyy / Φuu implies).
         ``"normal"`` (default for other data, and for time series without typical
         values): N(0, 1), positive parameters in absolute value, and θ = 0 first for a
         state-space model, as in the thesis (ch. 3-4).
@@ -462,6 +464,10 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                     relative_noise_note(model, estimator.data, result.theta_vector))
         if relative is not None:  # said in the summary (a new user's load angle over 5 decades: Jm on its bound)
             result = dataclasses.replace(result, options={**result.options, "relative_noise": relative})
+    far = _far_from_start(result, x0s[0] if x0 is not None else None, options.get("scale"), model)
+    if far is not None:  # said in the summary too (a new user's time column in s read as h: success, C1 3600× off)
+        result = dataclasses.replace(result, options={**result.options, "far_from_start": far})
+        warnings.warn(far["text"], DataWarning, stacklevel=2)
     if noise_std is not None and result.uncertainty is not None:
         # the declared noise judges the fit (noise floor): a residual improbably smaller than it says the noise_std
         # is too large, and then a wrong model fits (a new user's k2 5 % off, noise_std 3 times the noise's: success,
@@ -470,6 +476,47 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if text is not None:
             warnings.warn(text, DataWarning, stacklevel=2)
     return result
+
+
+FAR_FROM_START = 100.0
+"""A successful estimate whose parameters lie, in the median, more than this factor from the user's own start (or
+typical values) gets a note: the data's units are the likelier cause (:func:`_far_from_start`)."""
+
+
+def _far_from_start(result: IdentificationResult, x0: Any, scale: Any, model: Any) -> dict[str, Any] | None:
+    """A note when a fit lies far from what the user said of the parameters, else None.
+
+    A time column in seconds read as hours makes every rate 3600 times another's and the model fits as well (a new
+    user's thermal network: success, capacitances 3600 times the model file's start), as milliseconds read as
+    seconds do by 1000; only the user's own start (``x0``), else typical values (``scale``), can tell. The median
+    over the nonzero parameters of |log₁₀(θ̂ / reference)| above log₁₀ :data:`FAR_FROM_START` says so (a typical
+    value 34 times off on a right fit, a new user's loudspeaker, is one parameter, not the median).
+    """
+    if not result.success:
+        return None
+    if x0 is not None:
+        ref, what = np.asarray(x0, dtype=float).reshape(-1), "your start (x0)"
+    elif scale is not None:
+        ref = np.broadcast_to(np.asarray(scale, dtype=float).reshape(-1), result.theta_vector.shape)
+        what = "your typical values (scale=)"
+    else:
+        return None
+    theta = np.asarray(result.theta_vector, dtype=float)
+    use = np.isfinite(theta) & np.isfinite(ref) & (theta != 0) & (ref != 0)
+    if ref.shape != theta.shape or np.count_nonzero(use) < 2:
+        return None
+    logs = np.log10(np.abs(theta[use]) / np.abs(ref[use]))
+    median = float(np.median(np.abs(logs)))
+    if median <= math.log10(FAR_FROM_START):
+        return None
+    names = [n for n, u in zip(model.parameter_names, use, strict=True) if u]
+    k = int(np.argmax(np.abs(logs)))
+    off = int(np.count_nonzero(np.abs(logs) > math.log10(FAR_FROM_START)))
+    text = (f"the estimate fits, but lies far from {what}: {off} of {len(names)} parameters more than "
+            f"{FAR_FROM_START:g} times off (median factor {10 ** median:.3g}; {names[k]} {10 ** logs[k]:.3g} times "
+            f"its value there). If {what} is right, check the data's units: a time column in s read as h makes every "
+            f"rate 3600 times off, ms read as s 1000 times, a frequency in Hz read as rad/s 2π")
+    return {"median_factor": 10 ** median, "parameters_off": off, "text": text}
 
 
 def _bounds_reject(result: IdentificationResult) -> IdentificationResult:
