@@ -63,6 +63,8 @@ SUCCESS = 1e-4  # largest entry error of M, V, K (issue 6)
 VARIANTS = {
     "scr-cvxpy": ("scr", {"backend": "cvxpy"}),
     "scr-admm": ("scr", {"backend": "admm"}),
+    "scr-admm-typical": ("scr", {"backend": "admm", "scale": "typical"}),
+    "scr-cvxpy-typical": ("scr", {"backend": "cvxpy", "scale": "typical"}),
     "scr-printed-sign": ("scr", {"backend": "cvxpy", "aux_sign": 1}),
     "scr-no-lmi": ("scr", {"backend": "cvxpy", "lmis": False, "positivity": False}),
     "ipopt": ("ipopt", {}),
@@ -76,6 +78,10 @@ def run_variant(name: str, starts: int, seed: int, log: RunLog) -> dict:
     model, data = entry.model, entry.data()
     truth = model.theta_vector(entry.truth)
     kind, opts = VARIANTS[name]
+    if opts.get("scale") == "typical":  # the typical values the spectra give (symid.fit.spectra.scale)
+        from symid.fit.spectra.scale import typical_scale
+
+        opts = {**opts, "scale": typical_scale(model, data)}
     t0 = time.perf_counter()
     solver = ScrPSD(model, data, **opts) if kind == "scr" else IpoptPSD(model, data, **opts)
     setup = time.perf_counter() - t0

@@ -45,7 +45,7 @@ def scr_psd(mdl, spec, x0, scaled=True):
     from symid.fit.spectra.scr import ScrPSD
 
     x0 = np.asarray(x0, dtype=float)
-    return ScrPSD(mdl, spec, aux_init="model", scale=np.abs(x0) if scaled else None).run(x0)
+    return ScrPSD(mdl, spec, aux_init="model", scale=np.abs(x0) if scaled else None, unit_scale=scaled).run(x0)
 
 
 @pytest.fixture(scope="module")
@@ -77,6 +77,13 @@ def test_without_a_scale_the_frequency_axis_changes_the_estimate(spectra_ref):
     out = scr_psd(model(), si.SpectralData(spec.w * 1e-6, spec.Phi_yy, spec.Phi_uu), np.array([2.0, 1.0, 2.0]) * phys,
                   scaled=False)
     assert np.max(np.abs(out.theta / phys / ref.theta - 1)) > 0.01
+    # by default (unit_scale) the spectra's typical values, far from 1 here, become the scale: the physics' estimate
+    from symid.fit.spectra.scr import ScrPSD
+
+    slow = si.SpectralData(spec.w * 1e-6, spec.Phi_yy, spec.Phi_uu)
+    est = ScrPSD(model(), slow, aux_init="model")
+    assert est.options["scale_from"].startswith("the spectra's typical values")
+    np.testing.assert_allclose(est.run(np.array([2.0, 1.0, 2.0]) * phys).theta / phys, [1.0, 0.5, 4.0], rtol=1e-6)
 
 
 @pytest.mark.parametrize("a", [-6, -3, 3, 6])

@@ -132,8 +132,8 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         magnitudes as the typical values unless ``scale`` is given.
         ``"normal"``: N(0, 1), with θ = 0 first for a state-space model (the thesis).
         Default: ``"scale"`` for a frequency response, or when ``scale`` is given, or
-        when the data give typical values of their own (time series, unless there is
-        only ``x0`` to return); ``"normal"`` otherwise.
+        when the data give typical values of their own (time series and spectra, unless
+        there is only ``x0`` to return); ``"normal"`` otherwise.
     scale : float or array_like, optional
         The user's typical values (the methods' ``scale=`` option).
     black_box : bool, optional
@@ -167,8 +167,9 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         if kind.name == "frequency response" or scale is not None:
             draws = "scale"
         elif x0 is None or starts > 1:
-            # data that give typical values of their own (time series, through their frequency response): starts at
-            # the data's physical scale rather than N(0, 1) (measured: benchmarks/timeseries_defaults.py)
+            # data that give typical values of their own (time series through their frequency response, spectra
+            # through the level they imply): starts at the data's physical scale rather than N(0, 1) (measured:
+            # benchmarks/timeseries_defaults.py, benchmarks/psd_units.py)
             typical = kind.typical_scale(model, data)
             draws = "normal" if typical is None else "scale"
         else:

@@ -16,8 +16,9 @@ from typing import Any
 
 from symid.errors import ModelError, OptionError
 from symid.fit.base import Estimator
+from symid.fit.spectra.scale import typical_scale
 
-__all__ = ["METHODS", "prepare"]
+__all__ = ["METHODS", "prepare", "typical_scale"]
 
 METHODS = ("scr", "ipopt")
 

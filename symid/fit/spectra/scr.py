@@ -32,6 +32,17 @@ keep the sub-problems small and unit-free without changing a single iterate:
   at its residual tolerance 1e-8 with an entry 2.9e-4 off; the others 1.3e-6–2.2e-8
   against 6.8e-8), and on the 2-DOF with ADMM from 3 of 20 N(0, 1) starts instead of 8.
 
+* **physical units** (``unit_scale``, default on). The relaxation above and the random
+  start of the Yᵢ (σ = 10, "high valued" next to entries of order one) are the thesis's,
+  in the thesis's units; a model in SI units (a building: masses of 2e4 kg, stiffnesses
+  of 3e7 N/m) is another problem to them. Without ``scale``, the typical values read off
+  the spectra (:func:`symid.fit.spectra.scale.typical_scale`) become the scale when one of
+  them lies outside ``UNIT_RANGE`` = 1e-2 … 1e2, and not otherwise (the thesis's
+  ``msd3_psd``, typical values 0.03–1, reached the truth from 5 of 5 starts as it is and
+  from 0 of 5 with them as the scale; ``benchmarks/psd.py --variants
+  scr-admm,scr-admm-typical``). Measured on shear buildings in SI units
+  (``benchmarks/psd_units.py``; numbers in the README).
+
 Unlike the frequency-response formulations, the engine's per-term equilibration is off
 by default (``normalize=False``): it changes the relaxation, and on the thesis example
 (§5-6) the equilibrated iteration stalls where the thesis's plain one converges.
@@ -69,9 +80,39 @@ from symid.fit.options import check_bool, check_choice, check_float, check_scale
 from symid.fit.result import StartOutcome
 from symid.fit.spectra.equations import SpectraEstimator, spectral_equations
 
-__all__ = ["ScrPSD"]
+__all__ = ["UNIT_RANGE", "ScrPSD", "physical_units_scale"]
 
 _AUX_INITS = ("random", "model")
+
+
+UNIT_RANGE = (1e-2, 1e2)
+"""Typical values within this range leave θ as it is (units of order one, as the thesis's); one outside makes them the
+scale (module notes, ``unit_scale``)."""
+
+
+def physical_units_scale(model: Any, data: Any) -> np.ndarray | None:
+    """The spectra's typical values when one lies outside :data:`UNIT_RANGE` (a model in physical units), else None.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.spectra.scr import physical_units_scale
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> w = np.logspace(-0.5, 0.5, 12)
+    >>> physical_units_scale(model, si.simulate_spectra(model, [1.0, 0.2, 1.0], w, 1.0)) is None
+    True
+    >>> big = physical_units_scale(model, si.simulate_spectra(model, [2e4, 4e4, 3e7], 40 * w, 1e6))
+    >>> bool(np.all(np.abs(np.log10(big / [2e4, 4e4, 3e7])) < 1))   # each within a factor 10
+    True
+    """
+    from symid.fit.spectra.scale import typical_scale
+
+    typical = typical_scale(model, data)
+    if typical is None or np.all((typical >= UNIT_RANGE[0]) & (typical <= UNIT_RANGE[1])):
+        return None
+    return typical
 
 
 class ScrPSD(ScrEstimator, SpectraEstimator):
@@ -121,7 +162,11 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         Print one line per SCR iteration (iteration, residual, misfit, elapsed). Default False.
     scale : array_like, optional
         Typical magnitude of each parameter; the engine works on θ / scale (module notes).
-        Default 1 (θ as it is).
+        Default: θ as it is, unless ``unit_scale`` finds the model in physical units.
+    unit_scale : bool, optional
+        Without ``scale``, take the typical values read off the spectra
+        (:func:`symid.fit.spectra.scale.typical_scale`) as the scale when one lies outside
+        ``UNIT_RANGE`` (a model in physical units, module notes); default True.
 
     Examples
     --------
@@ -140,7 +185,7 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
                  backend: str = "cvxpy", max_iter: int = 40, tol: float = 1e-8, aux_init: str = "random",
                  aux_std: float = 10.0, aux_sign: int = -1, seed: int = 0, rank_tol: float = 1e-10,
                  normalize: bool = False, admm: Any = None, time_limit: float | None = None, callback: Any = None,
-                 verbose: bool = False, scale: Any = None):
+                 verbose: bool = False, scale: Any = None, unit_scale: bool = True):
         self.aux_init = check_choice("aux_init", aux_init, _AUX_INITS)
         self.aux_std = check_float("aux_std", aux_std, low=0, strict_low=True)
         if aux_sign not in (-1, 1) or isinstance(aux_sign, bool):
@@ -153,13 +198,18 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         self._progress_options(callback, verbose)
         self.model, self.data = model, data
         self.eq = spectral_equations(model, data)
+        scale_from = "given" if scale is not None else None
+        if scale is None and check_bool("unit_scale", unit_scale):
+            scale = physical_units_scale(model, data)
+            scale_from = None if scale is None else "the spectra's typical values (a model in physical units)"
         self.options: dict[str, Any] = {"lmis": lmis, "positivity": positivity, "backend": backend,
                                         "max_iter": max_iter, "tol": tol, "aux_init": aux_init, "aux_std": aux_std,
                                         "aux_sign": aux_sign, "seed": seed, "rank_tol": rank_tol,
                                         "normalize": normalize, "time_limit": solve_opts["time_limit"],
                                         "callback": None if callback is None else "given", "verbose": self._verbose,
                                         "scale": None if scale is None else check_scale("scale", scale,
-                                                                                        model.n_parameters).tolist()}
+                                                                                        model.n_parameters).tolist(),
+                                        "unit_scale": bool(unit_scale), "scale_from": scale_from}
         self._normalize = check_bool("normalize", normalize)
         self.scale = float(np.max(np.linalg.norm(self.eq.Q, ord=2, axis=(1, 2)))) or 1.0
         # with a scale: P / max‖Pᵢ‖ and X·√(max‖Pᵢ‖ / max‖Qᵢ‖), the same terms in any output unit (module notes)
