@@ -40,7 +40,7 @@ keep the sub-problems small and unit-free without changing a single iterate:
   them lies outside ``UNIT_RANGE`` = 1e-2 … 1e2, and not otherwise (the thesis's
   ``msd3_psd``, typical values 0.03–1, reached the truth from 5 of 5 starts as it is and
   from 0 of 5 with them as the scale; ``benchmarks/psd.py --variants
-  scr-admm,scr-admm-typical``). Measured on shear buildings in SI units
+  scr-admm,scr-admm-typical --out benchmarks/results/psd_typical_scale.json``). Measured on shear buildings in SI units
   (``benchmarks/psd_units.py``; numbers in the README).
 
 Unlike the frequency-response formulations, the engine's per-term equilibration is off
