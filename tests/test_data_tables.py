@@ -598,3 +598,26 @@ def test_a_units_comment_may_name_a_column_without_its_unit_suffix(tmp_path):
         rec = si.read_data(tmp_path / "b.csv", columns={"time": "time_min", "input": "power", "output": "temp"},
                            units={"time": "min"})
     assert rec.stated_units["input"] == (("power", None),)
+
+
+def test_quoted_cells_delimiters_and_a_units_row(tmp_path):
+    """A new user's tables: a quoted text cell with a comma ("a, b") and quoted decimal commas ("0,0002") were split
+    at their commas ('5 cells; the header has 4'); a ';'-separated file read with ',' was told only its cell counts;
+    a row of units under the header was "'s' is not a number"."""
+    cols = {"time": "t", "input": "u", "output": "y"}
+    quoted = tmp_path / "quoted.csv"
+    quoted.write_text('t,u,y,note\n0,1,0.5,"a, b"\n1,1,0.6,"c"\n2,0,0.4,""\n', encoding="utf-8")
+    io = IOData.from_table(quoted, columns=cols, units={"time": "s"})
+    np.testing.assert_array_equal(io.y[:, 0], [0.5, 0.6, 0.4])
+    commas = tmp_path / "commas.csv"
+    commas.write_text('t,u,y\n"0","1","0,5"\n"1","1","0,6"\n', encoding="utf-8")
+    with pytest.raises(si.DataError, match=r"line 2, column 'y': '0,5' is not a number \(a decimal comma\?"):
+        IOData.from_table(commas, columns=cols, units={"time": "s"})
+    semi = tmp_path / "semi.csv"
+    semi.write_text("t;u;y\n0;1;0,5\n1;1;0,6\n", encoding="utf-8")
+    with pytest.raises(si.DataError, match=r"the header holds ';': is that the delimiter\? \(delimiter=';'"):
+        IOData.from_table(semi, columns=cols, units={"time": "s"})
+    units = tmp_path / "units.csv"
+    units.write_text("t,u,y\ns,A,rad/s\n0,1,0.5\n1,1,0.6\n", encoding="utf-8")
+    with pytest.raises(si.DataError, match=r"'s' is not a number \(a row of units under the header\? .*'t \[s\]'"):
+        IOData.from_table(units, columns=cols, units={"time": "s"})

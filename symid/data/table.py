@@ -51,6 +51,7 @@ symid never guesses one.
 
 from __future__ import annotations
 
+import csv
 import os
 import re
 import warnings
@@ -102,6 +103,30 @@ _MISSING_HINT = {"uniform": " (an output not measured at some times: read the ta
 """What to add to an error about a missing or non-finite value, by the source's ``missing_hint``."""
 
 
+def _looks_like_units(cells: list[str]) -> bool:
+    """Every cell of a row is a short text with a letter, %, ° or µ and none is a number: a row of units."""
+    def unit(cell: str) -> bool:
+        text = cell.strip().strip("[]()")
+        try:
+            float(text)
+            return False
+        except ValueError:
+            return 0 < len(text) <= 12 and bool(re.search(r"[A-Za-z%°µ]", text))
+    return bool(cells) and all(unit(c) for c in cells)
+
+
+def _other_delimiter(header: list[str], delimiter: str) -> str:
+    """A hint when a one-column header holds another delimiter (a new user's ';'-separated file with decimal commas
+    was told only its cell counts)."""
+    if len(header) != 1:
+        return ""
+    for other, name in ((";", "';'"), ("\t", "tab ('\\t')"), ("|", "'|'")):
+        if other != delimiter and other in header[0]:
+            return (f"; the header holds {name}: is that the delimiter? (delimiter={other!r} in Python, "
+                    f"--delimiter {other!r} on the command line)")
+    return ""
+
+
 class _Csv:
     """A plain CSV file: header of names, rows of text cells parsed column by column on demand."""
 
@@ -132,14 +157,16 @@ class _Csv:
         self.comments: list[tuple[int, str]] = []
         self.rows: list[tuple[int, list[str]]] = []
         header = None
-        split = (lambda line: line.split()) if delimiter == " " else (lambda line: line.split(delimiter))
+        # a cell in double quotes (as spreadsheets export every cell, numbers too) is its text, the delimiter inside
+        # it included (a new user's "a, b" and "0,0002" were split at their commas)
+        split = (lambda line: line.split()) if delimiter == " " else (
+            lambda line: next(csv.reader([line], delimiter=delimiter, quotechar='"', skipinitialspace=True), []))
         for k, line in enumerate(text.splitlines(), start=1):
             if not line.strip():
                 continue
             if line.lstrip().startswith("#"):
                 self.comments.append((k, line.strip()))
                 continue
-            # a cell in double quotes (as spreadsheets export every cell, numbers too) is its text
             cells = [c[1:-1].strip() if len(c) >= 2 and c[0] == c[-1] == '"' else c
                      for c in (c.strip() for c in split(line))]
             if header is None:
@@ -148,7 +175,8 @@ class _Csv:
                 continue
             if len(cells) != len(header):
                 raise DataError(f"{self.where}, line {k}: {len(cells)} cells; the header (line {self.header_line}) "
-                                f"has {len(header)} columns (delimiter {delimiter!r})")
+                                f"has {len(header)} columns (delimiter {delimiter!r})" + _other_delimiter(header,
+                                                                                                          delimiter))
             self.rows.append((k, cells))
         if header is None:
             raise DataError(f"{self.where} holds no header line of column names")
@@ -180,9 +208,14 @@ class _Csv:
                 out[r] = float(cell)
             except ValueError:
                 comma = re.fullmatch(r"[+-]?\d*,\d+(?:[eE][+-]?\d+)?", cell.strip())
+                # a row of units under the header (a new user's "s,A,rad/s"): said so, with where units go
+                units_row = r == 0 and len(self.rows) > 1 and _looks_like_units(cells)
                 raise DataError(f"{self.where}, line {line}, column {name!r}: {_files._show(cell)} is not a "
                                 "number" + (" (a decimal comma? symid reads '.' as the decimal point: export the "
-                                            "file with '.', or replace ',' by '.' in its numbers)" if comma else "")
+                                            "file with '.', or replace ',' by '.' in its numbers)" if comma else
+                                            f" (a row of units under the header? symid reads units from the header "
+                                            f"('{name} [{cell}]') or a '# units:' comment line, and declared ones "
+                                            f"(units=, --units): delete that row)" if units_row else "")
                                 ) from None
             if not np.isfinite(out[r]):
                 raise DataError(f"{self.where}, line {line}, column {name!r}: {cell} is not a finite number; "
