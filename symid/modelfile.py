@@ -214,8 +214,7 @@ class ModelFile:
                               f"model file gives for it: check the value or the bounds", DataWarning, stacklevel=2)
         bounds_.update(_bounds_values(bounds or {}, free, known_, where))
         if start is not None:  # a partial start is completed from the file's start, the scale, then the bounds
-            given = _name_map(start, f"{where}: x0")
-            _check_free(given, free, known_, f"{where}: x0")
+            given = _check_free(_name_map(start, f"{where}: x0"), free, known_, f"{where}: x0")
             fill = {**_bounds_centres(bounds_), **scale_, **(self.start or {})}
             missing = [n for n in free if n not in given and n not in fill]
             if missing:
@@ -571,14 +570,24 @@ def _known_values(value: Any, model: Any, what: str) -> dict[str, float]:
     return out
 
 
-def _check_free(given: Mapping[str, Any], free: Sequence[str], known: Mapping[str, float], what: str) -> None:
+def _check_free(given: Mapping[str, Any], free: Sequence[str], known: Mapping[str, float], what: str
+                ) -> dict[str, Any]:
+    """``given`` without the known parameters (a ModelWarning names them: their known value is used); a name that is
+    no parameter at all is a ModelError."""
     on_known = [k for k in given if k in known]
     if on_known:
-        raise ModelError(f"{what} gives {', '.join(on_known)}, declared known; known parameters are not estimated")
+        # two new users added `known` to a file whose start named the parameter, and were refused: the known value
+        # is what the fit uses, so the entry is set aside, and said
+        values = ", ".join(f"{k} = {known[k]:g}" for k in on_known)
+        warnings.warn(f"{what} gives {', '.join(on_known)}, declared known ({values}): known parameters are not "
+                      f"estimated, so {'this entry is' if len(on_known) == 1 else 'these entries are'} left out",
+                      ModelWarning, stacklevel=4)
+        given = {k: v for k, v in given.items() if k not in known}
     unknown = [k for k in given if k not in free]
     if unknown:
         raise ModelError(f"{what} names {', '.join(map(repr, unknown))}, not a parameter of the model "
                          f"(free parameters: {', '.join(free)})")
+    return dict(given)
 
 
 def _bounds_centres(bounds: Mapping[str, tuple[float, float]]) -> dict[str, float]:
@@ -592,8 +601,7 @@ def _bounds_centres(bounds: Mapping[str, tuple[float, float]]) -> dict[str, floa
 
 def _start_values(value: Any, model: Any, free: list[str], known: Mapping[str, float], where: str
                   ) -> dict[str, float]:
-    given = _name_map(value, f"{where}: start")
-    _check_free(given, free, known, f"{where}: start")
+    given = _check_free(_name_map(value, f"{where}: start"), free, known, f"{where}: start")
     missing = [k for k in free if k not in given]
     if missing:
         raise ModelError(f"{where}: start lacks {', '.join(missing)}; a start gives every free parameter")
@@ -606,8 +614,7 @@ def _scale_values(value: Any, free: list[str], known: Mapping[str, float], where
     if isinstance(value, numbers.Real) and not isinstance(value, bool):
         given = dict.fromkeys(free, value)
     else:
-        given = _name_map(value, f"{where}: scale")
-        _check_free(given, free, known, f"{where}: scale")
+        given = _check_free(_name_map(value, f"{where}: scale"), free, known, f"{where}: scale")
         missing = [k for k in free if k not in given]
         if missing:
             raise ModelError(f"{where}: scale lacks {', '.join(missing)}; give one typical magnitude per free "
@@ -621,8 +628,7 @@ def _scale_values(value: Any, free: list[str], known: Mapping[str, float], where
 
 def _bounds_values(value: Any, free: list[str], known: Mapping[str, float], where: str
                    ) -> dict[str, tuple[float, float]]:
-    given = _name_map(value, f"{where}: bounds")
-    _check_free(given, free, known, f"{where}: bounds")
+    given = _check_free(_name_map(value, f"{where}: bounds"), free, known, f"{where}: bounds")
     out = {}
     for k in free:
         if k not in given:

@@ -87,7 +87,6 @@ BAD_FILES = {
     "known not a parameter": (CHAIN + "known = {'mass': 1.0}\n", "known names 'mass', not a parameter"),
     "known nan": (CHAIN + "known = {'m1': float('nan')}\n", "known m1 must be finite"),
     "start partial": (CHAIN + "start = {'m1': 1.0}\n", "start lacks m2, c1, c2, k1, k2"),
-    "start on known": (CHAIN + "known = {'m1': 1.0}\nstart = {'m1': 1.0}\n", "declared known"),
     "scale negative": (CHAIN + "scale = -1\n", "a typical magnitude is a positive number"),
     "bounds reversed": (CHAIN + "bounds = {'k1': (100, 10)}\n", "the low end must be below the high end"),
     "bounds not a pair": (CHAIN + "bounds = {'k1': 10}\n", "must be a pair (low, high)"),
@@ -450,3 +449,20 @@ def test_a_scale_by_name_extends_the_files_scale(tmp_path):
         "model = si.SecondOrderModel(M=[[m]], V=[[0.1]], K=[[k]], B=[[1]], C=[[1]])\n")
     with pytest.raises(si.ModelError, match="scale lacks k"):
         si.load_model(str(tmp_path / "n.py")).updated(scale={"m": 2.0})
+
+
+def test_a_start_scale_or_bounds_entry_on_a_known_parameter_is_left_out_and_said(tmp_path):
+    """Two new users added `known` to a model file whose start named the parameter, and were refused ("declared
+    known"); the known value is what the fit uses, so the entry is left out with a ModelWarning naming it."""
+    path = tmp_path / "chain.py"
+    path.write_text(CHAIN + "known = {'m1': 1.0}\nstart = dict(m1=2.0, m2=1, c1=1, c2=1, k1=1, k2=1)\n"
+                    "scale = dict(m1=2.0, m2=1, c1=1, c2=1, k1=1, k2=1)\nbounds = {'m1': (0.5, 3.0)}\n",
+                    encoding="utf-8")
+    with pytest.warns(si.ModelWarning) as record:
+        spec = si.load_model(path)
+    said = [str(w.message) for w in record]
+    for what in ("start", "scale", "bounds"):
+        assert any(f"{what} gives m1, declared known (m1 = 1): known parameters are not estimated, so this entry is "
+                   "left out" in text for text in said), what
+    assert "m1" not in spec.start and "m1" not in spec.scale and "m1" not in spec.bounds
+    assert spec.known == {"m1": 1.0}
