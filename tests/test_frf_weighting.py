@@ -465,3 +465,27 @@ def test_a_fit_of_relative_noise_over_decades_names_variance_relative():
                      (frf, {"variance": "relative"})):
         other = si.identify(model, data, method="lm", x0=[1.2, 0.12, 0.9], identifiability_check=False, **kw)
         assert "relative_noise" not in other.options and "NOTE: the residual looks like" not in other.summary()
+
+
+def test_a_response_of_reversed_polarity_is_named(monkeypatch):
+    """Two new users' failed fits with a sensor of reversed polarity (a frame's accelerometer mounted the other way,
+    a servo's current measured backwards) were told "more starts" and "check the units"; a failed fit is tried
+    again with each output (and the whole response) negated, and the flip that fits is named in NEXT. Truth: the
+    values simulated, noise-free; output 1 negated."""
+    import symid.fit.frf.polarity as polarity
+
+    monkeypatch.setattr(polarity, "TRY_SECONDS", 3.0)  # each flip that cannot fit runs out its budget
+    m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+    model = si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
+                                K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[1, 0], [0, 1]])
+    truth = [2.0, 1.0, 0.3, 0.2, 200.0, 100.0]
+    frf = si.simulate_frf(model, truth, np.logspace(0, 1.5, 60))
+    H = np.asarray(frf.H).copy()
+    H[:, 1, :] *= -1  # the second sensor mounted the other way
+    res = si.identify(model, si.FrequencyData(frf.w, H), x0=[1.5, 1.5, 0.2, 0.2, 150.0, 150.0],
+                      identifiability_check=False, time_limit=3.0)
+    assert not res.success and res.options["polarity"]["flip"] == "output 1"
+    np.testing.assert_allclose(res.options["polarity"]["theta"], truth, rtol=1e-6)
+    assert "NEXT: the data fit with output 1 negated" in res.summary()
+    right = si.identify(model, frf, x0=[1.5, 1.5, 0.2, 0.2, 150.0, 150.0], identifiability_check=False)
+    assert right.success and "polarity" not in right.options

@@ -453,6 +453,16 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     # summary still says it, beside the NEXT line that matters more (a new user's room at misfit 0.82 was warned)
     if ambiguity is not None and (result.success or result.cost <= 1e-2):
         warnings.warn(ambiguity, IdentifiabilityWarning, stacklevel=2)
+    if (isinstance(estimator, FrfEstimator) and not result.success and np.all(np.isfinite(result.theta_vector))
+            and not result.options.get("interrupted")):
+        # a failed fit tried again with an input or output negated (symid.fit.frf.polarity): reversed polarity is
+        # what "more starts" and "check the units" never find
+        from symid.fit.frf.polarity import polarity_flip
+
+        flip = polarity_flip(model, estimator.data, result.theta_vector, scale=options.get("scale"),
+                             bounds=options.get("bounds"), noise_floor=estimator.noise_floor)
+        if flip is not None:
+            result = dataclasses.replace(result, options={**result.options, "polarity": flip})
     if isinstance(estimator, FrfEstimator) and estimator.line_weights is None \
             and np.all(np.isfinite(result.theta_vector)):
         weak = weak_lines_missed(model, estimator.data, result.theta_vector)

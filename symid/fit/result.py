@@ -462,7 +462,13 @@ class IdentificationResult:
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
         if not self.success:
-            if self.polished is not None and self.polished.success:
+            if (flip := self.options.get("polarity")) is not None:
+                # before anything else: no start, bound or unit fixes a response of reversed polarity
+                lines.append(f"NEXT: the data fit with {flip['flip']} negated (misfit {flip['misfit']:.3g}, against "
+                             f"{self.cost:.3g} as they are): an input or output of reversed polarity (a sensor "
+                             f"mounted the other way, a current measured backwards)? Negate it in the data and fit "
+                             f"again (.options['polarity'] holds that fit's estimate)")
+            elif self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
             elif self.on_bounds:  # before the signs of an offset, which then follow: a new user's concentrations
                 # in ug/L against a model in mg/L, every parameter on a bound, were told of the initial state alone

@@ -1,0 +1,97 @@
+"""Is the response of reversed polarity? A failed fit tried again with an input or output negated.
+
+A sensor mounted the other way, a current measured backwards or a force cell's sign
+convention flips an input or an output: the measured response is the model's times −1 in
+those entries. A model whose parameters are physical (positive masses, stiffnesses,
+gains) cannot change the sign of its quasi-static response, so no start fits such data,
+and the advice of a failed fit ("more starts", "check the units") sends the user the
+wrong way (two new users: a frame with one accelerometer flipped, a servo with its
+current reversed). The correlation of the failed estimate's response with the data does
+not show it reliably (the fit half-adapts: +0.71 for the flipped entry of the frame), so
+the test is the fit itself: after a failed fit, the frequency-response ``auto`` is run
+from the failed estimate on the data with the whole response negated, and, for several
+outputs or inputs, with each output's row or input's column negated; a flip whose fit
+succeeds where the data as they are did not is reported (``options["polarity"]`` and a
+NEXT line in the summary). Each try has ``TRY_SECONDS``, all of them ``TOTAL_SECONDS``; at
+most ``1 + p + m`` tries.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from symid.data import FrequencyData
+from symid.errors import SymidError
+
+__all__ = ["TOTAL_SECONDS", "TRY_SECONDS", "polarity_flip"]
+
+TRY_SECONDS = 10.0
+"""The budget of each try (a failed fit already spent its own)."""
+TOTAL_SECONDS = 30.0
+"""The budget of all tries."""
+
+
+def _flips(p: int, m: int) -> list[tuple[str, np.ndarray]]:
+    """The sign patterns tried: the whole response, then each output row and each input column (several of them)."""
+    out = [("the whole response (every input or every output)", -np.ones((p, m)))]
+    if p > 1:
+        for i in range(p):
+            sign = np.ones((p, m))
+            sign[i, :] = -1
+            out.append((f"output {i}", sign))
+    if m > 1:
+        for j in range(m):
+            sign = np.ones((p, m))
+            sign[:, j] = -1
+            out.append((f"input {j}", sign))
+    return out
+
+
+def polarity_flip(model: Any, data: FrequencyData, theta: np.ndarray, *, scale: Any = None, bounds: Any = None,
+                  noise_floor: float | None = None) -> dict[str, Any] | None:
+    """The first sign flip of ``data`` that the model fits (module notes), or None.
+
+    Returns
+    -------
+    dict or None
+        ``{"flip": what was negated, "misfit": the fit's misfit, "theta": its estimate}``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.frf.polarity import polarity_flip
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> frf = si.simulate_frf(model, [2.0, 0.5, 30.0], np.logspace(0, 1.5, 40))
+    >>> flipped = si.FrequencyData(frf.w, -np.asarray(frf.H))      # a sensor mounted the other way
+    >>> polarity_flip(model, flipped, np.array([1.0, 1.0, 10.0]))["flip"]
+    'the whole response (every input or every output)'
+    """
+    import time
+
+    from symid.fit.frf.lm import AutoFRF
+
+    t0 = time.perf_counter()
+    H = np.asarray(data.H)
+    _, p, m = H.shape
+    variance = getattr(data, "variance", None)
+    for what, sign in _flips(p, m):
+        left = TOTAL_SECONDS - (time.perf_counter() - t0)
+        if left <= 0:
+            break
+        flipped = FrequencyData(data.w, H * sign[None], variance=variance)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                est = AutoFRF(model, flipped, scale=scale, bounds=bounds, time_limit=min(TRY_SECONDS, left))
+                est.noise_floor = noise_floor
+                out = est.run(np.asarray(theta, dtype=float))
+        except (SymidError, np.linalg.LinAlgError, ValueError):
+            continue
+        if out.success:
+            return {"flip": what, "misfit": float(out.cost), "theta": np.asarray(out.theta, dtype=float).tolist()}
+    return None
