@@ -98,6 +98,12 @@ class SecondOrderModel(ParametricModel):
         n = self.n_dof
         for _ in range(2):
             M = np.asarray(self._maps["M"](np.exp(rng.uniform(-1.0, 1.0, self.n_parameters))), dtype=float)
+            # rows, then columns, scaled to a largest entry of 1: masses in any units (1e-6 beside 1e6) are not rank
+            # loss, a zero row (a massless node) is
+            rows = np.max(np.abs(M), axis=1)
+            if np.all(rows > 0):
+                M = M / rows[:, None]
+                M = M / np.max(np.abs(M), axis=0)[None, :]
             sv = np.linalg.svd(M, compute_uv=False)
             if sv[0] > 0 and sv[-1] > 1e-10 * sv[0]:
                 return
