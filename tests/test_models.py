@@ -484,6 +484,9 @@ def test_a_mass_matrix_singular_for_every_theta_is_refused_when_the_model_is_bui
     with pytest.raises(si.ModelError, match=r"a mass given as 0 among the known values"):
         si.SecondOrderModel(M=[[c1, 0], [0, c2]], V=[[1, 0], [0, 1]], K=[[g, -g], [-g, g]], B=[[1], [0]],
                             C=[[0, 1]]).with_known({"c2": 0.0})
+    # masses in units far apart are not rank loss (the units test writes m1 in 1e-6 and m2 in 1e6 of its unit)
+    si.SecondOrderModel(M=[[1e-6 * c1, 0], [0, 1e6 * c2]], V=[[1, 0], [0, 1]], K=[[g, -g], [-g, g]], B=[[1], [0]],
+                        C=[[0, 1]])
     # the first-order form the message names works: x = q' with M = C, V = G, K = 0
     model = si.SecondOrderModel(M=[[c1, 0], [0, c2]], V=[[g, -g], [-g, g]], K=[[0, 0], [0, 0]], B=[[1], [0]],
                                 C=[[0, 1]], output="velocity")
