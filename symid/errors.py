@@ -7,6 +7,8 @@ bad types), so ``except ValueError`` keeps working.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 __all__ = [
     "DataError",
     "DataWarning",
@@ -17,6 +19,7 @@ __all__ = [
     "OptionError",
     "SolverError",
     "SymidError",
+    "did_you_mean",
 ]
 
 
@@ -77,3 +80,24 @@ class ModelWarning(UserWarning):
 
 class IdentifiabilityWarning(UserWarning):
     """Parameters asked for are not (locally) identifiable from the data kind."""
+
+
+def did_you_mean(names: Sequence[str], valid: Sequence[str]) -> str:
+    """`` (did you mean 'Kt'?)`` for the first of ``names`` close to one of ``valid`` (the same but for case, or
+    :func:`difflib.get_close_matches` at a similarity of 0.5, which two-letter names need: "Jn" for "Jm"), else
+    ``""``: the part of an error message that names the likely typo.
+
+    Examples
+    --------
+    >>> from symid.errors import did_you_mean
+    >>> did_you_mean(["kt"], ["Jm", "Kt"]), did_you_mean(["Jn"], ["Jm", "Kt"]), did_you_mean(["zz"], ["Jm"])
+    (" (did you mean 'Kt'?)", " (did you mean 'Jm'?)", '')
+    """
+    import difflib
+
+    for name in names:
+        same_case = [v for v in valid if v.lower() == str(name).lower()]
+        close = same_case or difflib.get_close_matches(str(name), list(valid), n=1, cutoff=0.5)
+        if close:
+            return f" (did you mean {close[0]!r}?)"
+    return ""

@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from symid.errors import ModelError, ModelWarning, SymidError
+from symid.errors import ModelError, ModelWarning, SymidError, did_you_mean
 from symid.model.secondorder import SecondOrderModel
 from symid.model.statespace import StateSpaceModel
 
@@ -559,8 +559,8 @@ def _known_values(value: Any, model: Any, what: str) -> dict[str, float]:
     given = _name_map(value, what)
     unknown = [k for k in given if k not in model.parameter_names]
     if unknown:
-        raise ModelError(f"{what} names {', '.join(map(repr, unknown))}, not a parameter of the model "
-                         f"({', '.join(model.parameter_names)})")
+        raise ModelError(f"{what} names {', '.join(map(repr, unknown))}, not a parameter of the model"
+                         f"{did_you_mean(unknown, model.parameter_names)} ({', '.join(model.parameter_names)})")
     out = {k: _number(v, f"{what} {k}") for k, v in given.items()}
     positive = dict(zip(model.parameter_names, model.positive, strict=True))
     bad = [k for k, v in out.items() if positive[k] and v < 0]
@@ -585,8 +585,8 @@ def _check_free(given: Mapping[str, Any], free: Sequence[str], known: Mapping[st
         given = {k: v for k, v in given.items() if k not in known}
     unknown = [k for k in given if k not in free]
     if unknown:
-        raise ModelError(f"{what} names {', '.join(map(repr, unknown))}, not a parameter of the model "
-                         f"(free parameters: {', '.join(free)})")
+        raise ModelError(f"{what} names {', '.join(map(repr, unknown))}, not a parameter of the model"
+                         f"{did_you_mean(unknown, [*free, *known])} (free parameters: {', '.join(free)})")
     return dict(given)
 
 

@@ -87,6 +87,10 @@ BAD_FILES = {
     "known not a parameter": (CHAIN + "known = {'mass': 1.0}\n", "known names 'mass', not a parameter"),
     "known nan": (CHAIN + "known = {'m1': float('nan')}\n", "known m1 must be finite"),
     "start partial": (CHAIN + "start = {'m1': 1.0}\n", "start lacks m2, c1, c2, k1, k2"),
+    # a new user's typo was listed with every name but not pointed at
+    "start typo": (CHAIN + "start = dict(M1=1, m2=1, c1=1, c2=1, k1=1, k2=1)\n", "'M1', not a parameter of the model "
+                                                                             "(did you mean 'm1'?)"),
+    "known typo": (CHAIN + "known = {'K2': 1.0}\n", "(did you mean 'k2'?)"),
     "scale negative": (CHAIN + "scale = -1\n", "a typical magnitude is a positive number"),
     "bounds reversed": (CHAIN + "bounds = {'k1': (100, 10)}\n", "the low end must be below the high end"),
     "bounds not a pair": (CHAIN + "bounds = {'k1': 10}\n", "must be a pair (low, high)"),

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from symid.errors import ModelError
+from symid.errors import ModelError, did_you_mean
 from symid.model.affine import AffineMap, affine_map, order_parameters
 
 __all__ = ["ParametricModel", "Theta"]
@@ -176,8 +176,9 @@ class ParametricModel:
                     raise ModelError(f"theta gives {', '.join(held)}, whose value is known in this model "
                                      f"(with_known: {', '.join(f'{n} = {fixed[n]:g}' for n in held)}); leave it out: "
                                      f"the model's parameters are {', '.join(names) or 'none'}")
-                raise ModelError(f"theta names unknown parameter(s) {', '.join(unknown)}; "
-                                 f"the model's parameters are {', '.join(names) or 'none'}")
+                raise ModelError(f"theta names unknown parameter(s) {', '.join(unknown)}"
+                                 f"{did_you_mean(unknown, names)}; the model's parameters are "
+                                 f"{', '.join(names) or 'none'}")
             if missing:
                 raise ModelError(f"theta is missing parameter(s) {', '.join(missing)}")
             vals = [given[n] for n in names]

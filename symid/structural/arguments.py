@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from symid.errors import ModelError, OptionError
+from symid.errors import ModelError, OptionError, did_you_mean
 from symid.fit.options import check_bool, check_seed
 from symid.structural.msolve import msolve_binary
 from symid.structural.summary import model_kind, rational
@@ -105,8 +105,8 @@ def checked_known(model, known: Any, *, require_free: bool = True) -> tuple[dict
         if not isinstance(name, str):
             raise ModelError(f"known= keys must be parameter names or symbols; got {key!r} ({type(key).__name__})")
         if name not in names:
-            raise ModelError(f"known= names unknown parameter {name!r}; the model's parameters are "
-                             f"{', '.join(names) or 'none'}")
+            raise ModelError(f"known= names unknown parameter {name!r}{did_you_mean([name], names)}; the model's "
+                             f"parameters are {', '.join(names) or 'none'}")
         if name in exact:
             raise ModelError(f"known= gives {name!r} twice (as a name and as a symbol)")
         if not _is_real(value):

@@ -45,7 +45,7 @@ from sympy import QQ, ZZ
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.rings import PolyElement, PolyRing, ring
 
-from symid.errors import ModelError, SolverError
+from symid.errors import ModelError, SolverError, did_you_mean
 from symid.model.expressions import sympify_value
 from symid.structural.modp import PRIME, BadPrime, inverse_mod_p, matmul_mod_p, matrix_mod_p, rank_mod_p
 from symid.structural.order import grevlex_memo
@@ -107,8 +107,9 @@ def free_parameters(model, known: Mapping[str, object] | None) -> tuple[sp.Symbo
     known = dict(known or {})
     unknown = sorted(set(known) - set(model.parameter_names))
     if unknown:
-        raise ModelError(f"known= names unknown parameter(s) {', '.join(unknown)}; "
-                         f"the model's parameters are {', '.join(model.parameter_names)}")
+        raise ModelError(f"known= names unknown parameter(s) {', '.join(unknown)}"
+                         f"{did_you_mean(unknown, model.parameter_names)}; the model's parameters are "
+                         f"{', '.join(model.parameter_names)}")
     return tuple(p for p in model.parameters if p.name not in known)
 
 
