@@ -360,3 +360,13 @@ def test_simulate_io_labels_the_record_in_the_models_time_unit():
     assert io.time_unit == "h" and io.dt == 0.25
     with pytest.raises(DataError, match=r"time_unit='s', but the model's rates are per h"):
         si.simulate_io(model, {"a": 0.5}, np.ones(4), dt=900.0, time_unit="s")
+
+
+def test_simulating_at_a_negative_value_of_a_positive_parameter_is_said():
+    """A new user's C1 = -1000 for a capacitance declared positive was simulated silently; it still is simulated
+    (a study may want it), with a ModelWarning naming it."""
+    a = si.parameters("a", positive=True)
+    model = si.StateSpaceModel(A=[[-1.0]], B=[[a]], C=[[1]])
+    with pytest.warns(si.ModelWarning, match=r"simulating at a = -2, negative for parameter\(s\) declared positive"):
+        io = si.simulate_io(model, {"a": -2.0}, np.ones(3), dt=0.5)
+    np.testing.assert_allclose(io.y[:, 0], [0.0, -2 * (1 - np.exp(-0.5)), -2 * (1 - np.exp(-1.0))], rtol=1e-12)

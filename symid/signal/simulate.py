@@ -13,6 +13,7 @@ makes the draws reproducible (an int, or a :class:`numpy.random.Generator`).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -20,7 +21,7 @@ import numpy as np
 import scipy.linalg
 
 from symid.data import BlackBox, FrequencyData, IOData, SpectralData, checks
-from symid.errors import DataError, ModelError
+from symid.errors import DataError, ModelError, ModelWarning
 from symid.model.lti import StateSpaceMatrices
 from symid.model.parametric import ParametricModel, Theta
 
@@ -46,7 +47,13 @@ def _system(model: Any, theta: Theta | None) -> tuple[ParametricModel | BlackBox
         if theta is None:
             raise ModelError(f"theta is required: values for {', '.join(model.parameter_names)} "
                              f"(a dict by name or a sequence in model.parameter_names order)")
-        return model, model.theta_vector(theta)
+        vec = model.theta_vector(theta)
+        negative = [n for n, v, pos in zip(model.parameter_names, vec, model.positive, strict=True) if pos and v < 0]
+        if negative:  # simulated as asked (a study may want it), but said: a new user's C1 = -1000 passed silently
+            values = ", ".join(f"{n} = {vec[model.parameter_names.index(n)]:g}" for n in negative)
+            warnings.warn(f"simulating at {values}, negative for parameter(s) declared positive: no fit with "
+                          f"positivity (the default) can reach these values", ModelWarning, stacklevel=3)
+        return model, vec
     raise ModelError(f"model must be a StateSpaceModel, a SecondOrderModel (any symid model) or a BlackBox; "
                      f"got {type(model).__name__}")
 
