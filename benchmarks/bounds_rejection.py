@@ -9,7 +9,7 @@ at n = 2 and 3), 1 % noise relative to |H| (as ``population.py``) or of one leve
 line, three records each, ``auto`` from an informed start (within a factor 3 of the truth)
 with the typical values as ``scale``, 30 s per fit.
 
-Run (about 5 minutes)::
+Run (about 2 minutes)::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bounds_rejection.py
 
