@@ -64,7 +64,8 @@ def main(argv: list[str] | None = None) -> int:
                                           identifiability_check=False, time_limit=30)
                     unc = res.uncertainty
                     row = {"problem": p.name, "seed": seed, "noise": kind, "success": bool(res.success),
-                           "refused_by_bounds": res.fit.startswith("pulled beyond the bounds"),
+                           "refused_by_bounds": res.fit.startswith("pulled beyond the bounds"), "fit": res.fit,
+                           "status": res.status,
                            "shift": None if unc is None else unc.shift,
                            "beyond_bounds": None if unc is None else unc.beyond_bounds,
                            "largest_error": float(np.max(np.abs(res.theta_vector / p.truth - 1))),
