@@ -454,13 +454,16 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     if ambiguity is not None and (result.success or result.cost <= 1e-2):
         warnings.warn(ambiguity, IdentifiabilityWarning, stacklevel=2)
     if (isinstance(estimator, FrfEstimator) and not result.success and np.all(np.isfinite(result.theta_vector))
-            and not result.options.get("interrupted")):
+            and not result.options.get("interrupted") and not result.on_bounds
+            and not result.fit.startswith("pulled beyond")):  # a fit the bounds explain is not tried again
         # a failed fit tried again with an input or output negated (symid.fit.frf.polarity): reversed polarity is
         # what "more starts" and "check the units" never find
         from symid.fit.frf.polarity import polarity_flip
 
-        flip = polarity_flip(model, estimator.data, result.theta_vector, scale=options.get("scale"),
-                             bounds=options.get("bounds"), noise_floor=estimator.noise_floor)
+        with Heartbeat("the failed fit tried with the response negated: a reversed sensor?",
+                       enabled=progress is not False):
+            flip = polarity_flip(model, estimator.data, result.theta_vector, scale=options.get("scale"),
+                                 bounds=options.get("bounds"), noise_floor=estimator.noise_floor)
         if flip is not None:
             result = dataclasses.replace(result, options={**result.options, "polarity": flip})
     if isinstance(estimator, FrfEstimator) and estimator.line_weights is None \
