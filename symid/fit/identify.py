@@ -507,16 +507,18 @@ def _far_from_start(result: IdentificationResult, x0: Any, scale: Any, model: An
     """
     if not result.success:
         return None
+    theta = np.asarray(result.theta_vector, dtype=float)
     if x0 is not None:
         ref, what = np.asarray(x0, dtype=float).reshape(-1), "your start (x0)"
     elif scale is not None:
-        ref = np.broadcast_to(np.asarray(scale, dtype=float).reshape(-1), result.theta_vector.shape)
-        what = "your typical values (scale=)"
+        ref, what = np.asarray(scale, dtype=float).reshape(-1), "your typical values (scale=)"
+        ref = np.full(theta.shape, ref[0]) if ref.size == 1 else ref
     else:
         return None
-    theta = np.asarray(result.theta_vector, dtype=float)
+    if ref.shape != theta.shape:
+        return None
     use = np.isfinite(theta) & np.isfinite(ref) & (theta != 0) & (ref != 0)
-    if ref.shape != theta.shape or np.count_nonzero(use) < 2:
+    if np.count_nonzero(use) < 2:
         return None
     logs = np.log10(np.abs(theta[use]) / np.abs(ref[use]))
     median = float(np.median(np.abs(logs)))
