@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -195,3 +197,19 @@ def test_welch_spectra_noise_is_relative_to_the_measured_auto_spectra():
     for name in ("m1", "m2", "k1", "k2"):
         low, high = unc.interval(name)
         assert low < truth[name] < high and (high - low) / 2 < 0.5 * res.theta[name], name
+
+
+def test_many_lines_with_clarabel_are_said_to_be_slow():
+    """A new user's 779 Welch lines ran SCR with Clarabel for 11 minutes without an end; more than MANY_LINES lines
+    with backend='cvxpy' is a DataWarning naming the ADMM back end and fewer lines, and a start has a 600 s budget
+    by default."""
+    from symid.fit.spectra.scr import MANY_LINES
+
+    model, truth = _si_two_storey()
+    spec = si.simulate_spectra(model, truth, np.logspace(0.5, 2.2, MANY_LINES + 1), 1e6)
+    with pytest.warns(si.DataWarning, match=r"frequencies with backend='cvxpy' \(Clarabel\).*backend='admm'"):
+        est = ScrPSD(model, spec)
+    assert est.options["time_limit"] == 600.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", si.DataWarning)
+        ScrPSD(model, spec, backend="admm")

@@ -80,11 +80,13 @@ from symid.fit.options import check_bool, check_choice, check_float, check_scale
 from symid.fit.result import StartOutcome
 from symid.fit.spectra.equations import SpectraEstimator, spectral_equations
 
-__all__ = ["UNIT_RANGE", "ScrPSD", "physical_units_scale"]
+__all__ = ["MANY_LINES", "UNIT_RANGE", "ScrPSD", "physical_units_scale"]
 
 _AUX_INITS = ("random", "model")
 
 
+MANY_LINES = 250
+"""Frequencies above which SCR with Clarabel (``backend="cvxpy"``) is said to be slow (one conic block per line)."""
 UNIT_RANGE = (1e-2, 1e2)
 """Typical values within this range leave θ as it is (units of order one, as the thesis's); one outside makes them the
 scale (module notes, ``unit_scale``)."""
@@ -153,7 +155,9 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
     time_limit : float, optional
         Wall-time budget of one start in seconds, the first step from the random Yᵢ
         included (status ``"time_limit"``; the iteration under way is cut short, see
-        :func:`symid.engine.scr.solve`). Default: none.
+        :func:`symid.engine.scr.solve`). Default 600, a safety (the thesis's ``msd3_psd``
+        takes 75 s a start with Clarabel; a new user's 779 lines ran 11 minutes without an
+        end); ``None`` for none.
     callback : callable, optional
         Called after every SCR iteration with a :class:`symid.engine.scr.ScrProgress`
         (iteration, residual, data misfit, elapsed seconds, θ); a true return value stops
@@ -184,7 +188,7 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
     def __init__(self, model: Any, data: Any, *, lmis: bool = True, positivity: bool = True,
                  backend: str = "cvxpy", max_iter: int = 40, tol: float = 1e-8, aux_init: str = "random",
                  aux_std: float = 10.0, aux_sign: int = -1, seed: int = 0, rank_tol: float = 1e-10,
-                 normalize: bool = False, admm: Any = None, time_limit: float | None = None, callback: Any = None,
+                 normalize: bool = False, admm: Any = None, time_limit: float | None = 600.0, callback: Any = None,
                  verbose: bool = False, scale: Any = None, unit_scale: bool = True):
         self.aux_init = check_choice("aux_init", aux_init, _AUX_INITS)
         self.aux_std = check_float("aux_std", aux_std, low=0, strict_low=True)
@@ -198,6 +202,16 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         self._progress_options(callback, verbose)
         self.model, self.data = model, data
         self.eq = spectral_equations(model, data)
+        lines = int(np.asarray(data.w).size)
+        if solve_opts["backend"] == "cvxpy" and lines > MANY_LINES:
+            import warnings
+
+            from symid.errors import DataWarning
+
+            warnings.warn(f"{lines} frequencies with backend='cvxpy' (Clarabel): every SCR iteration is one conic "
+                          f"problem of {lines} blocks, minutes each at this size (the thesis's 170 took 5 s an "
+                          f"iteration); backend='admm' (11 times faster there) or fewer lines "
+                          f"(si.estimate_spectra(..., n_frequencies=100))", DataWarning, stacklevel=4)
         scale_from = "given" if scale is not None else None
         if scale is None and check_bool("unit_scale", unit_scale):
             scale = physical_units_scale(model, data)
