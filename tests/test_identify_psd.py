@@ -174,6 +174,8 @@ def test_spectra_of_a_model_in_si_units_are_started_and_scaled_at_their_own_scal
     assert np.all(np.abs(np.log10(starts / typical)) <= np.log10(3) + 1e-12)  # within a factor 3 of them
     res = si.identify(model, spec, method="scr", backend="admm", seed=0, identifiability_check=False)
     assert res.success and res.options["scale_from"].startswith("the spectra's typical values")
+    # the start only seeds the random Yᵢ of §5-6, and the message says so (a new user's start changed no digit)
+    assert "the start only seeds the random Yᵢ (aux_init='model' starts from it)" in res.message
     np.testing.assert_allclose(res.theta_vector, theta, rtol=1e-6)
     # the thesis's own units are left as they are (msd3_psd, typical values 0.03-1)
     entry = si.load_model("msd3_psd")

@@ -337,4 +337,7 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
         elif first is not None:
             message = (f"first step from random Yᵢ (§5-6), then {message}" if first is not sol else
                        f"first step from random Yᵢ (§5-6) failed: {first.message}")
+        if self.aux_init == "random":
+            # a new user's start and none gave every digit the same, and nothing said why
+            message += "; the start only seeds the random Yᵢ (aux_init='model' starts from it)"
         return self.solved_outcome(x0, theta, sol, t0, message=message, history=hist)
