@@ -8,14 +8,15 @@ and the advice of a failed fit ("more starts", "check the units") sends the user
 wrong way (two new users: a frame with one accelerometer flipped, a servo with its
 current reversed). The correlation of the failed estimate's response with the data does
 not show it reliably (the fit half-adapts: +0.71 for the flipped entry of the frame), so
-the test is the fit itself: after a failed fit, the frequency-response ``auto`` is run
-from the user's start, then from the failed estimate, on the data with the whole response negated, and, for several
-outputs or inputs, with each output's row or input's column negated; a flip whose fit
-succeeds is reported when the same try on the data as they are does not
-(a model with parameters of either sign can fit a negated response too, and is not tried:
-the belt drive of the thesis, IPOPT from θ = 0 failed, fitted its response negated) (``options["polarity"]`` and a
-NEXT line in the summary). Each try has ``TRY_SECONDS`` and ``RESTARTS``, all of them
-``TOTAL_SECONDS``; at most ``1 + p + m`` tries, and the control on the data as they are.
+the test is the fit itself: after a failed fit, the frequency-response ``auto`` is run,
+from the user's start and then from the failed estimate, on the data with the whole
+response negated and, for several outputs or inputs, with each output's row or input's
+column negated; a flip whose fit succeeds is reported (``options["polarity"]`` and a NEXT
+line in the summary) when the same try on the data as they are does not. A model with
+parameters of either sign can negate its response itself and is not tried (the thesis's
+belt drive, IPOPT from θ = 0 failed, fitted its response negated). Each try has
+``TRY_SECONDS`` and ``RESTARTS``, all of them ``TOTAL_SECONDS``; at most ``1 + p + m``
+flips, each from up to two points, and one control on the data as they are.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ TRY_SECONDS = 10.0
 TOTAL_SECONDS = 40.0
 """The budget of all tries."""
 RESTARTS = 4
-"""Restarts of each try (a flip that fits does so from the failed estimate or soon after)."""
+"""Restarts of each try (a flip that fits does so from the point tried or soon after)."""
 
 
 def _flips(p: int, m: int) -> list[tuple[str, np.ndarray]]:
