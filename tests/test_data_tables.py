@@ -615,7 +615,8 @@ def test_quoted_cells_delimiters_and_a_units_row(tmp_path):
         IOData.from_table(commas, columns=cols, units={"time": "s"})
     semi = tmp_path / "semi.csv"
     semi.write_text("t;u;y\n0;1;0,5\n1;1;0,6\n", encoding="utf-8")
-    with pytest.raises(si.DataError, match=r"the header holds ';': is that the delimiter\? \(delimiter=';'"):
+    with pytest.raises(si.DataError, match=r"the header \(line 1\) has 1 column \(delimiter ','\); the header holds "
+                                           r"';': is that the delimiter\? \(delimiter=';'"):
         IOData.from_table(semi, columns=cols, units={"time": "s"})
     units = tmp_path / "units.csv"
     units.write_text("t,u,y\ns,A,rad/s\n0,1,0.5\n1,1,0.6\n", encoding="utf-8")

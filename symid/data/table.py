@@ -175,8 +175,8 @@ class _Csv:
                 continue
             if len(cells) != len(header):
                 raise DataError(f"{self.where}, line {k}: {len(cells)} cells; the header (line {self.header_line}) "
-                                f"has {len(header)} columns (delimiter {delimiter!r})" + _other_delimiter(header,
-                                                                                                          delimiter))
+                                f"has {len(header)} column{'s' if len(header) != 1 else ''} (delimiter "
+                                f"{delimiter!r})" + _other_delimiter(header, delimiter))
             self.rows.append((k, cells))
         if header is None:
             raise DataError(f"{self.where} holds no header line of column names")
