@@ -347,7 +347,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     # linear least squares (and SRIVC from its own least-squares start): the start plays no part
     linear = estimator.method in ("ls", "svf") or (estimator.method == "srivc" and estimator.options["init"] == "ls")
     x0s = draw_starts(model, data, starts, seed, x0, draws=draws, scale=options.get("scale"), black_box=not linear,
-                      bounds=options.get("bounds"))
+                      bounds=options.get("bounds"), data_typical=getattr(estimator, "data_typical", None))
     if x0 is not None:
         estimator.check_start(x0s[0])  # the user's own start: refused with a reason (e.g. outside the bounds)
     check_s, not_local = None, ()

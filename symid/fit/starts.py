@@ -115,7 +115,8 @@ def make_starts(model: Any, starts: int, seed: int | None, x0: Any = None, *, ze
 
 
 def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = None, *, draws: str | None = None,
-                scale: Any = None, black_box: bool = True, bounds: Any = None) -> list[np.ndarray]:
+                scale: Any = None, black_box: bool = True, bounds: Any = None,
+                data_typical: np.ndarray | None = None) -> list[np.ndarray]:
     """The starts of :func:`symid.identify` and :func:`symid.compare`: ``x0`` first, then random draws.
 
     Parameters
@@ -145,6 +146,9 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
         gives its typical value, and every start but the user's ``x0`` is moved into the
         bounds (:mod:`symid.fit.bounded`; a user's start outside them is the method's
         to refuse).
+    data_typical : array_like, optional
+        The typical values the data kind reads off the data, when the caller has them
+        already (an estimator that computed them: not computed again).
 
     Examples
     --------
@@ -170,7 +174,7 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
             # data that give typical values of their own (time series through their frequency response, spectra
             # through the level they imply): starts at the data's physical scale rather than N(0, 1) (measured:
             # benchmarks/timeseries_defaults.py, benchmarks/psd_units.py)
-            typical = kind.typical_scale(model, data)
+            typical = kind.typical_scale(model, data) if data_typical is None else np.asarray(data_typical)
             draws = "normal" if typical is None else "scale"
         else:
             draws = "normal"  # the user's start alone
@@ -187,7 +191,7 @@ def draw_starts(model: Any, data: Any, starts: int, seed: int | None, x0: Any = 
     if scale is not None:
         typical = np.abs(check_scale("scale", scale, model.n_parameters))
     elif typical is None:
-        typical = kind.typical_scale(model, data)
+        typical = kind.typical_scale(model, data) if data_typical is None else np.asarray(data_typical)
         if typical is None:
             raise OptionError(f"draws='scale' needs typical values: give scale= (one value or one per parameter); "
                               f"{kind.name} data give none of their own")

@@ -92,8 +92,9 @@ UNIT_RANGE = (1e-2, 1e2)
 scale (module notes, ``unit_scale``)."""
 
 
-def physical_units_scale(model: Any, data: Any) -> np.ndarray | None:
-    """The spectra's typical values when one lies outside :data:`UNIT_RANGE` (a model in physical units), else None.
+def physical_units_scale(model: Any, data: Any, typical: np.ndarray | None = None) -> np.ndarray | None:
+    """The spectra's typical values when one lies outside :data:`UNIT_RANGE` (a model in physical units), else None;
+    ``typical``: those values when the caller has them already.
 
     Examples
     --------
@@ -111,7 +112,7 @@ def physical_units_scale(model: Any, data: Any) -> np.ndarray | None:
     """
     from symid.fit.spectra.scale import typical_scale
 
-    typical = typical_scale(model, data)
+    typical = typical_scale(model, data) if typical is None else typical
     if typical is None or np.all((typical >= UNIT_RANGE[0]) & (typical <= UNIT_RANGE[1])):
         return None
     return typical
@@ -213,8 +214,12 @@ class ScrPSD(ScrEstimator, SpectraEstimator):
                           f"iteration); backend='admm' (11 times faster there) or fewer lines "
                           f"(si.estimate_spectra(..., n_frequencies=100))", DataWarning, stacklevel=4)
         scale_from = "given" if scale is not None else None
+        self.data_typical = None  # the spectra's typical values when computed here (identify's draws reuse them)
         if scale is None and check_bool("unit_scale", unit_scale):
-            scale = physical_units_scale(model, data)
+            from symid.fit.spectra.scale import typical_scale
+
+            self.data_typical = typical_scale(model, data)
+            scale = physical_units_scale(model, data, typical=self.data_typical)
             scale_from = None if scale is None else "the spectra's typical values (a model in physical units)"
         self.options: dict[str, Any] = {"lmis": lmis, "positivity": positivity, "backend": backend,
                                         "max_iter": max_iter, "tol": tol, "aux_init": aux_init, "aux_std": aux_std,
