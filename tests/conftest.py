@@ -90,3 +90,17 @@ def free_chain():
         return si.SecondOrderModel(M=sp.diag(*m), V=V, K=K, B=B, C=C)
 
     return build
+
+
+@pytest.fixture
+def grounded_two_mass():
+    """A builder of the two-mass chain tied to the ground at mass 1 (m1, m2, c1, c2, k1, k2; element 1 to the
+    ground, element 2 between the masses): ``grounded_two_mass(B, C, output="position")``."""
+    import symid as si
+
+    def build(B, C, output: str = "position"):
+        m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
+        return si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
+                                   K=[[k1 + k2, -k2], [-k2, k2]], B=B, C=C, output=output)
+
+    return build

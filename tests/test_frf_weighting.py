@@ -467,7 +467,7 @@ def test_a_fit_of_relative_noise_over_decades_names_variance_relative():
         assert "relative_noise" not in other.options and "NOTE: the residual looks like" not in other.summary()
 
 
-def test_a_response_of_reversed_polarity_is_named(monkeypatch):
+def test_a_response_of_reversed_polarity_is_named(monkeypatch, grounded_two_mass):
     """Two new users' failed fits with a sensor of reversed polarity (a frame's accelerometer mounted the other way,
     a servo's current measured backwards) were told "more starts" and "check the units"; a failed fit is tried
     again with each output (and the whole response) negated, and the flip that fits is named in NEXT. Truth: the
@@ -475,9 +475,7 @@ def test_a_response_of_reversed_polarity_is_named(monkeypatch):
     import symid.fit.frf.polarity as polarity
 
     monkeypatch.setattr(polarity, "TRY_SECONDS", 3.0)  # each flip that cannot fit runs out its budget
-    m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
-    model = si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
-                                K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[1, 0], [0, 1]])
+    model = grounded_two_mass(B=[[0], [1]], C=[[1, 0], [0, 1]])
     truth = [2.0, 1.0, 0.3, 0.2, 200.0, 100.0]
     frf = si.simulate_frf(model, truth, np.logspace(0, 1.5, 60))
     H = np.asarray(frf.H).copy()

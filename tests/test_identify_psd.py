@@ -148,16 +148,15 @@ def test_compare_and_polish_work_for_spectra(spec):
     assert res.polished.cost <= res.cost
 
 
-def _si_two_storey() -> tuple[si.SecondOrderModel, dict[str, float]]:
+@pytest.fixture
+def si_two_storey(grounded_two_mass) -> tuple[si.SecondOrderModel, dict[str, float]]:
     """Two storeys in SI units (a new user's building had masses of 2e4 kg and stiffnesses of 3e7 N/m), a white
     force at the roof, both displacements measured: the full sensor set Algorithm 5.1 needs."""
-    m1, m2, c1, c2, k1, k2 = si.parameters("m1 m2 c1 c2 k1 k2", positive=True)
-    model = si.SecondOrderModel(M=[[m1, 0], [0, m2]], V=[[c1 + c2, -c2], [-c2, c2]],
-                                K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [1]], C=[[1, 0], [0, 1]])
+    model = grounded_two_mass(B=[[0], [1]], C=[[1, 0], [0, 1]])
     return model, {"m1": 2e4, "m2": 1.5e4, "c1": 4e4, "c2": 2e4, "k1": 3e7, "k2": 2e7}
 
 
-def test_spectra_of_a_model_in_si_units_are_started_and_scaled_at_their_own_scale():
+def test_spectra_of_a_model_in_si_units_are_started_and_scaled_at_their_own_scale(si_two_storey):
     """Spectra gave no typical values: starts were N(0, 1) draws, and SCR's relaxation and random start are the
     thesis's, in units of order one; a new user's building in SI units ended with masses of 1.3 kg for 2e4. Now the
     starts are drawn around the typical values the spectra give, and SCR takes them as its scale when one lies
@@ -165,7 +164,7 @@ def test_spectra_of_a_model_in_si_units_are_started_and_scaled_at_their_own_scal
     from symid.fit.spectra.scale import typical_scale
     from symid.fit.starts import draw_starts
 
-    model, truth = _si_two_storey()
+    model, truth = si_two_storey
     theta = model.theta_vector(truth)
     spec = si.simulate_spectra(model, truth, np.logspace(0.5, 2.2, 40), 1e6)
     typical = typical_scale(model, spec)
@@ -182,13 +181,13 @@ def test_spectra_of_a_model_in_si_units_are_started_and_scaled_at_their_own_scal
     assert ScrPSD(entry.model, entry.data()).options["scale"] is None
 
 
-def test_welch_spectra_noise_is_relative_to_the_measured_auto_spectra():
+def test_welch_spectra_noise_is_relative_to_the_measured_auto_spectra(si_two_storey):
     """The uncertainty took the noise of a spectrum relative to the model's |Φyyᵢⱼ(θ)|; where 2 % sensor noise is all
     the Welch estimate holds (lines far above the modes, a displacement falling as ω⁻⁴), the model's value is orders
     of magnitude smaller, the level came out at 219 % and every interval held 0. Relative to √(Φᵢᵢ Φⱼⱼ) measured (a
     Welch estimate's variance): 23 %, intervals of 9-18 % that hold the truth (values the record is simulated
     with; the estimate, IPOPT from the truth, is 10-17 % off on 60 s of data)."""
-    model, truth = _si_two_storey()
+    model, truth = si_two_storey
     dt, phi = 0.01, 1e6
     u = np.random.default_rng(0).standard_normal(60000) * np.sqrt(phi / dt)
     io = si.simulate_io(model, truth, u, dt, noise=0.02, seed=1)
@@ -201,13 +200,13 @@ def test_welch_spectra_noise_is_relative_to_the_measured_auto_spectra():
         assert low < truth[name] < high and (high - low) / 2 < 0.5 * res.theta[name], name
 
 
-def test_many_lines_with_clarabel_are_said_to_be_slow():
+def test_many_lines_with_clarabel_are_said_to_be_slow(si_two_storey):
     """A new user's 779 Welch lines ran SCR with Clarabel for 11 minutes without an end; more than MANY_LINES lines
     with backend='cvxpy' is a DataWarning naming the ADMM back end and fewer lines, and a start has a 600 s budget
     by default."""
     from symid.fit.spectra.scr import MANY_LINES
 
-    model, truth = _si_two_storey()
+    model, truth = si_two_storey
     spec = si.simulate_spectra(model, truth, np.logspace(0.5, 2.2, MANY_LINES + 1), 1e6)
     with pytest.warns(si.DataWarning, match=r"frequencies with backend='cvxpy' \(Clarabel\).*backend='admm'"):
         est = ScrPSD(model, spec)
