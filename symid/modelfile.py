@@ -353,7 +353,7 @@ def _substituted(model: Any, known: Mapping[str, float]) -> Any:
         with warnings.catch_warnings():  # the model's own construction said what there is to say of its matrices
             warnings.simplefilter("ignore", ModelWarning)
             return SecondOrderModel(M=sym["M"], V=sym["V"], K=sym["K"], B=sym["B"], C=sym["C"],
-                                    output=model.output, parameters=free, name=model.name)
+                                    output=model.outputs, parameters=free, name=model.name)
     kind = model.initial_state_kind
     x0: Any = None
     if kind == "estimate":

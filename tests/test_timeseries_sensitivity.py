@@ -27,7 +27,7 @@ def _casadi_jacobian(est, theta):
     return np.asarray(est._jacobian_function(s)(est._unknowns(theta), q))
 
 
-@pytest.mark.parametrize("output", ["position", "velocity", "acceleration"])
+@pytest.mark.parametrize("output", ["position", "velocity", "acceleration", ("acceleration", "position")])
 def test_state_space_derivatives_match_central_differences(output):
     model, truth = _chain(output)
     mats, dmats = state_space_derivatives(model, truth)
@@ -44,7 +44,7 @@ def test_state_space_derivatives_match_central_differences(output):
             np.testing.assert_allclose(dX[k], fd, rtol=1e-6, atol=1e-8 * max(1.0, np.abs(fd).max()))
 
 
-@pytest.mark.parametrize("output", ["position", "acceleration"])
+@pytest.mark.parametrize("output", ["position", "acceleration", ("velocity", "acceleration")])
 def test_jacobian_equals_casadi_with_estimated_initial_states_and_uneven_sampling(output):
     model, truth = _chain(output)
     rng = np.random.default_rng(4)

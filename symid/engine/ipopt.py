@@ -64,10 +64,17 @@ def casadi_frf(model: Any, theta: ca.MX, w: np.ndarray) -> tuple[list[ca.MX], li
             big = ca.vertcat(ca.horzcat(R, -S), ca.horzcat(S, R))
             X = ca.solve(big, ca.vertcat(B, ca.MX(n, m)))
             hr, hi = C @ X[:n, :], C @ X[n:, :]
-            if model.output == "velocity":
-                hr, hi = -wi * hi, wi * hr
-            elif model.output == "acceleration":
-                hr, hi = -(wi**2) * hr, -(wi**2) * hi
+            if model.output != "position":  # each row times (jω)ᵈ, d its derivative order
+                rows_r, rows_i = [], []
+                for i, d in enumerate(model.output_orders):
+                    r_, i_ = hr[i, :], hi[i, :]
+                    if d == 1:
+                        r_, i_ = -wi * i_, wi * r_
+                    elif d == 2:
+                        r_, i_ = -(wi**2) * r_, -(wi**2) * i_
+                    rows_r.append(r_)
+                    rows_i.append(i_)
+                hr, hi = ca.vertcat(*rows_r), ca.vertcat(*rows_i)
             Hr.append(hr)
             Hi.append(hi)
     else:

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from symid.errors import ModelError
+from symid.model.secondorder import output_factor
 
 __all__ = ["frf_sensitivity", "spectra_sensitivity"]
 
@@ -120,9 +121,8 @@ def frf_sensitivity(model: Any, theta: Any, w: Any) -> tuple[np.ndarray, np.ndar
                 dG = dG + _left(_coef(maps["C"]), ZB)
             if not maps["B"].is_constant:
                 dG = dG + _right(CZ, _coef(maps["B"]))
-            f = {"position": np.ones(w.size, complex), "velocity": 1j * w,
-                 "acceleration": -(w**2) + 0j}[model.output]
-            return f[:, None, None] * G, f[:, None, None, None] * dG
+            f = output_factor(model, w)  # (s, p): each output row times (jω)ᵈ
+            return f[:, :, None] * G, f[:, :, None, None] * dG
         A, B, C, D = (mats[k] for k in "ABCD")
         n = A.shape[0]
         Zs = 1j * w[:, None, None] * np.eye(n) - A

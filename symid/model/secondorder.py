@@ -14,9 +14,12 @@ from symid.model.lti import StateSpaceMatrices, as_frequencies
 from symid.model.parametric import ParametricModel, Theta
 from symid.model.symbols import as_symbolic_matrix
 
-__all__ = ["OUTPUT_KINDS", "SecondOrderModel"]
+__all__ = ["MIXED", "OUTPUT_KINDS", "OUTPUT_ORDERS", "SecondOrderModel", "output_factor"]
 
 OUTPUT_KINDS = ("position", "velocity", "acceleration")
+OUTPUT_ORDERS = {"position": 0, "velocity": 1, "acceleration": 2}
+"""The derivative order d of each output kind: its response is (jω)ᵈ times the position's."""
+MIXED = "mixed"
 
 
 class SecondOrderModel(ParametricModel):
@@ -36,8 +39,11 @@ class SecondOrderModel(ParametricModel):
         Input matrix (n, m).
     C : array_like or sympy.Matrix
         Output matrix (p, n).
-    output : {"position", "velocity", "acceleration"}
-        What the sensors measure. Default ``"position"``.
+    output : {"position", "velocity", "acceleration"} or sequence of them
+        What the sensors measure. Default ``"position"``. A sequence gives one kind
+        per row of C (an accelerometer beside a displacement sensor): row i of the
+        output is ``Cᵢ q``, ``Cᵢ q'`` or ``Cᵢ q''``; :attr:`output` is then ``"mixed"``
+        and :attr:`outputs` holds the kinds.
     parameters : sequence of sympy.Symbol or str, or str, optional
         Fixes the order of θ (a string is split at spaces and commas); by default the
         order of first appearance, row by row, through M, V, K, B, C (within one
@@ -58,7 +64,11 @@ class SecondOrderModel(ParametricModel):
     ``A = [[0, I], [−M⁻¹K, −M⁻¹V]]``, ``B = [[0], [M⁻¹B]]``. The thesis's (4-3)
     prints ``−M⁻¹B``; the sign there is a typo (it contradicts (4-2) and (7-2)).
     The output matrix is ``[C, 0]`` for position, ``[0, C]`` for velocity and, for
-    acceleration, ``[−CM⁻¹K, −CM⁻¹V]`` with the feedthrough ``D = CM⁻¹B``.
+    acceleration, ``[−CM⁻¹K, −CM⁻¹V]`` with the feedthrough ``D = CM⁻¹B`` (row by row
+    for mixed outputs). The response of an output of derivative order d is (jω)ᵈ times
+    its position's, a known factor: a model's structural identifiability is the same
+    whatever its outputs' kinds, and :func:`symid.identifiability` analyses a mixed
+    model as its position twin.
 
     Examples
     --------
@@ -69,14 +79,20 @@ class SecondOrderModel(ParametricModel):
     >>> ss.A
     array([[ 0. ,  1. ],
            [-2. , -0.5]])
+
+    An accelerometer and a displacement sensor on one mass:
+
+    >>> two = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1], [1]],
+    ...                           output=["acceleration", "position"])
+    >>> two.output, two.outputs
+    ('mixed', ('acceleration', 'position'))
     """
 
     _kind = "second-order"
 
-    def __init__(self, M: Any, V: Any, K: Any, B: Any, C: Any, output: str = "position", *,
+    def __init__(self, M: Any, V: Any, K: Any, B: Any, C: Any, output: str | Sequence[str] = "position", *,
                  parameters: Sequence[Any] | None = None, name: str | None = None):
-        if output not in OUTPUT_KINDS:
-            raise ModelError(f"output must be one of {', '.join(map(repr, OUTPUT_KINDS))}; got {output!r}")
+        kinds = _output_kinds(output)
         M_ = as_symbolic_matrix(M, "M")
         if M_.rows != M_.cols:
             raise ModelError(f"M must be square; got shape {M_.shape}")
@@ -85,7 +101,13 @@ class SecondOrderModel(ParametricModel):
         K_ = as_symbolic_matrix(K, "K", shape=(n, n))
         B_ = as_symbolic_matrix(B, "B", shape=(n, None))
         C_ = as_symbolic_matrix(C, "C", shape=(None, n))
-        self.output = output
+        if not isinstance(kinds, str) and len(kinds) != C_.rows:
+            raise ModelError(f"output gives {len(kinds)} kind(s) but C has {C_.rows} row(s): give one kind per row "
+                             f"of C, or one kind for all")
+        #: The kind of every output row (a tuple of ``OUTPUT_KINDS``, one per row of C).
+        self.outputs: tuple[str, ...] = (kinds,) * C_.rows if isinstance(kinds, str) else kinds
+        #: The outputs' common kind, or ``"mixed"`` when the rows differ.
+        self.output: str = self.outputs[0] if len(set(self.outputs)) == 1 else MIXED
         self._setup([("M", M_), ("V", V_), ("K", K_), ("B", B_), ("C", C_)], parameters, name)
         self._refuse_singular_mass()
         _warn_if_not_symmetric(self._symbolic)
@@ -135,8 +157,15 @@ class SecondOrderModel(ParametricModel):
         """Number of outputs p."""
         return self._maps["C"].shape[0]
 
+    @property
+    def output_orders(self) -> tuple[int, ...]:
+        """The derivative order of every output row: 0 position, 1 velocity, 2 acceleration."""
+        return tuple(OUTPUT_ORDERS[k] for k in self.outputs)
+
     def _shape_text(self) -> str:
-        return (f"{self.n_dof} DOF, {self.n_inputs} input(s), {self.n_outputs} {self.output} output(s)")
+        if self.output == MIXED:
+            return f"{self.n_dof} DOF, {self.n_inputs} input(s), {self.n_outputs} outputs ({', '.join(self.outputs)})"
+        return f"{self.n_dof} DOF, {self.n_inputs} input(s), {self.n_outputs} {self.output} output(s)"
 
     def _minv(self, M: np.ndarray, theta: np.ndarray) -> np.ndarray:
         try:
@@ -181,13 +210,15 @@ class SecondOrderModel(ParametricModel):
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ V]])
         Bss = np.vstack([np.zeros_like(B), Minv @ B])
         D = np.zeros((C.shape[0], B.shape[1]))
-        if self.output == "position":
-            Css = np.hstack([C, np.zeros_like(C)])
-        elif self.output == "velocity":
-            Css = np.hstack([np.zeros_like(C), C])
-        else:
-            Css = np.hstack([-C @ Minv @ K, -C @ Minv @ V])
-            D = C @ Minv @ B
+        Css = np.zeros((C.shape[0], 2 * n))
+        for i, kind in enumerate(self.outputs):
+            if kind == "position":
+                Css[i, :n] = C[i]
+            elif kind == "velocity":
+                Css[i, n:] = C[i]
+            else:
+                Css[i] = np.concatenate([-C[i] @ Minv @ K, -C[i] @ Minv @ V])
+                D[i] = C[i] @ Minv @ B
         return StateSpaceMatrices(A, Bss, Css, D)
 
     def symbolic_state_space(self) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix, sp.Matrix]:
@@ -199,18 +230,22 @@ class SecondOrderModel(ParametricModel):
         Z, I = sp.zeros(n, n), sp.eye(n)
         A = sp.BlockMatrix([[Z, I], [-Minv * K, -Minv * V]]).as_explicit()
         Bss = sp.Matrix.vstack(sp.zeros(*B.shape), Minv * B)
-        D = sp.zeros(C.rows, B.cols)
-        if self.output == "position":
-            Css = sp.Matrix.hstack(C, sp.zeros(*C.shape))
-        elif self.output == "velocity":
-            Css = sp.Matrix.hstack(sp.zeros(*C.shape), C)
-        else:
-            Css = sp.Matrix.hstack(-C * Minv * K, -C * Minv * V)
-            D = C * Minv * B
-        return A, Bss, Css, D
+        rows, drows = [], []
+        for i, kind in enumerate(self.outputs):
+            Ci = C[i, :]
+            if kind == "position":
+                rows.append(sp.Matrix.hstack(Ci, sp.zeros(1, n)))
+                drows.append(sp.zeros(1, B.cols))
+            elif kind == "velocity":
+                rows.append(sp.Matrix.hstack(sp.zeros(1, n), Ci))
+                drows.append(sp.zeros(1, B.cols))
+            else:
+                rows.append(sp.Matrix.hstack(-Ci * Minv * K, -Ci * Minv * V))
+                drows.append(Ci * Minv * B)
+        return A, Bss, sp.Matrix.vstack(*rows), sp.Matrix.vstack(*drows)
 
     def frequency_response(self, theta: Theta, w: Any) -> np.ndarray:
-        """H(ω) = C (−ω²M + jωV + K)⁻¹ B, times jω (velocity) or −ω² (acceleration).
+        """H(ω) = C (−ω²M + jωV + K)⁻¹ B, each row times jω (velocity) or −ω² (acceleration).
 
         Computed directly from M, V, K (no first-order form, no M⁻¹); it equals the
         response of :meth:`state_space` to rounding.
@@ -251,17 +286,51 @@ class SecondOrderModel(ParametricModel):
         except np.linalg.LinAlgError:
             raise ModelError("−ω²M + jωV + K is singular at one of the frequencies "
                              "(an undamped resonance or a rigid-body mode at ω = 0)") from None
-        H = C @ X
-        if self.output == "velocity":
-            H = H * (1j * w)[:, None, None]
-        elif self.output == "acceleration":
-            H = H * (-(w**2))[:, None, None]
-        return H
+        return (C @ X) * output_factor(self, w)[:, :, None]
 
     def summary(self) -> str:
         """Parameters and matrices as readable text."""
         head = f"SecondOrderModel{' ' + repr(self.name) if self.name else ''}: {self._shape_text()}"
         return f"{head}\nparameters: {', '.join(self.parameter_names) or '(none)'}\n{self._matrix_text()}"
+
+
+def _output_kinds(output: Any) -> str | tuple[str, ...]:
+    """One kind, or a tuple of kinds (one per row of C), checked against ``OUTPUT_KINDS``."""
+    choices = ", ".join(map(repr, OUTPUT_KINDS))
+    if isinstance(output, str):
+        if output not in OUTPUT_KINDS:
+            raise ModelError(f"output must be one of {choices} (or a list of them, one per row of C); got {output!r}")
+        return output
+    if isinstance(output, Sequence) and len(output) > 0:
+        for i, kind in enumerate(output):
+            if not isinstance(kind, str) or kind not in OUTPUT_KINDS:
+                raise ModelError(f"output[{i}] must be one of {choices}; got {kind!r}")
+        return tuple(output)
+    raise ModelError(f"output must be one of {choices}, or a non-empty list of them (one per row of C); "
+                     f"got {output!r}")
+
+
+def output_factor(model: Any, w: np.ndarray) -> np.ndarray:
+    """(jω)ᵈ of every frequency and output row, shape (len(w), p): the factor that turns the position response
+    C (−ω²M + jωV + K)⁻¹ B into the model's; ones for a model without output kinds (a state-space model).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> two = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1], [1]],
+    ...                           output=["velocity", "acceleration"])
+    >>> output_factor(two, np.array([2.0]))
+    array([[ 0.+2.j, -4.+0.j]])
+    """
+    w = np.asarray(w, dtype=float)
+    orders = getattr(model, "output_orders", None)
+    if orders is None:
+        return np.ones((w.size, model.n_outputs), dtype=complex)
+    # exact columns, not (jω)**d: a complex power leaves an imaginary part of rounding on −ω²
+    by_order = (np.ones(w.size, dtype=complex), 1j * w, -(w**2) + 0j)
+    return np.stack([by_order[d] for d in orders], axis=1) if orders else np.ones((w.size, 0), dtype=complex)
 
 
 def _warn_if_not_symmetric(matrices: dict[str, sp.Matrix]) -> None:

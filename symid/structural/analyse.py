@@ -736,12 +736,12 @@ def _solutions_at(model, point: list) -> list[dict[str, float]]:
     """The admissible real solutions of summary(θ) = summary(point) (a run of the global step at that point)."""
     from symid.structural.global_ import global_analysis, star_and_summary
     from symid.structural.msolve import msolve_binary
-    from symid.structural.summary import KIND_TF, is_minimal_at, model_matrices
+    from symid.structural.summary import KIND_TF, analysed_output, is_minimal_at, model_matrices
 
     params, _, _, summ, rng = star_and_summary(model, seed=0)
     star = [sp.Rational(v.numerator, v.denominator) for v in point]
     kind = model_kind(model)
-    if summ.kind == KIND_TF and not (is_minimal_at(model_matrices(model, None), kind, getattr(model, "output", None),
+    if summ.kind == KIND_TF and not (is_minimal_at(model_matrices(model, None), kind, analysed_output(model),
                                                    params, star) or summ.exhaustive_at(star)):
         raise ModelError("the transfer function is not an exhaustive summary at this point")
     binary = msolve_binary()

@@ -99,6 +99,7 @@ from symid.structural.order import grevlex_memo
 from symid.structural.summary import (
     KIND_MATRICES,
     KIND_TF,
+    analysed_output,
     evaluator,
     exhaustive_summary,
     free_parameters,
@@ -334,7 +335,7 @@ def star_and_summary(model, known: Mapping[str, object] | None = None, *, seed: 
         generator, advanced past θ* (for later random choices).
     """
     kind = model_kind(model)
-    output = getattr(model, "output", None)
+    output = analysed_output(model)
     mats = model_matrices(model, known)
     params = free_parameters(model, known)
     rng = random.Random(10_007 + 1000 * seed + draw)

@@ -87,7 +87,7 @@ from itertools import pairwise
 import sympy as sp
 
 from symid.errors import ModelError, OptionError
-from symid.structural.summary import free_parameters, model_kind, model_matrices
+from symid.structural.summary import analysed_output, free_parameters, model_kind, model_matrices
 
 __all__ = ["ChainParts", "Ladder", "chain_parts", "impedance", "invert", "ladder_of", "peel", "proves_global", "series",
            "values_at"]
@@ -186,7 +186,7 @@ def chain_parts(model, known: Mapping[str, object] | None = None) -> ChainParts 
             return None
     except ModelError:  # not a model this module handles: the usual step reports it
         return None
-    shift = _SHIFT.get(getattr(model, "output", None))
+    shift = _SHIFT.get(analysed_output(model))
     if shift is None:
         return None
     mats = model_matrices(model, known)

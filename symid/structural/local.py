@@ -40,7 +40,7 @@ from sympy.polys.matrices.exceptions import DMNonInvertibleMatrixError
 
 from symid.errors import ModelError
 from symid.structural.modp import PRIME, BadPrime, inverse_mod_p, matmul_mod_p, rank_mod_p, residue
-from symid.structural.summary import free_parameters, model_kind, rational
+from symid.structural.summary import analysed_output, free_parameters, model_kind, rational
 
 __all__ = ["LocalResult", "PoleError", "jacobian_at", "local_analysis", "random_point", "rank_at"]
 
@@ -92,8 +92,7 @@ def _affine_parts(model, known: Mapping[str, object] | None) -> _Parts:
                 c = c + rational(known[p.name]) * amap.coefficients[i].applyfunc(rational)
         const[name] = _dm(c)
         coefs[name] = [_sparse(amap.coefficients[i]) for i in free_idx]
-    output = getattr(model, "output", None)
-    return _Parts(kind, output, model.n_states, const, coefs)
+    return _Parts(kind, analysed_output(model), model.n_states, const, coefs)
 
 
 def _at(parts: _Parts, name: str, point: Sequence) -> DomainMatrix:

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from symid.errors import ModelError
+from symid.model.secondorder import output_factor
 
 __all__ = ["NumericLocalResult", "numeric_local_check"]
 
@@ -56,8 +57,7 @@ def _jacobian(model: Any, theta: np.ndarray, w: np.ndarray) -> np.ndarray:
     if "M" in maps:
         mats = model.matrices(theta)
         M, V, K, B, C = (mats[k] for k in "MVKBC")
-        f = {"position": np.ones_like(w, dtype=complex), "velocity": 1j * w, "acceleration": -(w**2) + 0j}[
-            model.output]
+        f = output_factor(model, w)  # (s, p): each output row times (jω)ᵈ
         for wi, fi in zip(w, f, strict=True):
             Z = K - wi**2 * M + 1j * wi * V
             ZB = np.linalg.solve(Z, B)
@@ -65,7 +65,7 @@ def _jacobian(model: Any, theta: np.ndarray, w: np.ndarray) -> np.ndarray:
             dZ = maps["K"].Xi - wi**2 * maps["M"].Xi + 1j * wi * maps["V"].Xi
             d = (np.einsum("kpn,nm->kpm", maps["C"].Xi, ZB) - np.einsum("pn,knr,rm->kpm", CZ, dZ, ZB)
                  + np.einsum("pn,knm->kpm", CZ, maps["B"].Xi))
-            rows.append((fi * d).reshape(l, -1))
+            rows.append((fi[None, :, None] * d).reshape(l, -1))
     else:
         A, B, C, _ = model.state_space(theta)
         n = A.shape[0]

@@ -124,6 +124,14 @@ def model_matrices(model, known: Mapping[str, object] | None) -> dict[str, sp.Ma
     return out
 
 
+def analysed_output(model) -> str | None:
+    """The output kind the analysis takes: the model's, and ``"position"`` for a model whose rows measure different
+    kinds (``"mixed"``): each row's response is (jω)ᵈ times its position's, a known factor, so the parameters that
+    determine the one determine the other and the verdicts are the same."""
+    output = getattr(model, "output", None)
+    return "position" if output == "mixed" else output
+
+
 def model_kind(model) -> str:
     """``"state-space"`` or ``"second-order"``; raises for anything else."""
     if hasattr(model, "n_dof") and hasattr(model, "output"):
@@ -480,7 +488,7 @@ def exhaustive_summary(model, known: Mapping[str, object] | None = None, *,
     ('transfer-function coefficients', [a, b])
     """
     mkind = model_kind(model)
-    output = getattr(model, "output", None)
+    output = analysed_output(model)
     mats = model_matrices(model, known)
     params = free_parameters(model, known)
     names = list(params)

@@ -327,7 +327,7 @@ def _siso(model: Any, i: int, j: int, gain: sp.Symbol | None = None) -> Any:
         return None
     with warnings.catch_warnings():  # the whole model's construction said what there is to say of its matrices
         warnings.simplefilter("ignore", ModelWarning)
-        return SecondOrderModel(**mats, output=model.output, parameters=params)
+        return SecondOrderModel(**mats, output=model.outputs[i], parameters=params)
 
 
 def chain_start(model: Any, data: Any) -> ChainStart | None:

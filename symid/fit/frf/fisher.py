@@ -30,6 +30,7 @@ import scipy.linalg
 
 from symid.fit.sensitivity import frf_sensitivity
 from symid.fit.uncertainty import FisherInformation, Uncertainty, broadcast_noise
+from symid.model.secondorder import output_factor
 
 __all__ = ["FrfFisher", "residual_noise_model"]
 
@@ -224,8 +225,7 @@ def _ls_sensitivity(model: Any, data: Any, theta: np.ndarray, case: str,
     _, p, m = H.shape
     maps = model.maps
     l = model.n_parameters
-    out = getattr(model, "output", "position")
-    f = {"position": np.ones_like(w, dtype=complex), "velocity": 1j * w, "acceleration": -(w**2) + 0j}[out]
+    f = output_factor(model, w)  # (s, p): each output row times (jω)ᵈ
     th = np.asarray(theta, dtype=float)
     rows_J, blocks = [], []
     for i, wi in enumerate(w):
@@ -236,17 +236,17 @@ def _ls_sensitivity(model: Any, data: Any, theta: np.ndarray, case: str,
             Z0 = 1j * wi * np.eye(maps["A"].shape[0]) - maps["A"].X0
             Zk = -maps["A"].Xi.astype(complex)
         Z = Z0 + np.tensordot(th, Zk, axes=1)
-        Hh = H[i] / f[i]
+        Hh = H[i] / f[i][:, None]
         if case == "sensors":
             Ci = np.linalg.inv(maps["C"].X0)
             Je = np.einsum("knr,rm->knm", Zk, Ci @ Hh) - maps["B"].Xi      # (l, n, m)
-            K = Z @ Ci / f[i]                                               # de = K dH   (n × p)
+            K = Z @ Ci / f[i][None, :]                                      # de = K dH   (n × p)
             L = np.einsum("ab,jc->ajbc", K, np.eye(m)).reshape(K.shape[0] * m, p * m)
         else:
             Bi = np.linalg.inv(maps["B"].X0)
             Je = np.einsum("pm,kmn->kpn", Hh @ Bi, Zk) - maps["C"].Xi       # (l, p, n)
-            K = Bi @ Z / f[i]                                               # de = dH K   (m × n)
-            L = np.einsum("ac,bj->ajcb", np.eye(p), K).reshape(p * K.shape[1], p * m)
+            K = Bi @ Z                                                      # de = diag(1/f) dH K   (m × n)
+            L = np.einsum("ac,bj->ajcb", np.diag(1 / f[i]), K).reshape(p * K.shape[1], p * m)
         Je = Je.reshape(l, -1).T
         if whitening is not None:
             Je, L = whitening[i] @ Je, whitening[i] @ L

@@ -17,6 +17,7 @@ from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighte
 from symid.fit.options import check_bool, check_choice, check_time_limit
 from symid.fit.result import StartOutcome
 from symid.fit.similarity.data import budget_message
+from symid.model.secondorder import output_factor
 
 __all__ = ["LinearFRF", "equation_residual", "ls_applicable"]
 
@@ -170,8 +171,8 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         out = getattr(model, "output", "position")
         if out != "position" and np.any(w == 0):
             raise ModelError(f"{out} output: H is zero at ω = 0 and cannot be divided back; drop ω = 0")
-        factor = {"position": np.ones_like(w, dtype=complex), "velocity": 1j * w, "acceleration": -(w**2) + 0j}[out]
-        Hh = H / factor[:, None, None]
+        factor = output_factor(model, w)  # (s, p): each output row times (jω)ᵈ
+        Hh = H / factor[:, :, None]
         maps = model.maps
         l = model.n_parameters
         rows0, rowsJ, self._Z = [], [], []
@@ -219,12 +220,11 @@ class LinearFRF(NoiseWeighted, FrfEstimator):
         for i, (Z0, Zi) in enumerate(self._Z):
             Z = Z0 + np.tensordot(th, Zi, axes=1)
             if self.case == "sensors":
-                G = Z @ np.linalg.inv(maps["C"].X0)                      # e[:, k] = G dH[:, k] / f
+                G = Z @ np.linalg.inv(maps["C"].X0) / self._factor[i][None, :]  # e[:, k] = G diag(1/f) dH[:, k]
                 S = np.einsum("ap,kp,bp->kab", G, var[i].T, G.conj())
             else:
-                G = Z.T @ np.linalg.inv(maps["B"].X0).T                  # e[j, :]ᵀ = G dH[j, :]ᵀ / f
-                S = np.einsum("am,jm,bm->jab", G, var[i], G.conj())
-            S = S / abs(self._factor[i]) ** 2
+                G = Z.T @ np.linalg.inv(maps["B"].X0).T                  # e[j, :]ᵀ = G dH[j, :]ᵀ / f_j
+                S = np.einsum("am,jm,bm->jab", G, var[i], G.conj()) / (abs(self._factor[i]) ** 2)[:, None, None]
             vals, vecs = np.linalg.eigh(S)
             top = np.max(vals, axis=1, keepdims=True)
             vals = np.maximum(vals, 1e-12 * np.where(top > 0, top, 1.0))  # a singular Z(θ, ωᵢ): no blow-up

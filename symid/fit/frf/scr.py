@@ -85,6 +85,7 @@ from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighte
 from symid.fit.options import check_bool, check_choice, check_float, check_int, check_scale, check_seed
 from symid.fit.polish import polish_outcome
 from symid.fit.result import StartOutcome
+from symid.model.secondorder import MIXED, output_factor
 
 __all__ = ["ScrFRF"]
 
@@ -341,8 +342,8 @@ class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
             MVK0 = np.hstack([maps["M"].X0, maps["V"].X0, maps["K"].X0])
             MVKc = np.concatenate([tc(maps["M"]), tc(maps["V"]), tc(maps["K"])], axis=1)
             A_mvk = scr.Affine(MVK0, {theta: MVKc})
-            f = {"position": np.ones(self.w.size, dtype=complex), "velocity": 1j * self.w,
-                 "acceleration": -(self.w**2) + 0j}[model.output]
+            f = output_factor(model, self.w)  # (s, p): each output row times (jω)ᵈ
+            C0, Cc = maps["C"].X0, tc(maps["C"])
             self.gamma_vars = []
             for i, wi in enumerate(self.w):
                 G = scr.Variable(f"Gamma{i}", (n, m), complex=True)
@@ -351,7 +352,11 @@ class ScrFRF(NoiseWeighted, ScrEstimator, FrfEstimator):
                 Pi = np.vstack([-(wi**2) * np.eye(n), 1j * wi * np.eye(n), np.eye(n)])
                 Gi = scr.Affine(np.zeros((n, m)), {G: g[i] * identity_coef((n, m))})
                 add("dynamics", i, A=A_mvk, P=Pi, B=Gi, C=aff(maps["B"]))
-                add("output", i, A=aff(maps["C"]), P=f[i] * np.eye(n), B=Gi, C=scr.Affine(H[i]))  # Hᵢ = fᵢ C Γᵢ
+                if model.output != MIXED:  # Hᵢ = fᵢ C Γᵢ
+                    add("output", i, A=aff(maps["C"]), P=f[i, 0] * np.eye(n), B=Gi, C=scr.Affine(H[i]))
+                else:  # Hᵢ = diag(fᵢ) C(θ) Γᵢ, the rows' factors in the map of C
+                    Cf = scr.Affine(f[i][:, None] * C0, {theta: f[i][:, None, None] * Cc})
+                    add("output", i, A=Cf, P=np.eye(n), B=Gi, C=scr.Affine(H[i]))
             if lmis:
                 lmi_list.extend(mvk_lmis(maps, theta, self.options, scale=sc))
         else:

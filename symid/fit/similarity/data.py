@@ -88,7 +88,7 @@ def model_has_feedthrough(model: Any) -> bool:
     maps = model.maps
     if "D" in maps:
         return not (maps["D"].is_constant and not np.any(maps["D"].X0))
-    return getattr(model, "output", "position") == "acceleration"
+    return "acceleration" in getattr(model, "outputs", ())
 
 
 def _check_sizes(model: Any, n: int, m: int, p: int, what: str) -> None:

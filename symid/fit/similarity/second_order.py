@@ -58,8 +58,10 @@ _COND_MAX = 1e12
 def check_second_order(model: Any) -> None:
     """Refuse what the similarity formulations of chapter 7 do not cover, with the reason."""
     if model.output not in ("position", "velocity"):
+        has = (f"outputs of different kinds ({', '.join(model.outputs)})" if model.output == "mixed"
+               else f"{model.output} output")
         raise ModelError("the similarity formulations of thesis ch. 7 take position or velocity outputs (7-2), "
-                         f"(7-24); this model has {model.output} output (thesis §7-7-3: future work). "
+                         f"(7-24), all of one kind; this model has {has} (thesis §7-7-3: future work). "
                          "Use method='ipopt' on a black box; on input/output records the default method "
                          "('auto') or 'oe' (output error on the samples)")
 

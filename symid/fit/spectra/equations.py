@@ -19,7 +19,7 @@ import numpy as np
 from symid.errors import DataError, ModelError
 from symid.fit.base import Estimator
 from symid.fit.spectra.fisher import SpectraFisher
-from symid.model.secondorder import SecondOrderModel
+from symid.model.secondorder import SecondOrderModel, output_factor
 
 __all__ = ["SpectraEstimator", "SpectralEquations", "check_spectral", "model_spectra", "spectral_equations",
            "spectral_misfit", "spectral_residuals"]
@@ -133,8 +133,8 @@ def spectral_equations(model: Any, data: Any) -> SpectralEquations:
                          "B must hold no parameter")
     w = np.asarray(data.w, dtype=float)
     Ci = np.linalg.inv(C)
-    f2 = {"position": np.ones_like(w), "velocity": w**2, "acceleration": w**4}[model.output]
-    P = Ci @ np.asarray(data.Phi_yy, dtype=complex) @ Ci.conj().T / f2[:, None, None]
+    f = output_factor(model, w)  # (s, p): Φyy = F C Z⁻¹ B Φuu Bᴴ Z⁻ᴴ Cᴴ Fᴴ, F = diag((jω)ᵈ) per output
+    P = Ci @ (np.asarray(data.Phi_yy, dtype=complex) / (f[:, :, None] * f.conj()[:, None, :])) @ Ci.conj().T
     B = maps["B"].X0
     Q = B @ np.asarray(data.Phi_uu, dtype=complex) @ B.conj().T
     P = 0.5 * (P + np.conj(np.swapaxes(P, 1, 2)))

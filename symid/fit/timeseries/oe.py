@@ -116,19 +116,23 @@ def _sx_state_space(model: Any, theta: Any) -> tuple[Any, Any, Any, Any]:
     if "M" not in maps:
         return tuple(_sx_matrix(maps[k], theta) for k in "ABCD")
     M, V, K, B, C = (_sx_matrix(maps[k], theta) for k in "MVKBC")
-    n, m, p = model.n_dof, model.n_inputs, model.n_outputs
+    n, m = model.n_dof, model.n_inputs
     MiK, MiV, MiB = ca.solve(M, K), ca.solve(M, V), ca.solve(M, B)
     A = ca.vertcat(ca.horzcat(ca.SX(n, n), ca.SX.eye(n)), ca.horzcat(-MiK, -MiV))
     Bss = ca.vertcat(ca.SX(n, m), MiB)
-    D = ca.SX(p, m)
-    if model.output == "position":
-        Css = ca.horzcat(C, ca.SX(p, n))
-    elif model.output == "velocity":
-        Css = ca.horzcat(ca.SX(p, n), C)
-    else:
-        Css = ca.horzcat(-ca.mtimes(C, MiK), -ca.mtimes(C, MiV))
-        D = ca.mtimes(C, MiB)
-    return A, Bss, Css, D
+    rows, drows = [], []
+    for i, kind in enumerate(model.outputs):  # row by row: an output's kind is its own
+        Ci = C[i, :]
+        if kind == "position":
+            rows.append(ca.horzcat(Ci, ca.SX(1, n)))
+            drows.append(ca.SX(1, m))
+        elif kind == "velocity":
+            rows.append(ca.horzcat(ca.SX(1, n), Ci))
+            drows.append(ca.SX(1, m))
+        else:
+            rows.append(ca.horzcat(-ca.mtimes(Ci, MiK), -ca.mtimes(Ci, MiV)))
+            drows.append(ca.mtimes(Ci, MiB))
+    return A, Bss, ca.vertcat(*rows), ca.vertcat(*drows)
 
 
 def _initial_state_mode(model: Any, initial_state: Any) -> tuple[str, Any]:

@@ -75,14 +75,15 @@ def state_space_derivatives(model: Any, theta: np.ndarray) -> tuple[tuple[np.nda
     p = Cm.shape[0]
     dC = np.zeros((l, p, 2 * n))
     dD = np.zeros((l, p, Bm.shape[1]))
-    if model.output == "position":
-        dC[:, :, :n] = dC2
-    elif model.output == "velocity":
-        dC[:, :, n:] = dC2
-    else:  # acceleration: C = −Cm [M⁻¹K, M⁻¹V], D = Cm M⁻¹B
-        dC[:, :, :n] = -(dC2 @ MiK + Cm @ dMiK)
-        dC[:, :, n:] = -(dC2 @ MiV + Cm @ dMiV)
-        dD = dC2 @ MiB + Cm @ dMiB
+    for i, kind in enumerate(model.outputs):  # row by row: an output's kind is its own
+        if kind == "position":
+            dC[:, i, :n] = dC2[:, i]
+        elif kind == "velocity":
+            dC[:, i, n:] = dC2[:, i]
+        else:  # acceleration: Cᵢ = −Cmᵢ [M⁻¹K, M⁻¹V], Dᵢ = Cmᵢ M⁻¹B
+            dC[:, i, :n] = -(dC2[:, i] @ MiK + Cm[i] @ dMiK)
+            dC[:, i, n:] = -(dC2[:, i] @ MiV + Cm[i] @ dMiV)
+            dD[:, i] = dC2[:, i] @ MiB + Cm[i] @ dMiB
     return (A, B, C, D), (dA, dB, dC, dD)
 
 

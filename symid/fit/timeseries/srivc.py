@@ -208,8 +208,8 @@ def transfer_polynomials(model: Any) -> TransferPolynomials:
     if "M" in sym:
         Z = sym["M"] * s**2 + sym["V"] * s + sym["K"]
         den = Z.det(method="berkowitz")
-        power = {"position": 0, "velocity": 1, "acceleration": 2}[model.output]
-        num = (sym["C"] * Z.adjugate(method="berkowitz") * sym["B"]) * s**power
+        # each output row times sᵈ, d its derivative order
+        num = sp.diag(*[s**d for d in model.output_orders]) * sym["C"] * Z.adjugate(method="berkowitz") * sym["B"]
         where_den = "det(M s² + V s + K)"
     else:
         n = sym["A"].rows

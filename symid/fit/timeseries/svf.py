@@ -289,7 +289,8 @@ def _check_model(model: Any) -> str:
         why.append(f"C ({r}×{c}) is not square and invertible")
     if "M" in maps:
         if getattr(model, "output", "position") != "position":
-            why.append(f"the output is {model.output}, not position")
+            why.append(f"the output is {model.output}, not position" if model.output != "mixed"
+                       else f"the outputs are {', '.join(model.outputs)}, not all position")
         kind = "second order"
     else:
         if "D" in maps and not (maps["D"].is_constant and not np.any(maps["D"].X0)):
