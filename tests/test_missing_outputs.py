@@ -100,6 +100,30 @@ def test_validation_scores_the_measured_values_and_says_so():
     assert np.isnan(v.y[0][2, 0])
 
 
+def test_validation_of_a_short_record_by_default(tmp_path):
+    """A clinical record of 12 rows: the default lag is a quarter of the 11 measured (2, said in a note; 25 needed
+    longer records, a new user's trial), and the model's curve between the sparse samples is drawn from the same
+    simulation (its values at the samples are the simulated ones)."""
+    rec = infusion(noise=0.0)
+    v = si.validate(PK, TRUTH, rec)
+    assert v.lags[-1] == 2 and any("up to lag 2, a quarter of the shortest record (11 samples" in n for n in v.notes)
+    with pytest.raises(si.DataError, match=r"max_lag = 11 needs records longer than 11 samples.*leave max_lag out"):
+        si.validate(PK, TRUTH, rec, max_lag=11)
+    t, y = v.t_fine[0], v.y_fine[0]
+    assert t.size > 1000 and t[0] == rec.t[0] and t[-1] == rec.t[-1]
+    at = np.searchsorted(t, rec.t)
+    np.testing.assert_array_equal(t[at], rec.t)
+    # the same system from the same state, in steps a q-th of each interval: equal to rounding (expm either way)
+    np.testing.assert_allclose(y[at], v.y_sim[0], rtol=1e-9, atol=1e-12)
+    # and between them the response an independent simulation on a 9 s grid gives (exact there for the held input;
+    # linear interpolation between its points errs by ~1e-5 of the peak)
+    fine = np.linspace(0.0, 24.0, 24 * 400 + 1)
+    clean = si.simulate_io(PK, TRUTH, np.where(fine < STOP, 100.0, 0.0), fine[1] - fine[0])
+    np.testing.assert_allclose(y[:, 0], np.interp(t, fine, clean.y[:, 0]), rtol=0, atol=1e-4 * clean.y.max())
+    first, _ = v.plot(tmp_path / "pk")
+    assert first.stat().st_size > 10_000
+
+
 def test_methods_that_filter_every_sample_refuse_missing_outputs():
     m, c, k = si.parameters("m c k", positive=True)
     mck = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])

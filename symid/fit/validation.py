@@ -39,9 +39,14 @@ import numpy as np
 
 from symid.errors import DataError, DataWarning
 
-__all__ = ["Validation", "validate"]
+__all__ = ["DEFAULT_MAX_LAG", "Validation", "validate"]
+
+DEFAULT_MAX_LAG = 25  # correlation lags of the residual tests, MATLAB's resid; a quarter of a shorter record
 
 _Z = {0.95: 1.959963984540054, 0.99: 2.5758293035489004}
+FINE_BELOW = 500  # records with fewer samples get the simulated output between them too (``t_fine``, ``y_fine``)
+FINE_POINTS = 2000  # about as many points on that grid per record
+MARKERS_BELOW = 200  # records with fewer samples are drawn as markers, not joined by lines
 
 
 @dataclass(frozen=True)
@@ -83,6 +88,12 @@ class Validation:
     notes : tuple of str
         What the reader should know (non-uniform sampling, constant inputs ...).
     time_unit : str
+    t_fine, y_fine : tuple of numpy.ndarray
+        Per record with fewer than ``FINE_BELOW`` samples, the simulated output on a grid
+        about ``FINE_POINTS`` long that holds the sample times and even steps between them
+        (the input held or linear between samples, as simulated): the curve between
+        sparse samples (a concentration's peak between two draws). Empty arrays for longer
+        records and for ``hold="bandlimited"``.
     """
 
     parameter_names: tuple[str, ...]
@@ -107,6 +118,8 @@ class Validation:
     confidence: float = 0.99
     notes: tuple[str, ...] = ()
     time_unit: str = "s"
+    t_fine: tuple[np.ndarray, ...] = field(default=(), repr=False)
+    y_fine: tuple[np.ndarray, ...] = field(default=(), repr=False)
     channel_names: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """The input and output columns of a table the records were read from (``{"input": (...), "output": (...)}``,
     from ``stated_units``): the labels of :meth:`summary` and :meth:`plot` when no names are given."""
@@ -234,9 +247,22 @@ class Validation:
             ax, rax = axes[2 * j, 0], axes[2 * j + 1, 0]
             unit = ounits[j] if ounits[j] else "unit not given"
             for e, (tt, yy, ys) in enumerate(zip(self.t, self.y, self.y_sim, strict=True)):
-                ax.plot(tt, yy[:, j], color="0.55", lw=2.6, alpha=0.8, label="measured" if e == 0 else None)
-                ax.plot(tt, ys[:, j], color="C3", lw=1.1, ls=(0, (5, 2)), label="simulated" if e == 0 else None)
-                rax.plot(tt, yy[:, j] - ys[:, j], color="C0", lw=0.8, label="measured − simulated" if e == 0 else None)
+                lead = e == 0
+                fine = e < len(self.t_fine) and self.t_fine[e].size > 0
+                if tt.size < MARKERS_BELOW:  # sparse samples: markers, and the model's curve between them
+                    ax.plot(tt, yy[:, j], "o", color="0.35", ms=5, label="measured" if lead else None)
+                    ax.plot(tt, ys[:, j], "x", color="C3", ms=5, label="simulated at the samples" if lead else None)
+                    rax.plot(tt, yy[:, j] - ys[:, j], "o", color="C0", ms=4,
+                             label="measured − simulated" if lead else None)
+                else:
+                    ax.plot(tt, yy[:, j], color="0.55", lw=2.6, alpha=0.8, label="measured" if lead else None)
+                    if not fine:
+                        ax.plot(tt, ys[:, j], color="C3", lw=1.1, ls=(0, (5, 2)), label="simulated" if lead else None)
+                    rax.plot(tt, yy[:, j] - ys[:, j], color="C0", lw=0.8,
+                             label="measured − simulated" if lead else None)
+                if fine:
+                    ax.plot(self.t_fine[e], self.y_fine[e][:, j], color="C3", lw=1.1,
+                            label="simulated" if lead else None)
             ax.set_ylabel(f"{onames[j]} ({unit})")
             ax.set_title(f"{onames[j]}: fit {self.fit_percent[j]:.2f} %, rms error {self.rms_error[j]:.3g}"
                          f"{' ' + ounits[j] if ounits[j] else ''}", fontsize=10)
@@ -390,7 +416,7 @@ def _independence(rho_e: np.ndarray, rho_u: np.ndarray, rho: np.ndarray, N: int)
     return s_stat, dof
 
 
-def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, max_lag: int = 25,
+def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, max_lag: int | None = None,
              confidence: float = 0.99, hold: str = "zoh", variance: Any = None) -> Validation:
     """Simulate the model at θ on measured records and test what is left (module text).
 
@@ -421,8 +447,12 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         ``None``: the model's (zero, known, affine in θ, or least squares for a model with
         ``x0="estimate"``); ``"estimate"``: the least-squares initial state of each record
         (as MATLAB's ``compare`` does by default); numbers (n,): known.
-    max_lag : int
-        M, the largest correlation lag in samples (default 25, MATLAB's ``resid``).
+    max_lag : int, optional
+        M, the largest correlation lag in samples. Default: 25 (MATLAB's ``resid``), or a
+        quarter of the shortest record where that is shorter than 100 samples (a
+        clinical record of 15 concentrations: M = 3; the tests need M below the number
+        of samples, and a correlation at a lag near it rests on a few products). A note
+        says so.
     confidence : {0.99, 0.95}
         Level of the bands and tests.
     hold : {"zoh", "foh", "bandlimited"}
@@ -471,14 +501,14 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
 
     from symid.fit.timeseries.oe import OutputError
 
-    if isinstance(max_lag, bool) or not isinstance(max_lag, (int, np.integer)) or max_lag < 1:
-        raise DataError(f"max_lag must be an int >= 1 (sample lags); got {max_lag!r}")
+    if max_lag is not None and (isinstance(max_lag, bool) or not isinstance(max_lag, (int, np.integer))
+                                or max_lag < 1):
+        raise DataError(f"max_lag must be an int >= 1 (sample lags), or None for the default; got {max_lag!r}")
     if confidence not in _Z:
         raise DataError(f"confidence must be 0.95 or 0.99; got {confidence!r}")
     if hold not in ("zoh", "foh", "bandlimited"):
         raise DataError(f"hold must be 'zoh' (the input held between samples), 'foh' (linear between them) or "
                         f"'bandlimited' (a sampled band-limited input); got {hold!r}")
-    M = int(max_lag)
     sim = OutputError(model, data, initial_state=initial_state, variance=variance, hold=hold)
     from symid.fit.identify import unit_mismatches
 
@@ -503,10 +533,18 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
     # the correlations run over the sample times where every output was measured, lags counted in those samples
     whole = [np.all(o, axis=1) for o in observed]
     N = int(sum(np.count_nonzero(k) for k in whole))
-    if M >= min(np.count_nonzero(k) for k in whole):
-        raise DataError(f"max_lag = {M} needs records longer than {M} samples; the shortest has "
-                        f"{min(np.count_nonzero(k) for k in whole)}" + (" with every output measured"
-                                                                         if sim.n_missing else ""))
+    shortest = min(np.count_nonzero(k) for k in whole)
+    measured = " with every output measured" if sim.n_missing else ""
+    if max_lag is None:
+        if shortest < 4:
+            raise DataError(f"the residual tests need records of 4 samples or more; the shortest has {shortest}"
+                            f"{measured}")
+        M = min(DEFAULT_MAX_LAG, shortest // 4)
+    else:
+        M = int(max_lag)
+        if M >= shortest:
+            raise DataError(f"max_lag = {M} needs records longer than {M} samples; the shortest has {shortest}"
+                            f"{measured} (leave max_lag out for {min(DEFAULT_MAX_LAG, max(shortest // 4, 1))})")
     y_all = np.vstack(ys_obs)
     e_all = np.vstack([y - s for y, s in zip(ys_obs, ys, strict=True)])
     if not np.all(np.isfinite(np.vstack(ys))):
@@ -536,6 +574,9 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
     s_stat, s_dof = _independence(rho_e, rho_u, rho_eu[:, :, M:], N)
     s_p = chi2.sf(s_stat, s_dof)
     notes = []
+    if max_lag is None and M < DEFAULT_MAX_LAG:
+        notes.append(f"correlations up to lag {M}, a quarter of the shortest record ({shortest} samples{measured}), "
+                     f"not {DEFAULT_MAX_LAG}")
     constant = np.flatnonzero(~(su > 0))
     if constant.size:
         notes.append(f"input(s) {', '.join(str(int(i)) for i in constant)} constant: no cross-correlation")
@@ -551,6 +592,7 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
             and variance.get("weights", "prediction") == "prediction" else ""))
     if len(recs) > 1:
         notes.append(f"{len(recs)} records pooled (fit over all samples; correlations summed over records)")
+    fine = _fine_curves(model, th, recs, x0s, hold)
     if sim.n_missing:
         notes.append(f"{sim.n_missing} output value(s) not measured (NaN): left out of the fit; the correlations "
                      f"run over the {N} sample times where every output was measured, their lags counted in those "
@@ -562,4 +604,32 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
                       cross_lags=np.arange(-M, M + 1), cross_correlation=rho_eu, cross_band=cross_band,
                       independence_s=s_stat, independence_p=s_p, confidence=float(confidence),
                       notes=tuple(notes), time_unit=getattr(recs[0], "time_unit", "s"),
-                      channel_names=_record_columns(data))
+                      t_fine=fine[0], y_fine=fine[1], channel_names=_record_columns(data))
+
+
+def _fine_curves(model: Any, theta: np.ndarray, recs: Any, x0s: Any, hold: str
+                 ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """(t_fine, y_fine) per record (class notes): each sample interval cut into equal steps, the input held (or
+    linear, ``hold="foh"``) between samples as in the simulation, from the record's initial state."""
+    from symid.fit.timeseries.response import simulate_output
+
+    if hold == "bandlimited":
+        return (), ()
+    A, B, C, D = model.state_space(theta)
+    ts, ys = [], []
+    for r, x0 in zip(recs, x0s, strict=True):
+        N = r.t.size
+        if N >= FINE_BELOW or N < 2:
+            ts.append(np.zeros(0))
+            ys.append(np.zeros((0, C.shape[0])))
+            continue
+        q = max(1, FINE_POINTS // (N - 1))  # steps per interval: equal within it, few distinct lengths overall
+        frac = np.arange(q) / q
+        t = np.concatenate([(r.t[:-1, None] + frac[None, :] * np.diff(r.t)[:, None]).ravel(), r.t[-1:]])
+        if hold == "foh":
+            u = np.column_stack([np.interp(t, r.t, r.u[:, i]) for i in range(r.u.shape[1])])
+        else:  # held from each sample to the next
+            u = np.concatenate([np.repeat(r.u[:-1], q, axis=0), r.u[-1:]])
+        ts.append(t)
+        ys.append(simulate_output(A, B, C, D, t, u, x0, hold=hold))
+    return tuple(ts), tuple(ys)
