@@ -417,6 +417,38 @@ def test_a_model_files_time_unit_is_read_and_compared_with_the_records(tmp_path)
     assert res.options["time_unit"] == "min" and "rates per min (the record's time unit)" in res.summary()
 
 
+def test_a_model_file_with_units_but_no_time_unit_is_per_second(tmp_path):
+    """The README: a model file's rates are per second when it states no time_unit. A new user's tank model with
+    input and output units but no time_unit, fitted to a record read in minutes, drew no warning (a file with
+    `time_unit = "s"` did); now the same warning, saying the unit is the default. A file with no units at all (or
+    a model written in Python) states nothing to compare."""
+    import warnings
+
+    import numpy as np
+
+    head = ("import symid as si\n"
+            "a, b = si.parameters('a b', positive=True)\n"
+            "model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])\n")
+    (tmp_path / "units.py").write_text(head + "input_units, output_units = 'kW', 'K'\n")
+    (tmp_path / "bare.py").write_text(head)
+    u = np.where(np.arange(60) < 30, 1.0, 0.0)
+    for name, record, expected in (
+            ("units.py", si.IOData(u, u, 5.0 / 60, time_unit="min"),
+             "the model file states no time_unit, so its rates are per s (its default), but the record's is min"),
+            ("units.py", si.IOData(u, u, 5.0, time_unit="s"), None),
+            ("bare.py", si.IOData(u, u, 5.0 / 60, time_unit="min"), None)):
+        model = si.load_model(tmp_path / name).free_model()
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            si.identify(model, record, x0={"a": 1.0, "b": 1.0}, identifiability_check=False, max_iter=1)
+        said = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning) and "time_unit" in
+                str(w.message)]
+        if expected is None:
+            assert not said, said
+        else:
+            assert expected in said[0] and "time_unit = 'min' in the model file" in said[0], said
+
+
 def test_a_known_value_outside_the_model_files_bounds_is_said(tmp_path):
     """A new user's `--known k2=5` against the model file's bounds k2 in [10, 1000]: nothing said, and the fit's
     advice named another parameter's bound."""

@@ -126,15 +126,21 @@ def unit_mismatches(model: Any, data: Any) -> list[str]:
                         out.append(text)
         time_unit = getattr(record, "time_unit", None) if hasattr(record, "t") else None
         model_time = (declared.get("time") or (None,))[0]
+        implied = model_time is None and bool(declared.get("input"))
+        if implied:  # a model file that states its units but no time_unit: its rates are per second (README)
+            model_time = "s"
         on_omega = time_unit is None and type(record).__name__ in ("FrequencyData", "SpectralData")
         if model_time is not None and (time_unit or ("s" if on_omega else model_time)) != model_time:
             # a new user's rates per minute on a record read in seconds: success=True, every rate 60 times off
-            text = (f"the model file's time unit is {model_time} (its rates are per {model_time}), but the "
+            text = (("the model file states no time_unit, so its rates are per s (its default), but the "
+                     if implied else f"the model file's time unit is {model_time} (its rates are per {model_time}), "
+                                     f"but the ")
                     + (f"record's is {time_unit}: read the record in {model_time} (time_unit={model_time!r}; "
                        f"--time-unit {model_time})" if not on_omega else
                        f"frequencies are in rad/s: give ω in rad/{model_time} (times the seconds in one {model_time})")
-                    + f" or write the model's rates per {time_unit or 's'}: symid converts no rate, so a factor "
-                      f"between them goes into the estimates")
+                    + f" or write the model's rates per {time_unit or 's'}"
+                    + (f" (if they are: time_unit = {time_unit!r} in the model file)" if implied and time_unit else "")
+                    + ": symid converts no rate, so a factor between them goes into the estimates")
             if text not in out:
                 out.append(text)
         for role in ("input", "output"):

@@ -9,7 +9,8 @@ wrong way (two new users: a frame with one accelerometer flipped, a servo with i
 current reversed). The correlation of the failed estimate's response with the data does
 not show it reliably (the fit half-adapts: +0.71 for the flipped entry of the frame), so
 the test is the fit itself: after a failed fit, the frequency-response ``auto`` is run,
-from the user's start and then from the failed estimate, on the data with the whole
+from the user's start (else ``scale=`` or the typical values the data imply) and then
+from the failed estimate, on the data with the whole
 response negated and, for several outputs or inputs, with each output's row or input's
 column negated; a flip whose fit succeeds is reported (``options["polarity"]`` and a NEXT
 line in the summary) when the same try on the data as they are does not. A model with
@@ -89,9 +90,19 @@ def polarity_flip(model: Any, data: FrequencyData, theta: np.ndarray, *, scale: 
     variance = getattr(data, "variance", None)
 
     # from the user's start first (a failed estimate can have a mass collapsed to 0: a new user's frame with its
-    # floor-2 accelerometer flipped fitted from the start in 0.5 s, from the failed estimate not in 2.5 s), then from
-    # the failed estimate
-    points = [np.asarray(theta, dtype=float)] if start is None else [np.asarray(start, dtype=float),
+    # floor-2 accelerometer flipped fitted from the start in 0.5 s, from the failed estimate not in 2.5 s), or
+    # without one from the typical values the data imply (|H| is the same flipped or not; a new user's servo, its
+    # failed estimate at masses of 1e-10, was not found from there), then from the failed estimate
+    first = start
+    if first is None:
+        from symid.fit.frf.scale import typical_scale
+
+        try:
+            first = typical_scale(model, data) if scale is None else np.broadcast_to(
+                np.asarray(scale, dtype=float), (model.n_parameters,))
+        except (SymidError, ValueError, np.linalg.LinAlgError):
+            first = None
+    points = [np.asarray(theta, dtype=float)] if first is None else [np.asarray(first, dtype=float),
                                                                    np.asarray(theta, dtype=float)]
 
     def attempt(sign: np.ndarray, at: np.ndarray) -> Any:
