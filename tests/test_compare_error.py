@@ -78,7 +78,9 @@ def test_a_method_that_cannot_take_the_data_is_refused_before_any_runs(monkeypat
     io = si.simulate_io(model, {"k": 0.5, "g": 2.0, "c": 1.5}, np.random.default_rng(0).standard_normal(200), 0.1)
     runs = []
     monkeypatch.setattr(OutputError, "run", lambda self, x0: runs.append(x0))
-    with pytest.raises(ModelError, match="srivc"):
+    # which method, that nothing ran, and the call without it (a new user's ("lm", "ls") got ls's message alone)
+    with pytest.raises(ModelError, match=r"compare\(\): method 'srivc' cannot run here, so nothing ran: .*"
+                                         r"Leave it out \(methods=\('oe',\)\)"):
         si.compare(model, io, methods=("oe", "srivc"), starts=2)
     assert runs == []
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -622,3 +623,33 @@ def test_quoted_cells_delimiters_and_a_units_row(tmp_path):
     units.write_text("t,u,y\ns,A,rad/s\n0,1,0.5\n1,1,0.6\n", encoding="utf-8")
     with pytest.raises(si.DataError, match=r"'s' is not a number \(a row of units under the header\? .*'t \[s\]'"):
         IOData.from_table(units, columns=cols, units={"time": "s"})
+
+
+def test_a_preamble_above_the_header_is_said_and_skipped(tmp_path):
+    """A dynamic signal analyzer's export (a new user's): "Instrument: …", "Date: …" lines, a blank one, then the
+    header. It was "line 5: 3 cells; the header (line 1) has 1 column". The first line that names every column
+    asked for is the header, when every line above it has fewer cells; the lines above are said in a DataWarning
+    and kept as comments. Without such a line the error says where a header is looked for."""
+    path = tmp_path / "dsa.csv"
+    path.write_text("Instrument: DSA-1234\nDate: 2026-11-29\nAverages: 20\n\n"
+                    "Frequency (Hz),Magnitude (dB),Phase (deg)\n1,20,-90\n2,14,-120\n4,6,-150\n", encoding="utf-8")
+    cols = {"frequency": "Frequency (Hz)", "magnitude": "Magnitude (dB)", "phase": "Phase (deg)"}
+    units = {"frequency": "Hz", "magnitude": "dB", "phase": "deg"}
+    with pytest.warns(si.DataWarning, match=r"lines 1–3 read as a preamble above the header \(line 5, the first to "
+                                           r"name the columns asked for\): 'Instrument: DSA-1234'") as seen:
+        frf = si.FrequencyData.from_table(path, columns=cols, units=units)
+    assert seen[0].filename == __file__  # pointed at the caller, not at symid's reader
+    np.testing.assert_allclose(frf.w, 2 * np.pi * np.array([1.0, 2.0, 4.0]), rtol=1e-15)
+    np.testing.assert_allclose(np.abs(frf.H[:, 0, 0]), 10 ** (np.array([20, 14, 6]) / 20), rtol=1e-12)
+    wrong = dict(cols, phase="Phase [deg]")  # a name no line holds: the reader's error, with where it looked
+    with pytest.raises(si.DataError, match=r"line 5: 3 cells; the header \(line 1\) has 1 column .*a preamble .*"
+                                           r"'Phase \[deg\]'\), and none of the first 50 does"):
+        si.FrequencyData.from_table(path, columns=wrong, units=units)
+    # a file whose first line names the columns is read as before, whatever lines below hold
+    plain = tmp_path / "plain.csv"
+    plain.write_text("t,u,y\n0,1,0\n1,1,0.5\n", encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        io = IOData.from_table(plain, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
+    assert io.y.shape == (2, 1)
+

@@ -54,6 +54,7 @@ from __future__ import annotations
 import csv
 import os
 import re
+import sys
 import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -127,12 +128,45 @@ def _other_delimiter(header: list[str], delimiter: str) -> str:
     return ""
 
 
+def _caller_level() -> int:
+    """The ``stacklevel`` of the first frame outside symid, for a warning of the function that calls this one (a
+    table is read through several layers, more from ``read_data`` than from ``from_table``)."""
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package + os.sep):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+def _cells(split: Any, line: str) -> list[str]:
+    """A line's cells, stripped, a cell in double quotes its text."""
+    return [c[1:-1].strip() if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in (c.strip() for c in split(line))]
+
+
+PREAMBLE_LINES = 50
+"""How far down a header is looked for when the first line does not name the columns asked for."""
+
+
+def _preamble(lines: list[tuple[int, str]], split: Any, names: Sequence[str]) -> int:
+    """How many lines precede the header: 0, or (an analyzer's export: "Instrument: …", "Date: …" above the names)
+    the index of the first of the first ``PREAMBLE_LINES`` lines whose cells hold every name asked for, when the
+    first line's do not and every line above it has fewer cells."""
+    wanted = [n for n in names if n]
+    if not wanted or not lines or all(n in _cells(split, lines[0][1]) for n in wanted):
+        return 0
+    for i, (_, line) in enumerate(lines[1:PREAMBLE_LINES], start=1):
+        cells = _cells(split, line)
+        if all(n in cells for n in wanted):
+            return i if all(len(_cells(split, above)) < len(cells) for _, above in lines[:i]) else 0
+    return 0
+
+
 class _Csv:
     """A plain CSV file: header of names, rows of text cells parsed column by column on demand."""
 
     missing_hint = ""
 
-    def __init__(self, path: _files.PathLike, delimiter: str):
+    def __init__(self, path: _files.PathLike, delimiter: str, names: Sequence[str] = ()):
         if delimiter not in (",", ";", "\t", "|", " "):
             raise DataError(f"delimiter must be one of ',', ';', tab, '|' or ' '; got {delimiter!r}")
         self.delimiter = delimiter
@@ -161,22 +195,38 @@ class _Csv:
         # it included (a new user's "a, b" and "0,0002" were split at their commas)
         split = (lambda line: line.split()) if delimiter == " " else (
             lambda line: next(csv.reader([line], delimiter=delimiter, quotechar='"', skipinitialspace=True), []))
+        lines = []
         for k, line in enumerate(text.splitlines(), start=1):
             if not line.strip():
                 continue
             if line.lstrip().startswith("#"):
                 self.comments.append((k, line.strip()))
                 continue
-            cells = [c[1:-1].strip() if len(c) >= 2 and c[0] == c[-1] == '"' else c
-                     for c in (c.strip() for c in split(line))]
+            lines.append((k, line))
+        skip = _preamble(lines, split, names)
+        if skip:  # said, and kept with the comments: nothing read as data, nothing lost
+            self.comments.extend((k, line.strip()) for k, line in lines[:skip])
+            self.comments.sort()
+            warnings.warn(f"{self.where}: line{'s' if skip > 1 else ''} {lines[0][0]}"
+                          f"{'–' + str(lines[skip - 1][0]) if skip > 1 else ''} read as a preamble above the "
+                          f"header (line {lines[skip][0]}, the first to name the columns asked for): "
+                          f"{_files._show(lines[0][1].strip())}{' …' if skip > 1 else ''}", DataWarning,
+                          stacklevel=_caller_level())
+        for k, line in lines[skip:]:
+            cells = _cells(split, line)
             if header is None:
                 header = cells
                 self.header_line = k
                 continue
             if len(cells) != len(header):
+                wanted = [n for n in names if n]
+                other = _other_delimiter(header, delimiter)
+                preamble = "" if other else (f"; if the lines above are a preamble (an instrument's export), the header is the first "
+                            f"line that names every column asked for ({', '.join(map(repr, wanted))}), and none of "
+                            f"the first {PREAMBLE_LINES} does" if wanted and len(cells) > len(header) else "")
                 raise DataError(f"{self.where}, line {k}: {len(cells)} cells; the header (line {self.header_line}) "
                                 f"has {len(header)} column{'s' if len(header) != 1 else ''} (delimiter "
-                                f"{delimiter!r})" + _other_delimiter(header, delimiter))
+                                f"{delimiter!r})" + other + preamble)
             self.rows.append((k, cells))
         if header is None:
             raise DataError(f"{self.where} holds no header line of column names")
@@ -516,7 +566,7 @@ def _source(table: Any, names: Sequence[str], delimiter: str) -> _Csv | _Arrays:
             # MATLAB names cannot hold brackets: "acc[0]" is channel 0 of the variable acc
             wanted = sorted({_CHANNEL.match(n).group(1) if _CHANNEL.match(n) else n for n in names})
             return _Arrays(read_mat_variables(path, wanted), repr(path))
-        return _Csv(path, delimiter)
+        return _Csv(path, delimiter, names)
     frame = _frame(table)
     if frame is not None:
         return _Arrays(frame, "the DataFrame")

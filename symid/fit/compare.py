@@ -368,8 +368,16 @@ def compare(model: Any, data: Any, methods: tuple[str, ...] | list[str] = ("scr"
     built: dict[str, tuple[Any, Any, float]] = {}
     for method in methods:
         t0 = time.perf_counter()
-        estimator, polisher = _build(model, data, method, dict(options.get(method.removesuffix("+polish"), {})),
-                                     noise_floor)
+        try:
+            estimator, polisher = _build(model, data, method, dict(options.get(method.removesuffix("+polish"), {})),
+                                         noise_floor)
+        except (ModelError, DataError, OptionError) as exc:
+            # which method, and that the comparison runs without it (a new user's methods=("lm", "ls") stopped at
+            # the linear least squares' own message, naming neither)
+            others = [m for m in methods if m != method]
+            kind = next(c for c in (OptionError, DataError, ModelError) if isinstance(exc, c))
+            raise kind(f"compare(): method {method!r} cannot run here, so nothing ran: {str(exc).rstrip('.')}"
+                       + (f". Leave it out (methods={tuple(others)!r})" if others else "")) from None
         built[method] = (estimator, polisher, time.perf_counter() - t0)
     for method in methods:
         outcomes: list[StartOutcome] = []
