@@ -221,9 +221,10 @@ class _Csv:
             if len(cells) != len(header):
                 wanted = [n for n in names if n]
                 other = _other_delimiter(header, delimiter)
-                preamble = "" if other else (f"; if the lines above are a preamble (an instrument's export), the header is the first "
-                            f"line that names every column asked for ({', '.join(map(repr, wanted))}), and none of "
-                            f"the first {PREAMBLE_LINES} does" if wanted and len(cells) > len(header) else "")
+                preamble = "" if other or not wanted or len(cells) <= len(header) else (
+                    f"; if the lines above are a preamble (an instrument's export), the header is the first line "
+                    f"that names every column asked for ({', '.join(map(repr, wanted))}), and none of the first "
+                    f"{PREAMBLE_LINES} does")
                 raise DataError(f"{self.where}, line {k}: {len(cells)} cells; the header (line {self.header_line}) "
                                 f"has {len(header)} column{'s' if len(header) != 1 else ''} (delimiter "
                                 f"{delimiter!r})" + other + preamble)
