@@ -653,3 +653,38 @@ def test_a_preamble_above_the_header_is_said_and_skipped(tmp_path):
         io = IOData.from_table(plain, columns={"time": "t", "input": "u", "output": "y"}, units={"time": "s"})
     assert io.y.shape == (2, 1)
 
+
+
+def test_a_phase_in_degrees_declared_in_radians_is_said(tmp_path):
+    """A new user's analyzer file in degrees, declared rad (a neutral column name): every phase a radian count up to
+    91, and the fit failed with a generic message. A phase in rad beyond ±2π that also jumps between neighbouring
+    lines is said; a smooth unwrapped phase in rad beyond 2π (a high-order response) is not."""
+    f = np.linspace(1, 100, 200)
+    H = 1 / ((1j * 2 * np.pi * f / 30 + 1) ** 6)  # phase from 0 to about −6 × 87°, unwrapped to −9.1 rad
+    deg = np.degrees(np.unwrap(np.angle(H)))
+    for name, phase, said in (("deg.csv", deg, True), ("rad.csv", np.radians(deg), False)):
+        path = tmp_path / name
+        np.savetxt(path, np.column_stack([f, np.abs(H), phase]), delimiter=",", header="f,mag,ph", comments="")
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            si.FrequencyData.from_table(path, columns={"frequency": "f", "magnitude": "mag", "phase": "ph"},
+                                        units={"frequency": "Hz", "magnitude": "linear", "phase": "rad"})
+        texts = [str(w.message) for w in seen if issubclass(w.category, si.DataWarning)]
+        assert any("phase 'ph' is declared in rad but reaches" in t and "is it in degrees?" in t
+                   for t in texts) == said, texts
+
+
+def test_a_sparse_phase_in_radians_is_not_said_to_be_degrees(tmp_path):
+    """No false alarm on a coarse grid of a lightly damped two-mode response in rad, unwrapped beyond −2π (steps
+    of up to 1.4 rad at the resonances)."""
+    w = np.logspace(0, 2, 40)
+    s = 1j * w
+    H = 1 / ((s**2 + 0.1 * s + 9) * (s**2 + 0.4 * s + 900) * (s / 50 + 1) ** 2)
+    path = tmp_path / "sparse.csv"
+    np.savetxt(path, np.column_stack([w, np.abs(H), np.unwrap(np.angle(H))]), delimiter=",", header="w,mag,ph",
+               comments="")
+    assert np.abs(np.unwrap(np.angle(H))).max() > 2 * np.pi
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        si.FrequencyData.from_table(path, columns={"frequency": "w", "magnitude": "mag", "phase": "ph"},
+                                    units={"frequency": "rad/s", "magnitude": "linear", "phase": "rad"})

@@ -761,10 +761,34 @@ def frequency_data_from_table(table: Any, *, columns: Mapping[str, Any], units: 
             k = int(np.argmax(x < 0))
             raise DataError(f"{src.where}: magnitude {name!r} is negative at sample {k} ({x[k]:g}); a linear "
                             "magnitude is |H| ≥ 0 (is it in dB?)")
+        if declared["phase"] == "rad" and (said := _degrees_as_radians(y)) is not None:
+            warnings.warn(f"{src.where}: phase {parts[b][(i, j)]!r} is declared in rad but {said}: is it in degrees? (units "
+                          f"phase=deg; it is read as rad)", DataWarning, stacklevel=_caller_level())
         mag = 10.0 ** (x / 20.0) if declared["magnitude"] == "dB" else x
         H[:, i, j] = mag * np.exp(1j * y * DIMENSIONS["phase"][declared["phase"]])
     with _naming(src.where):
         return FrequencyData(w, H)
+
+
+DEGREE_STEP = 0.3
+"""The step (rad, wrapped) between neighbouring lines that a quarter of the steps of a phase declared in rad and
+beyond 2π must exceed for it to be said to look like degrees."""
+
+
+def _degrees_as_radians(phase: np.ndarray) -> str | None:
+    """What makes a phase declared in rad look like degrees, or None: values beyond ±2π (a wrapped phase in rad
+    lies within ±π) that also jump between neighbouring lines (a degree read as a radian: a smooth curve in degrees,
+    about 57 times as steep; a new user's file in degrees declared rad, phases up to 91, ended in a generic failed
+    fit)."""
+    phase = np.asarray(phase, dtype=float)
+    top = float(np.max(np.abs(phase))) if phase.size else 0.0
+    if phase.size < 3 or top <= 2 * np.pi:
+        return None
+    # the upper quartile: a phase in degrees is flat away from its modes, and steep (57 times, read as rad) near them
+    step = float(np.quantile(np.abs(np.angle(np.exp(1j * np.diff(phase)))), 0.75))
+    if step <= DEGREE_STEP:
+        return None
+    return f"reaches {top:.4g} and a quarter of its steps between neighbouring lines exceed {step:.2g} rad"
 
 
 def _unit_columns(roles: Mapping[str, Any], parts: Mapping[str, Mapping[Any, Any]]) -> dict[str, str]:
