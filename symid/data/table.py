@@ -762,8 +762,8 @@ def frequency_data_from_table(table: Any, *, columns: Mapping[str, Any], units: 
             raise DataError(f"{src.where}: magnitude {name!r} is negative at sample {k} ({x[k]:g}); a linear "
                             "magnitude is |H| ≥ 0 (is it in dB?)")
         if declared["phase"] == "rad" and (said := _degrees_as_radians(y)) is not None:
-            warnings.warn(f"{src.where}: phase {parts[b][(i, j)]!r} is declared in rad but {said}: is it in degrees? (units "
-                          f"phase=deg; it is read as rad)", DataWarning, stacklevel=_caller_level())
+            warnings.warn(f"{src.where}: phase {parts[b][(i, j)]!r} is declared in rad but {said}: is it in "
+                          f"degrees? (units phase=deg; it is read as rad)", DataWarning, stacklevel=_caller_level())
         mag = 10.0 ** (x / 20.0) if declared["magnitude"] == "dB" else x
         H[:, i, j] = mag * np.exp(1j * y * DIMENSIONS["phase"][declared["phase"]])
     with _naming(src.where):
