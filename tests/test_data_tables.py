@@ -119,6 +119,15 @@ def test_even_times_written_with_few_digits_are_an_even_grid(tmp_path):
         io = IOData.from_table(path, columns=cols, units={"time": "h"}, time_unit="h")
         assert io.n_samples == 720
         np.testing.assert_allclose(io.dt, 1 / 6, rtol=1e-7)  # the grid fitted to 720 times rounded to 5e-4 h
+    # another user's 5 s samples over 4 h in minutes by "%.6g" (0.0833333 … 239.917): the grid fitted without
+    # weights, pulled by the coarse late times, missed the fine early ones by 1.1 half-units
+    minutes = np.arange(2881) * 5 / 60
+    path = tmp_path / "tanks.csv"
+    np.savetxt(path, np.column_stack([minutes, np.ones(2881), np.zeros(2881)]), delimiter=",", header="t,P,T",
+               comments="", fmt="%.6g")
+    io = IOData.from_table(path, columns={"time": "t", "input": "P", "output": "T"}, units={"time": "min"},
+                           time_unit="min")
+    np.testing.assert_allclose(io.dt, 5 / 60, rtol=1e-7)  # 0.0833333 is 4e-7 from 1/12
     jittered = t + 0.004 / 6 * np.sin(np.arange(720))  # up to 0.4 % of a sample, written at full precision
     path = tmp_path / "jitter.csv"
     np.savetxt(path, np.column_stack([jittered, u, y]), delimiter=",", header="t_h,P,T", comments="", fmt="%.17g")
