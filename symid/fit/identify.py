@@ -416,6 +416,13 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if offset is not None:
             extra["initial_offset"] = offset
     records = data if isinstance(data, (list, tuple)) else [data]
+    if not result.success and hasattr(records[0], "t"):
+        # the columns read the wrong way round: no start or offset fixes that (symid.fit.timeseries.roles)
+        from symid.fit.timeseries.roles import swapped_roles
+
+        roles = swapped_roles(records)
+        if roles is not None:
+            extra["swapped_roles"] = roles
     if hasattr(records[0], "t") and getattr(records[0], "time_unit", None):  # what the rates are per
         extra["time_unit"] = records[0].time_unit
     if not_local:  # said in the summary too (the warning alone went to a terminal, not to summary.txt)

@@ -468,6 +468,9 @@ class IdentificationResult:
                              f"{self.cost:.3g} as they are): an input or output of reversed polarity (a sensor "
                              f"mounted the other way, a current measured backwards)? Negate it in the data and fit "
                              f"again (.options['polarity'] holds that fit's estimate)")
+            elif (roles := self.options.get("swapped_roles")) is not None:
+                # before an offset or a bound, which swapped columns also produce (a new user's two tanks)
+                lines.append(f"NEXT: {roles}")
             elif self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
             elif self.on_bounds:  # before the signs of an offset, which then follow: a new user's concentrations
