@@ -109,3 +109,29 @@ def test_an_initial_position_the_output_cannot_see_is_not_a_near_singular_direct
     assert res.success and not unc.near_singular, unc.summary()
     th = np.array([truth[n] for n in model.parameter_names])
     assert np.all((unc.intervals[:, 0] <= th) & (th <= unc.intervals[:, 1]))
+
+
+def test_an_estimate_where_two_solutions_meet_is_said_to():
+    """A new user's oral dose (absorption into a two-compartment model): with noise the least-squares estimate often
+    lands where the flip-flop's two solutions meet (ka equal to a disposition rate), where no interval is finite, and
+    the note named "the other solution", the estimate itself. Reference: the estimate's own disposition matrix,
+    one of whose rates equals its ka at the fold (an exact property of the meeting point)."""
+    import warnings
+
+    ka, k10, k12, k21, q = si.parameters("ka k10 k12 k21 q", positive=True)
+    model = si.StateSpaceModel(A=[[-ka, 0, 0], [ka, -k10 - k12, k21], [0, k12, -k21]], B=[[1], [0], [0]],
+                               C=[[0, q, 0]])
+    truth = {"ka": 0.6, "k10": 0.15, "k12": 0.3, "k21": 0.2, "q": 1 / 30}  # ka at the disposition rate 0.6
+    t = np.array([0, 0.01, 0.25, 0.5, 1, 2, 3, 4, 6, 8, 12, 16, 20, 24.0])  # h; a 0.01 h bolus of 500 mg
+    fine = np.linspace(0, 24, 24 * 1000 + 1)
+    clean = si.simulate_io(model, truth, np.where(fine < 0.01, 5e4, 0.0), fine[1] - fine[0])
+    y = np.interp(t, fine, clean.y[:, 0]) * (1 + 0.05 * np.random.default_rng(3).standard_normal(t.size))
+    record = TimeSeries(t, np.where(t < 0.01, 5e4, 0.0), y, time_unit="h")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = si.identify(model, record, x0={"ka": 1.0, "k10": 0.1, "k12": 0.2, "k21": 0.3, "q": 0.05}, seed=0)
+    th = res.theta
+    rates = -np.linalg.eigvals([[-th["k10"] - th["k12"], th["k21"]], [th["k12"], -th["k21"]]])
+    assert np.min(np.abs(rates - th["ka"])) < 1e-3 * th["ka"]  # at the meeting point
+    assert "another solution coincides with it" in res.uncertainty.note
+    assert "the other solution is" not in res.uncertainty.note

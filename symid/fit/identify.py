@@ -35,6 +35,11 @@ _SEVERAL_INTERVALS = (
 """The uncertainty's note for an estimate of a model with several solutions (:func:`identify`)."""
 
 
+MERGED = 1e-3
+"""Another solution at the estimate within this relative difference in every parameter is the estimate itself: two
+solutions meet there (:func:`identify`'s uncertainty note says so)."""
+
+
 def _within(solution: dict[str, float], bounds: dict[str, list[float]] | None) -> bool:
     """Does a solution lie within the fit's bounds (with the 1e-9 relative slack of rounding)?"""
     for name, (lo, hi) in (bounds or {}).items():
@@ -71,6 +76,19 @@ def _nearest(others: list[dict[str, float]] | None, theta: np.ndarray, unc: Any)
         return max((abs(sol[n] - c) / s if s > 0 and np.isfinite(s) else np.inf, n)
                    for n, c, s in zip(names, theta, se, strict=True))
 
+    def apart(sol: dict[str, float]) -> tuple[float, str]:  # the largest relative difference from θ̂
+        return max((abs(sol[n] - c) / abs(c) if c else abs(sol[n]), n) for n, c in zip(names, theta, strict=True))
+
+    close = min(others, key=lambda sol: apart(sol)[0])
+    rel, which = apart(close)
+    if rel < MERGED:
+        # a new user's oral dose (ka at a disposition rate: the flip-flop's two solutions meet there): "the other
+        # solution is ka = 0.893804, …", the estimate itself, beside intervals that were all infinite
+        return (f"; at this estimate another solution coincides with it (to {rel:.1g} relative, in {which}): the "
+                f"estimate sits where two solutions meet, where the response cannot tell them apart to first order "
+                f"(the Fisher information is singular there, so intervals through it are not finite); a value known "
+                f"or bounds that keep one of the two (one rate above another) make the estimate a point of one "
+                f"branch")
     best = min(others, key=lambda sol: far(sol)[0])
     dist, name = far(best)
     values = ", ".join(f"{n} = {best[n]:.6g}" for n in names)
