@@ -12,6 +12,7 @@ import warnings
 from collections.abc import Sequence
 
 from symid.errors import SymidError
+from symid.fit.modes import modes_line
 from symid.fit.registry import all_methods, data_kinds
 from symid.interrupt import Interrupted
 
@@ -453,10 +454,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     outside = spec.outside_bounds(final.theta)
     fitted = bool(final.success or any(s.success for s in res.starts))
     code = 0 if fitted else NO_FIT
-    _say(args, res.summary(truth=truth))
-    modes = _modes_line(model, final.theta_vector, time_unit)
-    if modes:
-        _say(args, modes)
+    _say(args, res.summary(truth=truth))  # with the estimate's modes (symid.fit.modes)
+    if "modes" not in final.options and (modes := modes_line(model, final.theta_vector, time_unit)):
+        _say(args, modes)  # a result from another path (a partial one) has none
     if vdata is not data:
         _say(args, f"validation on {', '.join(args.validate)} (not the records fitted)")
     validation = _time_series_validation(model, vdata, final, args)
@@ -498,33 +498,6 @@ def _print_json(obj) -> None:
     from symid.runlog import json_safe
 
     print(json.dumps(json_safe(obj), indent=2, allow_nan=False))
-
-
-def _modes_line(model, theta, time_unit: str | None) -> str:
-    """The estimate's modes, natural frequency (Hz and rad per time unit) and damping ratio, and its real poles: a
-    check a person can make at a glance (a frequency axis in Hz read as rad/s moves every mode by 2π)."""
-    import numpy as np
-
-    try:
-        A = np.asarray(model.state_space(theta)[0], dtype=float)
-        poles = np.linalg.eigvals(A) if A.size and np.all(np.isfinite(A)) else np.array([])
-    except Exception:  # an estimate where the model cannot be evaluated: nothing to say
-        return ""
-    unit = time_unit or "s"
-    items = []
-    zero = np.abs(poles) <= 1e-12 * max(float(np.max(np.abs(poles))), 1e-300) if poles.size else poles
-    if np.count_nonzero(zero):  # integrators (a rigid-body mode, positions no output sees): one item, shown as 0
-        count = np.count_nonzero(zero)  # (a new user's drivetrain read "real pole 1.359e-11 /s", positive)
-        items.append(f"{count} pole{'s' if count > 1 else ''} at 0")
-        poles = poles[~zero]
-    for p in sorted(poles, key=abs):
-        if p.imag > 0:
-            wn = abs(p)
-            hz = f"{wn / (2 * np.pi):.4g} Hz, " if unit == "s" else ""
-            items.append(f"{hz}{wn:.4g} rad/{unit}, ζ {-p.real / wn:.3g}")
-        elif p.imag == 0:
-            items.append(f"real pole {p.real:.4g} /{unit}")
-    return "modes of the estimate: " + "; ".join(items) if items else ""
 
 
 def _time_series_validation(model, data, res, args):

@@ -589,11 +589,25 @@ def test_identify_prints_the_estimates_modes(capsys):
     eigenvalues of the thesis's 2-DOF mass-damper at its truth (4-20), computed here."""
     entry = si.load_model("mass_damper_2dof")
     assert main(["identify", "mass_damper_2dof", "--method", "ipopt"]) in (0, 4)
-    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("modes of the estimate: "))
+    out = capsys.readouterr().out
+    assert out.count("modes of the estimate: ") == 1
+    line = next(x for x in out.splitlines() if x.startswith("modes of the estimate: "))
     poles = np.linalg.eigvals(entry.model.state_space(entry.truth)[0])
     wn = sorted(abs(p) for p in poles if p.imag > 0)
     hz = [float(x.split(" Hz")[0]) for x in line.removeprefix("modes of the estimate: ").split("; ")]
     np.testing.assert_allclose(hz, np.array(wn) / (2 * np.pi), rtol=1e-3)  # printed to 4 digits
+
+
+def test_the_python_summary_holds_the_modes_once():
+    """The command line printed the modes, the Python result held them nowhere (a new user's servo): they are in
+    options["modes"] and summary(), and the command line prints them once. Reference: as above."""
+    entry = si.load_model("mass_damper_2dof")
+    res = si.identify(entry.model, entry.data(), method="ipopt", identifiability_check=False)
+    assert res.options["modes"].startswith("modes of the estimate: ")
+    assert res.summary().count("modes of the estimate: ") == 1
+    poles = np.linalg.eigvals(entry.model.state_space(entry.truth)[0])
+    hz = [float(x.split(" Hz")[0]) for x in res.options["modes"].removeprefix("modes of the estimate: ").split("; ")]
+    np.testing.assert_allclose(hz, np.sort([abs(p) for p in poles if p.imag > 0]) / (2 * np.pi), rtol=1e-3)
 
 
 def test_a_mimo_frequency_response_gets_a_bode_figure_per_entry(tmp_path, capsys):
@@ -617,13 +631,13 @@ def test_a_mimo_frequency_response_gets_a_bode_figure_per_entry(tmp_path, capsys
 def test_the_modes_line_groups_poles_at_zero():
     """A new user's room (K = 0, temperatures as velocities) listed "real pole 0 /s" once per node; the integrators
     are one item, and the other poles are the matrix's own (reference: the eigenvalues of A, computed here)."""
-    from symid.cli import _modes_line
+    from symid.fit.modes import modes_line
 
     Ca, Cw, Haw, Hwo = si.parameters("Ca Cw Haw Hwo", positive=True)
     model = si.SecondOrderModel(M=[[Ca, 0], [0, Cw]], V=[[Haw, -Haw], [-Haw, Haw + Hwo]], K=[[0, 0], [0, 0]],
                                 B=[[1], [0]], C=[[1, 0]], output="velocity")
     theta = [5e5, 8e6, 300.0, 80.0]
-    line = _modes_line(model, theta, "s")
+    line = modes_line(model, theta, "s")
     poles = sorted(np.linalg.eigvals(np.asarray(model.state_space(theta)[0], float)).real, key=abs)[2:]
     assert line == ("modes of the estimate: 2 poles at 0; " + "; ".join(f"real pole {p:.4g} /s" for p in poles))
 
@@ -739,8 +753,8 @@ def test_compare_leaves_out_a_method_that_refuses_and_keeps_the_others(tmp_path,
 def test_the_modes_line_shows_one_rigid_body_pole_as_zero():
     """A new user's drivetrain (nothing to the ground but a bearing's friction) read "real pole 1.359e-11 /s",
     positive, as if unstable: a single pole at 0 to rounding is "1 pole at 0"."""
-    from symid.cli import _modes_line
+    from symid.fit.modes import modes_line
 
     m, c = si.parameters("m c", positive=True)
     model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[0]], B=[[1]], C=[[1]])
-    assert _modes_line(model, [2.0, 3.0], "s") == "modes of the estimate: 1 pole at 0; real pole -1.5 /s"
+    assert modes_line(model, [2.0, 3.0], "s") == "modes of the estimate: 1 pole at 0; real pole -1.5 /s"

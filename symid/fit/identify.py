@@ -14,6 +14,7 @@ import numpy as np
 
 from symid.errors import DataWarning, IdentifiabilityWarning, OptionError
 from symid.fit.frf.misfit import FrfEstimator, relative_noise_note, weak_lines_missed
+from symid.fit.modes import modes_line
 from symid.fit.options import check_bool, scale_by_name, without_known
 from symid.fit.registry import check_model, prepare
 from symid.fit.result import IdentificationResult, StartOutcome
@@ -443,6 +444,15 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             extra["swapped_roles"] = roles
     if hasattr(records[0], "t") and getattr(records[0], "time_unit", None):  # what the rates are per
         extra["time_unit"] = records[0].time_unit
+    # the estimate's modes, in summary(): a frequency axis in Hz read as rad/s moves every one by 2π (a new user's
+    # servo: the command line printed them, the Python result held them nowhere)
+    if np.all(np.isfinite(result.theta_vector)) and (modes := modes_line(model, result.theta_vector,
+                                                                        extra.get("time_unit"))):
+        extra["modes"] = modes
+    if result.polished is not None and np.all(np.isfinite(result.polished.theta_vector)) and (
+            modes := modes_line(model, result.polished.theta_vector, extra.get("time_unit"))):
+        result = dataclasses.replace(result, polished=dataclasses.replace(
+            result.polished, options={**result.polished.options, "modes": modes}))
     if not_local:  # said in the summary too (the warning alone went to a terminal, not to summary.txt)
         extra["not_identifiable"] = {"parameters": list(not_local),
                                      "from_rest_only": getattr(model, "initial_state_kind", "zero") in ("known",

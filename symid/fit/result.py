@@ -536,6 +536,8 @@ class IdentificationResult:
             lines.append(unc.summary())
         if (unit := self.options.get("time_unit")) not in (None, "s"):  # a record in minutes: rates per minute
             lines.append(f"rates per {unit} (the record's time unit)")
+        if self.options.get("modes"):
+            lines.append(self.options["modes"])
         head = f"{'parameter':>12s} {'estimate':>14s}"
         if unc is not None:
             head += f" {'std. error':>11s} {'95 % interval':>27s}"
