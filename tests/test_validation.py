@@ -55,7 +55,7 @@ def test_wrong_model_is_caught_by_the_tests():
     assert not wrong_g.independent[0, 0] and wrong_g.independence_p[0, 0] < 1e-6
 
 
-def test_constant_input_several_records_and_estimated_initial_state():
+def test_constant_input_several_records_and_estimated_initial_state(tmp_path):
     model = mck(B=((1, 1),))
     u = np.column_stack([np.sign(np.sin(0.05 * np.arange(600))), np.ones(600)])
     recs = [si.simulate_io(model, TRUTH, u, dt=0.1, noise=0.02, seed=s, x0=[0.3 * s, 0.0]) for s in (1, 2)]
@@ -66,6 +66,13 @@ def test_constant_input_several_records_and_estimated_initial_state():
     assert v.fit_percent[0] > 97
     at_rest = si.validate(model, TRUTH, recs)
     assert at_rest.fit_percent[0] < v.fit_percent[0]
+    assert "input(s) 1 constant: no cross-correlation" in v.notes
+    # read from a table, the note names the column (a new user's "input(s) 2 constant" beside named tables)
+    path = tmp_path / "record.csv"
+    np.savetxt(path, np.column_stack([recs[0].t, u, recs[0].y]), delimiter=",", header="t,valve,one,y", comments="")
+    named = si.IOData.from_table(path, columns={"time": "t", "input": ["valve", "one"], "output": "y"},
+                                 units={"time": "s"})
+    assert "input(s) 'one' constant: no cross-correlation" in si.validate(model, TRUTH, named).notes
 
 
 def test_non_uniform_samples_are_said():

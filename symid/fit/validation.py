@@ -579,7 +579,10 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
                      f"not {DEFAULT_MAX_LAG}")
     constant = np.flatnonzero(~(su > 0))
     if constant.size:
-        notes.append(f"input(s) {', '.join(str(int(i)) for i in constant)} constant: no cross-correlation")
+        columns = _record_columns(data).get("input", ())  # by the table's names when read from one (a new user's
+        # "input(s) 2 constant" beside tables that named the columns)
+        named = [repr(columns[i]) if len(columns) == su.size else str(int(i)) for i in constant]
+        notes.append(f"input(s) {', '.join(named)} constant: no cross-correlation")
         s_stat[:, constant] = np.nan
         s_p[:, constant] = np.nan
         rho_eu[:, constant, :] = np.nan
