@@ -609,3 +609,25 @@ def test_a_fit_far_from_the_users_start_names_the_units():
     np.testing.assert_allclose(res.theta_vector, [0.5 / 3600, 2.0 / 3600], rtol=1e-6)
     assert res.options["far_from_start"]["median_factor"] == pytest.approx(3600, rel=1e-6)
     assert "NOTE: the estimate fits, but lies far from your start" in res.summary()
+
+
+def test_a_drifting_sensor_is_named_in_next():
+    """A new user's temperature sensor drifting 0.15 K/h on a 4 h record: the fit failed and NEXT said "more starts"
+    or "the data may be that noisy". A constant and a ramp that explain a share of the misfit (after the offset and
+    initial-state tests) are named, with the slope. Reference: the record is built here, a ramp added to the
+    simulated output."""
+    k, g = si.parameters("k g", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    rng = np.random.default_rng(2)
+    u = np.repeat(rng.integers(0, 2, 48), 60).astype(float)  # a PRBS held 5 min, sampled every 5 s for 4 h
+    io = si.simulate_io(model, {"k": 1 / 600, "g": 1e-3}, u, 5.0, noise=0.02, seed=3)
+    drift = 0.5 * io.y.max() * io.t / io.t[-1]  # half the output's range over the record
+    record = si.IOData(io.u, io.y + drift[:, None], io.dt)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = si.identify(model, record, x0={"k": 1e-3, "g": 1e-3}, initial_state="estimate",
+                          identifiability_check=False, time_limit=10)
+    assert not res.success
+    drift_said = res.options["initial_offset"]
+    assert drift_said["kind"] == "drift" and drift_said["slope"] > 0
+    assert "NEXT: the residual drifts (output 0:" in res.summary() and "a column of time (a ramp)" in res.summary()

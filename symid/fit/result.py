@@ -106,6 +106,12 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
                      f"will not fit it; subtract the operating point (deviation variables) or model it (guide: "
                      f"records around an operating point)")
         return text
+    if offset.get("kind") == "drift":
+        return (f"the residual drifts ({where}output {offset['output']}: {offset['slope']:.3g} per "
+                f"{offset.get('time_unit', 's')} on a mean of {offset['mean']:.3g}; with an offset and a ramp on each "
+                f"output removed {drop}): a sensor that drifts or a slow disturbance the model does not hold. Model "
+                f"it: two inputs, a column of ones and a column of time (a ramp), each with a gain that is a "
+                f"parameter on that output, the initial state estimated (guide: records around an operating point)")
     if offset.get("kind") == "level":
         return (f"{where}output {offset['output']} sits at a level (mean {offset['mean']:.6g}, standard deviation "
                 f"{offset['std']:.3g}): if the record lies around an operating point (absolute levels, "

@@ -681,7 +681,9 @@ class OutputError(Estimator, FisherInformation):
         ``OFFSET_SHARE`` of it, and more than noise would; not asked with the initial state
         estimated). ``"offset"``: a constant on each output (with the initial state) explains a
         share likewise, beyond what the initial state alone does (a record around an
-        operating point). Failing both, ``"level"``: an output whose mean exceeds
+        operating point). Failing both, ``"drift"``: a constant and a ramp on each output
+        explain a share likewise, the ramp beyond what noise would (a sensor that drifts;
+        ``slope`` per the record's time unit). Failing that, ``"level"``: an output whose mean exceeds
         :data:`LEVEL` of its standard deviations (absolute values around an operating
         point, which a fit can absorb in its gains). Else, without a feedthrough, a first
         measured output beyond a fifth of its range from the model's (an estimate that
@@ -708,9 +710,13 @@ class OutputError(Estimator, FisherInformation):
                     # a constant on each output
                     O = (np.einsum("pn,knr->kpr", C, state_transitions(A, r.t)) * sw[:, :, None]).reshape(-1, n)
                     const = (np.eye(p)[None, :, :] * sw[:, :, None]).reshape(-1, p)
+                    span = max(float(r.t[-1] - r.t[0]), 1e-300)
+                    ramp = ((r.t - r.t[0])[:, None, None] / span * np.eye(p)[None, :, :]
+                            * sw[:, :, None]).reshape(-1, p)
                     free = None if self._estimate_x0 else _projected_out(res, O)
                     joint = _projected_out(res, np.hstack([O, const]))
-                    rows.append((r, s, o, res, free, joint))
+                    trend = _projected_out(res, np.hstack([O, const, ramp]))
+                    rows.append((r, s, o, res, free, joint, trend))
         except (ModelError, np.linalg.LinAlgError, ValueError):
             return None
         misfit = sum(float(np.sum(row[3] ** 2)) for row in rows)
@@ -727,11 +733,18 @@ class OutputError(Estimator, FisherInformation):
         else:
             ref, extra = misfit, p * E + (0 if self._estimate_x0 else n * E)
         offset_explains = self._explains(ref, with_both, n_values, extra)
+        # a drift (a sensor's, a slow disturbance's) on top of the offsets: a ramp on each output (a new user's
+        # temperature sensor, 0.4 K and 0.15 K/h: "try more starts", k4 in the slow mode 5 times off)
+        with_trend = sum(float(np.sum(row[6] ** 2)) for row in rows)
+        drift_explains = (self._explains(ref, with_trend, n_values, extra + p * E)
+                          and self._explains(with_both, with_trend, n_values, p * E, share=0.0))
         if offset_explains:
             kind, after, shares = "offset", with_both, [np.sum(row[3] ** 2 - row[5] ** 2, axis=0) for row in rows]
         elif x0_explains:
             kind, after, shares = "initial_state", with_x0, [np.sum(row[3] ** 2 - row[4] ** 2, axis=0)
                                                                for row in rows]
+        elif drift_explains:  # after the two above: a start away from rest also leaves a slope in the residual
+            kind, after, shares = "drift", with_trend, [np.sum(row[3] ** 2 - row[6] ** 2, axis=0) for row in rows]
         elif (level := _level(rows, misfit)) is not None:
             # an estimate whose gains absorbed the level (a linear model through the origin fitted to absolute
             # levels around an operating point: a new user's tanks, misfit 3.7e-4 with the initial state estimated)
@@ -753,20 +766,25 @@ class OutputError(Estimator, FisherInformation):
         out = {"kind": kind, "record": e, "output": j, "misfit": misfit, "after": after, "sample": k,
                "measured": float(r.y[k, j]), "model": float(s[k, j]),
                "mean": float(raw.sum() / max(int(o[:, j].sum()), 1))}
+        if kind == "drift":  # the residual's slope on that output, per the record's time unit
+            keep = o[:, j]
+            out["slope"] = float(np.polyfit(r.t[keep] - r.t[0], raw[keep], 1)[0]) if np.count_nonzero(keep) > 1 \
+                else 0.0
+            out["time_unit"] = getattr(r, "time_unit", "s")
         if kind == "initial_state" and (level := _level(rows, misfit)) is not None:
             # a record at a level also starts away from a model at rest; estimating the initial state alone does
             # not fit it (a new user's absolute temperatures: 0.0286 → 0.0112, no fit), so both are said
             out["level"] = {key: level[key] for key in ("record", "output", "mean", "std")}
         return out
 
-    def _explains(self, misfit: float, after: float, n_values: int, extra: int) -> bool:
+    def _explains(self, misfit: float, after: float, n_values: int, extra: int, share: float = OFFSET_SHARE) -> bool:
         """Whether ``extra`` more unknowns (initial states, offsets) that lower the misfit to ``after`` explain a
         share of it: at least ``OFFSET_SHARE`` of it, and more than noise would (the likelihood-ratio statistic
         (misfit − after) / (after / dof) beyond the χ² 99.9 % quantile of ``extra`` degrees of freedom; on a failed
         fit the residual is not noise, so the share is what decides)."""
         from scipy.stats import chi2
 
-        if not (math.isfinite(after) and after < (1 - OFFSET_SHARE) * misfit):
+        if not (math.isfinite(after) and after < (1 - share) * misfit):
             return False
         dof = max(n_values - self.model.n_parameters - extra, 1)
         return after <= 0 or (misfit - after) / (after / dof) > float(chi2.ppf(0.999, extra))
