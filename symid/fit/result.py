@@ -576,6 +576,24 @@ class IdentificationResult:
             lines.append(self.polished.summary(truth))
         return "\n".join(lines)
 
+    def derived(self, quantities: Mapping[str, Any]) -> Any:
+        """Quantities computed from the estimate, with standard errors and 95 % intervals by the delta method
+        (:func:`symid.fit.derived.derived_quantities`): ``res.derived({"V": lambda th: 1 / th["q"]})``.
+
+        Parameters
+        ----------
+        quantities : dict of str to callable
+            Each callable takes the parameters as a dict by name and returns a number.
+
+        Returns
+        -------
+        symid.fit.derived.DerivedQuantities
+            With ``summary()``, ``values``, ``standard_errors`` and ``intervals``.
+        """
+        from symid.fit.derived import derived_quantities
+
+        return derived_quantities(self, quantities)
+
     @property
     def on_bounds(self) -> dict[str, str]:
         """The parameters whose estimate sits on a bound the user gave (``options["bounds"]``), by name:
