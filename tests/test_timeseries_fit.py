@@ -631,3 +631,27 @@ def test_a_drifting_sensor_is_named_in_next():
     drift_said = res.options["initial_offset"]
     assert drift_said["kind"] == "drift" and drift_said["slope"] > 0
     assert "NEXT: the residual drifts (output 0:" in res.summary() and "a column of time (a ramp)" in res.summary()
+
+
+def test_a_parameter_of_an_input_held_at_zero_is_not_determined(tmp_path):
+    """A new user's heater column left at 0: b2, its gain, came out 3.8e-12 in a successful fit, said only as a
+    near-singular direction. A parameter found only in the columns of inputs that are zero in every record is named,
+    by the table's column, in a DataWarning and the summary. Reference: the model's structure (b2 sits in B's
+    second column alone)."""
+    k, b1, b2 = si.parameters("k b1 b2", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[b1, b2]], C=[[1]])
+    rng = np.random.default_rng(0)
+    u = np.column_stack([np.repeat(rng.integers(0, 2, 30), 20).astype(float), np.zeros(600)])
+    io = si.simulate_io(model, {"k": 0.1, "b1": 0.2, "b2": 0.5}, u, 1.0, noise=0.01, seed=1)
+    path = tmp_path / "tank.csv"
+    np.savetxt(path, np.column_stack([io.t, u, io.y]), delimiter=",", header="t,valve,heater,T", comments="")
+    record = si.IOData.from_table(path, columns={"time": "t", "input": ["valve", "heater"], "output": "T"},
+                                  units={"time": "s"})
+    with pytest.warns(si.DataWarning, match=r"b2 multiplies only input 'heater', zero in every record"):
+        res = si.identify(model, record, x0={"k": 0.2, "b1": 0.1, "b2": 0.1}, identifiability_check=False)
+    assert "NOT DETERMINED BY THESE DATA: b2" in res.summary()
+    driven = si.simulate_io(model, {"k": 0.1, "b1": 0.2, "b2": 0.5}, np.column_stack([u[:, 0], u[::-1, 0]]), 1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        other = si.identify(model, driven, x0={"k": 0.2, "b1": 0.1, "b2": 0.1}, identifiability_check=False)
+    assert "not_determined" not in other.options

@@ -41,6 +41,37 @@ MERGED = 1e-3
 solutions meet there (:func:`identify`'s uncertainty note says so)."""
 
 
+def _idle_input_parameters(model: Any, records: list[Any]) -> str | None:
+    """'b2 multiplies input 'heater_kW' alone, which is zero in every record: …' for the parameters found only in
+    the columns of B (and D) of inputs that are zero throughout the records, or None."""
+    u = np.vstack([np.asarray(r.u, dtype=float) for r in records])
+    zero = [j for j in range(u.shape[1]) if not np.any(u[:, j])]
+    if not zero:
+        return None
+    maps = model.maps
+    idle = []
+    for k, name in enumerate(model.parameter_names):
+        elsewhere = False
+        for key, amap in maps.items():
+            coef = np.asarray(amap.Xi[k])
+            if key in ("B", "D"):
+                coef = np.delete(coef, zero, axis=1)
+            if np.any(coef):
+                elsewhere = True
+                break
+        if not elsewhere:
+            idle.append(name)
+    if not idle:
+        return None
+    stated = getattr(records[0], "stated_units", None) or {}
+    columns = stated.get("input", ())
+    named = [repr(columns[j][0]) if len(columns) == u.shape[1] else str(j) for j in zero]
+    which = f"input {named[0]}" if len(zero) == 1 else f"inputs {', '.join(named)}"
+    return (f"{', '.join(idle)} {'multiplies' if len(idle) == 1 else 'multiply'} only {which}, zero in every "
+            f"record: the data do not determine {'it' if len(idle) == 1 else 'them'} (the estimate is arbitrary, "
+            f"its standard error infinite); drive that input in a record, or make {idle[0]} known")
+
+
 def _within(solution: dict[str, float], bounds: dict[str, list[float]] | None) -> bool:
     """Does a solution lie within the fit's bounds (with the 1e-9 relative slack of rounding)?"""
     for name, (lo, hi) in (bounds or {}).items():
@@ -435,6 +466,11 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if offset is not None:
             extra["initial_offset"] = offset
     records = data if isinstance(data, (list, tuple)) else [data]
+    if hasattr(records[0], "t") and (idle := _idle_input_parameters(model, records)) is not None:
+        # a parameter that multiplies only an input the records hold at zero: its estimate is arbitrary (a new
+        # user's heater column left at 0: b2 = 3.8e-12, success, said only as a near-singular direction)
+        extra["not_determined"] = idle
+        warnings.warn(idle, DataWarning, stacklevel=2)
     if not result.success and hasattr(records[0], "t"):
         # the columns read the wrong way round: no start or offset fixes that (symid.fit.timeseries.roles)
         from symid.fit.timeseries.roles import swapped_roles

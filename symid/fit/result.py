@@ -517,6 +517,8 @@ class IdentificationResult:
                          f"own level, the maximum-likelihood fit for such noise")
         if (far := self.options.get("far_from_start")) is not None:
             lines.append(f"NOTE: {far['text']}")
+        if self.options.get("not_determined"):
+            lines.append(f"NOT DETERMINED BY THESE DATA: {self.options['not_determined']}")
         if (bad := self.options.get("not_identifiable")) is not None:
             names = ", ".join(bad["parameters"])
             lines.append(f"NOT IDENTIFIABLE (structure): {names} cannot be determined from "
