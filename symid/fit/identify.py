@@ -544,6 +544,16 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                                  start=x0s[0] if x0 is not None else None)
         if flip is not None:
             result = dataclasses.replace(result, options={**result.options, "polarity": flip})
+    made = getattr(data, "estimated_from", None) or {}
+    if isinstance(estimator, FrfEstimator) and not result.success and made and made.get("hold") is None:
+        # a response estimated from held records without hold=: the sampled system's, not H(jω) (two new users'
+        # acceleration records, told "units, local minimum")
+        result = dataclasses.replace(result, options={**result.options, "sampled_response": (
+            f"this response was estimated from sampled records (si.estimate_frf, dt = {made['dt']:.4g} s) without "
+            f"hold=: if the input was held between samples (a DAC, a controller, si.simulate_io), it is the sampled "
+            f"system's response, off H(jω) by the hold's half-sample delay and sinc and by aliasing (most with an "
+            f"acceleration output); estimate it with hold='zoh', or fit the records as samples (si.identify(model, "
+            f"io): output error models the hold exactly)")})
     if isinstance(estimator, FrfEstimator) and estimator.line_weights is None \
             and np.all(np.isfinite(result.theta_vector)):
         weak = weak_lines_missed(model, estimator.data, result.theta_vector)

@@ -474,6 +474,8 @@ class IdentificationResult:
                              f"{self.cost:.3g} as they are): an input or output of reversed polarity (a sensor "
                              f"mounted the other way, a current measured backwards)? Negate it in the data and fit "
                              f"again (.options['polarity'] holds that fit's estimate)")
+            elif (sampled := self.options.get("sampled_response")) is not None:
+                lines.append(f"NEXT: {sampled}")
             elif (roles := self.options.get("swapped_roles")) is not None:
                 # before an offset or a bound, which swapped columns also produce (a new user's two tanks)
                 lines.append(f"NEXT: {roles}")

@@ -545,11 +545,15 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
                       "uncorrelated inputs (arbitrary where they are one signal). Excite the inputs independently; "
                       "if one input is derived from another (its derivative, a scaled copy), it is not a separate "
                       "input: model the pair as one", DataWarning, stacklevel=2)
+    dt = _records(data)[0].dt
     if hold != "zoh":
-        return FrequencyData(est.w, est.H, est.variance, est.variance_dof)
-    factor = _hold_factor(est.w, _records(data)[0].dt)[:, None, None]
-    variance = None if est.variance is None else est.variance / np.abs(factor) ** 2
-    return FrequencyData(est.w, est.H / factor, variance, est.variance_dof)
+        out = FrequencyData(est.w, est.H, est.variance, est.variance_dof)
+    else:
+        factor = _hold_factor(est.w, dt)[:, None, None]
+        variance = None if est.variance is None else est.variance / np.abs(factor) ** 2
+        out = FrequencyData(est.w, est.H / factor, variance, est.variance_dof)
+    object.__setattr__(out, "estimated_from", {"dt": float(dt), "hold": hold})  # metadata, not a field
+    return out
 
 
 def estimate_coherence(data: IOData | Sequence[IOData], *, estimator: str = "h1", period: int | None = None,
