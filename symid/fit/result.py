@@ -109,8 +109,8 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
     if offset.get("kind") == "drift":
         return (f"the residual drifts ({where}output {offset['output']}: {offset['slope']:.3g} per "
                 f"{offset.get('time_unit', 's')}, mean residual {offset['mean']:.3g}; with an offset and a ramp on "
-                f"each output removed {drop}): a sensor that drifts or a slow disturbance the model does not hold. Model "
-                f"it: two inputs, a column of ones and a column of time (a ramp), each with a gain that is a "
+                f"each output removed {drop}): a sensor that drifts or a slow disturbance the model does not hold. "
+                f"Model it: two inputs, a column of ones and a column of time (a ramp), each with a gain that is a "
                 f"parameter on that output, the initial state estimated (guide: records around an operating point)")
     if offset.get("kind") == "level":
         return (f"{where}output {offset['output']} sits at a level (mean {offset['mean']:.6g}, standard deviation "
