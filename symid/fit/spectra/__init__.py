@@ -5,6 +5,7 @@ method   what it solves                                                  module
 =======  ==============================================================  =============================
 scr      Algorithm 5.1 with M, V, K ⪰ 0 (full set of known sensors)      :mod:`~symid.fit.spectra.scr`
 ipopt    nonlinear least squares on (5-13)                               :mod:`~symid.fit.spectra.ipopt`
+auto     IPOPT with restarts around the typical values, then SCR         :mod:`~symid.fit.spectra.auto`
 =======  ==============================================================  =============================
 
 Spectra have no linear least-squares special case (Φyy = H Φuu Hᴴ is quadratic in H).
@@ -20,7 +21,7 @@ from symid.fit.spectra.scale import typical_scale
 
 __all__ = ["METHODS", "prepare", "typical_scale"]
 
-METHODS = ("scr", "ipopt")
+METHODS = ("scr", "ipopt", "auto")
 
 
 def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
@@ -34,6 +35,10 @@ def prepare(model: Any, data: Any, method: str, options: dict[str, Any], *,
         from symid.fit.spectra.ipopt import IpoptPSD
 
         return IpoptPSD.create(model, data, options, noise_floor=noise_floor)
+    if method == "auto":
+        from symid.fit.spectra.auto import AutoPSD
+
+        return AutoPSD.create(model, data, options, noise_floor=noise_floor)
     if method == "ls":
         raise ModelError("spectral data have no linear least-squares special case (Φyy = H Φuu Hᴴ is quadratic "
                          "in H); use method='scr' or 'ipopt'")

@@ -1,0 +1,185 @@
+"""``method="auto"`` on spectra: IPOPT on (5-13) with restarts around the typical values, then SCR when none fits.
+
+Why this order (measured on shear buildings in SI units, ``benchmarks/psd_units.py``):
+IPOPT on the output-spectrum misfit reaches the truth from most starts in a fraction of a
+second (15 of 18 exact, 18 of 18 at 2 % noise, 0.23 s a start), SCR with its ADMM back end
+from more exact starts but fewer noisy ones and at 4.6 s a start (17 and 15 of 18). A pass
+of IPOPT that does not fit is followed by others from draws log-uniform within a factor
+``spread`` of the typical values (``scale=``, else the spectra's own,
+:func:`symid.fit.spectra.scale.typical_scale`), each drawn from the start's own stream; the
+first that fits ends the start. When none does and Algorithm 5.1 applies (a full set of
+known sensors, B known), SCR runs once (the ADMM back end) and IPOPT polishes its estimate:
+the relaxation does not depend on a start, which is what the restarts lack. Every pass
+counts against ``time_limit``, and the best pass is reported with the others in
+``passes``. ``benchmarks/psd_auto.py`` measures it against the single methods.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+import warnings
+from typing import Any, ClassVar
+
+import numpy as np
+
+from symid.errors import ModelError, SymidError
+from symid.fit.options import check_bool, check_float, check_int, check_scale, check_seed, check_time_limit
+from symid.fit.result import StartOutcome
+from symid.fit.spectra.equations import SpectraEstimator, check_spectral
+
+__all__ = ["AutoPSD"]
+
+
+class AutoPSD(SpectraEstimator):
+    """IPOPT with restarts, then SCR, on spectra (module notes).
+
+    Parameters
+    ----------
+    model : SecondOrderModel
+    data : SpectralData
+    scale : array_like, optional
+        Typical magnitude of each parameter: where restarts are drawn, and IPOPT's scaling.
+        Default: the spectra's typical values.
+    bounds : dict or array_like, optional
+        As IPOPT's (held by every pass; SCR's estimate is clipped into them before its polish).
+    positivity : bool
+        θₖ ≥ 0 for parameters declared positive (default True).
+    restarts : int
+        IPOPT passes after the first, from draws around the typical values (default 8).
+    spread : float
+        Draws lie log-uniformly within this factor of the typical values (default 10).
+    scr : bool
+        Run SCR (ADMM back end) when no IPOPT pass fits and Algorithm 5.1 applies (default True).
+    seed : int
+        Seeds the draws (with the start, so every start draws its own).
+    pass_iter : int
+        IPOPT's iteration limit in each pass (default 500: a pass that has not converged
+        by then is at a stationary point away from the fit more often than near one).
+    time_limit : float, optional
+        Wall-time budget of one start, every pass included, in seconds (default 300).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> from symid.fit.spectra.auto import AutoPSD
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> spec = si.simulate_spectra(model, [1.0, 0.5, 4.0], np.linspace(0.5, 3, 8), Phi_uu=1.0)
+    >>> out = AutoPSD(model, spec).run(np.array([30.0, 0.01, 0.1]))
+    >>> bool(out.success), np.round(out.theta, 4)
+    (True, array([1. , 0.5, 4. ]))
+    """
+
+    method: ClassVar[str] = "auto"
+
+    def __init__(self, model: Any, data: Any, *, scale: Any = None, bounds: Any = None, positivity: bool = True,
+                 restarts: int = 8, spread: float = 10.0, scr: bool = True, seed: int = 0, pass_iter: int = 500,
+                 time_limit: float | None = 300.0):
+        from symid.fit.spectra.ipopt import IpoptPSD
+
+        check_spectral(model, data)
+        self.model, self.data = model, data
+        l = model.n_parameters
+        self.scale = None if scale is None else check_scale("scale", scale, l)
+        self.restarts = check_int("restarts", restarts, low=0, high=10_000)
+        self.spread = check_float("spread", spread, low=1.0)
+        self.use_scr = check_bool("scr", scr)
+        self.seed = check_seed("seed", seed)
+        self.time_limit = check_time_limit("time_limit", time_limit)
+        self.pass_iter = check_int("pass_iter", pass_iter, low=1, high=10**7)
+        self._ipopt = IpoptPSD(model, data, scale=self.scale, bounds=bounds, positivity=positivity,
+                               max_iter=self.pass_iter)
+        self.lower, self.upper = self._ipopt.lower, self._ipopt.upper
+        self.options = {"scale": None if self.scale is None else self.scale.tolist(),
+                        "bounds": self._ipopt.options["bounds"], "positivity": positivity,
+                        "restarts": self.restarts, "spread": self.spread, "scr": self.use_scr, "seed": self.seed,
+                        "pass_iter": self.pass_iter, "time_limit": self.time_limit}
+        self._typical: np.ndarray | None = self.scale
+        self._scr_estimator: Any = None
+
+    def check_start(self, x0: Any) -> None:
+        """Refuse a start outside the bounds (an :class:`OptionError` naming the parameter)."""
+        self._ipopt.check_start(x0)
+
+    def _typical_values(self, x0: np.ndarray) -> np.ndarray:
+        """Where the restarts are drawn: ``scale``, else the spectra's typical values, else |x0| (1 where 0)."""
+        if self._typical is None:
+            from symid.fit.spectra.scale import typical_scale
+
+            try:
+                self._typical = typical_scale(self.model, self.data)
+            except (SymidError, ValueError, np.linalg.LinAlgError):
+                self._typical = None
+        if self._typical is not None:
+            return np.asarray(self._typical, dtype=float)
+        return np.where(np.abs(x0) > 0, np.abs(x0), 1.0)
+
+    def _scr(self, time_limit: float | None) -> Any:
+        """SCR's estimator (ADMM back end) with this budget, or None where Algorithm 5.1 does not apply."""
+        if self._scr_estimator is False:
+            return None
+        from symid.fit.spectra.scr import ScrPSD
+
+        try:
+            return ScrPSD(self.model, self.data, backend="admm", positivity=self.options["positivity"],
+                          time_limit=time_limit)
+        except ModelError:
+            self._scr_estimator = False  # not applicable to this model: not asked again
+            return None
+
+    def run(self, x0: np.ndarray) -> StartOutcome:
+        """IPOPT from ``x0``, then from draws, then SCR and a polish, until one pass fits (module notes)."""
+        t0 = time.perf_counter()
+        x0 = np.asarray(x0, dtype=float)
+        passes: list[StartOutcome] = []
+        words: list[str] = []
+
+        def left() -> float | None:
+            return None if self.time_limit is None else self.time_limit - (time.perf_counter() - t0)
+
+        def spent() -> bool:
+            rest = left()
+            return rest is not None and rest <= 0
+
+        def ipopt_from(start: np.ndarray) -> StartOutcome:
+            start = np.clip(start, self.lower, self.upper)
+            return self._ipopt.run(start, time_limit=left())
+
+        out = ipopt_from(x0)
+        passes.append(out)
+        words.append("pass 0 from the start")
+        if not out.success and self.restarts and not spent():
+            typical = self._typical_values(x0)
+            # the start's own stream: the same start draws the same restarts whatever else runs
+            digest = np.frombuffer(np.round(x0, 12).tobytes(), dtype=np.uint32)
+            rng = np.random.default_rng([self.seed, *digest.tolist()])
+            for k in range(1, self.restarts + 1):
+                if spent():
+                    words.append("time limit")
+                    break
+                draw = typical * np.exp(rng.uniform(-np.log(self.spread), np.log(self.spread), typical.size))
+                out = ipopt_from(draw)
+                passes.append(out)
+                if out.success:
+                    words.append(f"pass {k} from a draw around the typical values")
+                    break
+        if (not any(p.success for p in passes) and self.use_scr and not spent()
+                and (scr := self._scr(None if left() is None else max(left(), 1.0))) is not None):
+            with warnings.catch_warnings():  # its own warnings (many lines for Clarabel) are not this method's
+                warnings.simplefilter("ignore")
+                relaxed = scr.run(min(passes, key=lambda p: p.cost).theta)
+            polished = ipopt_from(relaxed.theta) if np.all(np.isfinite(relaxed.theta)) else relaxed
+            passes.extend([relaxed, polished])
+            words.append("SCR (ADMM) and IPOPT from its estimate")
+        best = next((p for p in passes if p.success), None) or min(passes, key=lambda p: p.cost)
+        others = tuple(p for p in passes if p is not best)
+        message = (f"{len(passes)} pass(es); " + "; ".join(words) + f"; best: {best.status}")
+        result = self.outcome(x0, best.theta, finished=best.finished, status=best.status, message=message,
+                              iterations=sum(p.iterations for p in passes), wall_time=time.perf_counter() - t0)
+        return dataclasses.replace(result, passes=others)
+
+    def polisher(self) -> Any:
+        """IPOPT on (5-13), as the passes."""
+        return self._ipopt
