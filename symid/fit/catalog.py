@@ -30,6 +30,7 @@ def estimator_classes() -> list[tuple[str, str, type]]:
     from symid.fit.similarity.ipopt import IpoptSimilarity, IpoptSimilarityFRF
     from symid.fit.similarity.scr import ScrSimilarity
     from symid.fit.similarity.second_order import LinearSimilarity2nd, ScrSimilarity2nd
+    from symid.fit.spectra.auto import AutoPSD
     from symid.fit.spectra.ipopt import IpoptPSD
     from symid.fit.spectra.scr import ScrPSD
     from symid.fit.timeseries.auto import AutoOutputError
@@ -40,7 +41,7 @@ def estimator_classes() -> list[tuple[str, str, type]]:
     frf, spec, bb = "frequency response", "spectra", "black box / I/O"
     return [(frf, "auto", AutoFRF), (frf, "lm", LmFRF), (frf, "scr", ScrFRF), (frf, "ipopt", IpoptFRF),
             (frf, "ls", LinearFRF),
-            (spec, "scr", ScrPSD), (spec, "ipopt", IpoptPSD), ("time series", "auto", AutoOutputError),
+            (spec, "auto", AutoPSD), (spec, "scr", ScrPSD), (spec, "ipopt", IpoptPSD), ("time series", "auto", AutoOutputError),
             ("time series", "oe", OutputError),
             ("time series", "svf", StateVariableFilter), ("time series", "srivc", SimplifiedRIVC),
             (bb, "scr (state space)", ScrSimilarity), (bb, "als", AlsSimilarity), (bb, "gb", GbSimilarity),

@@ -54,8 +54,8 @@ class AutoPSD(SpectraEstimator):
     seed : int
         Seeds the draws (with the start, so every start draws its own).
     pass_iter : int
-        IPOPT's iteration limit in each pass (default 500: a pass that has not converged
-        by then is at a stationary point away from the fit more often than near one).
+        IPOPT's iteration limit in each pass (default 500; IPOPT's own default for one
+        run is 3000).
     time_limit : float, optional
         Wall-time budget of one start, every pass included, in seconds (default 300).
 
