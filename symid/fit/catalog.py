@@ -41,7 +41,8 @@ def estimator_classes() -> list[tuple[str, str, type]]:
     frf, spec, bb = "frequency response", "spectra", "black box / I/O"
     return [(frf, "auto", AutoFRF), (frf, "lm", LmFRF), (frf, "scr", ScrFRF), (frf, "ipopt", IpoptFRF),
             (frf, "ls", LinearFRF),
-            (spec, "auto", AutoPSD), (spec, "scr", ScrPSD), (spec, "ipopt", IpoptPSD), ("time series", "auto", AutoOutputError),
+            (spec, "auto", AutoPSD), (spec, "scr", ScrPSD), (spec, "ipopt", IpoptPSD),
+            ("time series", "auto", AutoOutputError),
             ("time series", "oe", OutputError),
             ("time series", "svf", StateVariableFilter), ("time series", "srivc", SimplifiedRIVC),
             (bb, "scr (state space)", ScrSimilarity), (bb, "als", AlsSimilarity), (bb, "gb", GbSimilarity),
