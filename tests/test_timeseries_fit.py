@@ -325,7 +325,7 @@ def test_a_fit_of_a_model_with_two_solutions_says_so(monkeypatch):
     io = si.simulate_io(oral, truth, u, 0.5, noise=0.05, seed=1)
     # the check's one-second budget holds here unloaded (0.15-0.4 s), but not under any load: this test is of what
     # identify does with the verdict, so the check runs to the end
-    monkeypatch.setattr(analyse, "several_solutions", functools.partial(analyse.several_solutions, timeout=None))
+    monkeypatch.setattr(analyse, "global_check", functools.partial(analyse.global_check, timeout=None))
     monkeypatch.setattr(analyse, "solutions_at", functools.partial(analyse.solutions_at, timeout=None))
     with pytest.warns(si.IdentifiabilityWarning, match="locally but not globally identifiable") as caught:
         res = si.identify(oral, io, x0={"ka": 0.3, "ke": 0.05, "q": 0.01})
@@ -356,7 +356,7 @@ def test_bounds_that_exclude_the_other_solution_make_the_estimate_unique_within_
     """The oral dose's flip-flop: ka ↔ ke with q·ka/ke. A user who knows absorption is faster than elimination
     gives bounds that exclude the swapped values; the estimate is then unique within them, and symid says so
     instead of warning (a new user's trial: NOT UNIQUE was reported whatever the bounds)."""
-    monkeypatch.setattr(analyse, "several_solutions", functools.partial(analyse.several_solutions, timeout=None))
+    monkeypatch.setattr(analyse, "global_check", functools.partial(analyse.global_check, timeout=None))
     monkeypatch.setattr(analyse, "solutions_at", functools.partial(analyse.solutions_at, timeout=None))
     ka, ke, q = si.parameters("ka ke q", positive=True)
     oral = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])

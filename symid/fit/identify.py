@@ -494,11 +494,18 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                                      "from_rest_only": getattr(model, "initial_state_kind", "zero") in ("known",
                                                                                                        "affine")}
     if identifiability_check and not not_local and result.success:
-        from symid.structural.analyse import several_solutions
+        from symid.structural.analyse import GLOBAL_CHECK_BUDGET, global_check
 
         t_check = time.perf_counter()
-        several = several_solutions(model)
+        several, decided = global_check(model)
         extra["identifiability_check_s"] = (check_s or 0.0) + time.perf_counter() - t_check
+        if not decided:  # said, not left silent: the answer must not depend on the machine's load (a new user's
+            # LC ladder came back as its mirror image, warned in 1 of 4 runs)
+            extra["global_undecided"] = (
+                f"whether other parameter values give this estimate's response was not decided within "
+                f"{GLOBAL_CHECK_BUDGET:g} s (si.identifiability(model) decides it, without a time limit: "
+                f"timeout=None): a structure with several solutions (a ladder's mirror image, a flip-flop) fits "
+                f"as well from another start")
         if several is not None:
             extra["several_solutions"] = several
             from symid.structural.analyse import solutions_at

@@ -532,6 +532,8 @@ class IdentificationResult:
         ambiguity = self.ambiguity()
         if ambiguity is not None:
             lines.append(f"NOT UNIQUE: {ambiguity}")
+        if self.options.get("global_undecided"):
+            lines.append(f"UNIQUENESS NOT CHECKED (structure): {self.options['global_undecided']}")
         if self.options.get("unique_within_bounds"):
             lines.append(f"UNIQUE WITHIN THE BOUNDS (structure): {self.options['unique_within_bounds']}")
         elif self.options.get("several_solutions"):

@@ -622,9 +622,11 @@ _X0_IGNORED = ("this analysis is of the input-output map from a zero initial sta
                "that this report calls not identifiable")
 
 
-GLOBAL_CHECK_BUDGET = 1.0
+GLOBAL_CHECK_BUDGET = 3.0
 """Seconds :func:`several_solutions` gives :func:`identifiability` (the small models where a flip-flop hides, such
-as first-order absorption and elimination, take 0.1 to 0.5 s; larger ones end undetermined, and say nothing)."""
+as first-order absorption and elimination, take 0.1 to 0.5 s; a new user's 5th-order LC ladder, whose mirror image
+fits as well, 0.9 to 1.5 s idle, and more on a busy machine, where a budget of 1 s let the mirror pass unsaid in 3
+of 4 runs). Larger ones end undetermined, and :func:`global_check` says so."""
 
 
 def several_solutions(model, *, timeout: float | None = GLOBAL_CHECK_BUDGET) -> str | None:
@@ -634,8 +636,8 @@ def several_solutions(model, *, timeout: float | None = GLOBAL_CHECK_BUDGET) -> 
     :func:`symid.identify` calls it after a fit: the estimate is then one of several that the data
     cannot tell apart, and which one depends on the start (a new user's oral-dose model, ka and
     ke interchangeable, came back with them swapped from 19 of 20 records, a success every time
-    and nothing said). Cached per model structure and ``timeout`` within the process: on a busy
-    machine a check that runs out of time says nothing, and stays silent for that structure.
+    and nothing said). Cached per model structure and ``timeout`` within the process; a check
+    that runs out of time returns ``None`` here, and :func:`global_check` says it was not decided.
     ``None`` for a model with a
     nonzero initial state: the analysis is of the input-output map from rest, and a free
     response can tell apart solutions that map cannot.
@@ -649,14 +651,31 @@ def several_solutions(model, *, timeout: float | None = GLOBAL_CHECK_BUDGET) -> 
     >>> print(several_solutions(oral, timeout=None))  # doctest: +ELLIPSIS
     the model is locally but not globally identifiable: at a random parameter point, 2 admissible ...
     """
+    return global_check(model, timeout=timeout)[0]
+
+
+def global_check(model, *, timeout: float | None = GLOBAL_CHECK_BUDGET) -> tuple[str | None, bool]:
+    """:func:`several_solutions`'s sentence (or ``None``) and whether the question was decided within ``timeout``:
+    ``(None, False)`` when the analysis did not settle whether other admissible parameter values give the model's
+    response (what :func:`symid.identify` then says, rather than nothing: the answer must not depend on the
+    machine's load). Cached per model structure and ``timeout`` within the process.
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> from symid.structural.analyse import global_check
+    >>> k, g = si.parameters("k g", positive=True)
+    >>> global_check(si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]]), timeout=None)
+    (None, True)
+    """
     if getattr(model, "initial_state_kind", "zero") in ("known", "affine"):
-        return None
+        return None, True  # nothing asked: the map from rest is not what such records determine
     try:
         key = (timeout, type(model).__name__, getattr(model, "output", None), tuple(model.parameter_names),
                tuple(model.positive), getattr(model, "initial_state_kind", "zero"),
                tuple((k, sp.srepr(v)) for k, v in sorted(model.symbolic.items())))
     except (AttributeError, TypeError):
-        return None
+        return None, False
     if key not in _SEVERAL:
         if len(_SEVERAL) >= 64:  # the oldest goes
             _SEVERAL.pop(next(iter(_SEVERAL)))
@@ -664,20 +683,20 @@ def several_solutions(model, *, timeout: float | None = GLOBAL_CHECK_BUDGET) -> 
     return _SEVERAL[key]
 
 
-_SEVERAL: dict[tuple, str | None] = {}
-""":func:`several_solutions`'s answers by model structure (a cache: the answer depends on the structure only)."""
+_SEVERAL: dict[tuple, tuple[str | None, bool]] = {}
+""":func:`global_check`'s answers by model structure (a cache: the answer depends on the structure only)."""
 
 
-def _several_solutions(model, timeout: float | None) -> str | None:
+def _several_solutions(model, timeout: float | None) -> tuple[str | None, bool]:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             rep = identifiability(model, timeout=timeout)
-    except Exception:  # a check after the fit never costs the user the fit: it says nothing instead
-        return None
+    except Exception:  # a check after the fit never costs the user the fit: it says it was not decided instead
+        return None, False
     count, bound = rep.n_solutions, rep.n_solutions_at_least
     if rep.verdict != "local" or not ((count or 0) >= 2 or (bound or 0) >= 2):
-        return None
+        return None, bool(rep.verdicts_proven)
     star = {n: float(Fraction(str(v))) for n, v in rep.theta_star.items()}
     sols = [*rep.solutions] if rep.solutions else [star, *rep.witnesses]
     differ = [n for n in rep.parameters
@@ -689,7 +708,7 @@ def _several_solutions(model, timeout: float | None) -> str | None:
                                                          else "")
             + "; the estimate is one of them, which one depends on the start, and no data of this kind tell them "
             f"apart (si.identifiability(model).{listed}): fix what is known, or compare starts (starts=, "
-            ".alternatives())")
+            ".alternatives())"), True
 
 
 def warn_if_not_identifiable(model, known: Mapping[str, float] | None = None, *, stacklevel: int = 2
