@@ -285,10 +285,11 @@ def test_units_metadata_in_a_symid_csv_file_is_refused_not_ignored(tmp_path):
 
 BAD_DECLARATIONS = {
     "missing frequency unit": (dict(columns=POLAR, units={"magnitude": "dB", "phase": "deg"}),
-                               "the unit of 'frequency' is missing (Hz, kHz, rad/s); symid never guesses", True),
+                               "the unit of 'frequency' is missing (mHz, Hz, kHz, MHz, GHz, rad/s); symid never "
+                               "guesses", True),
     "no units at all": (dict(columns=POLAR, units=None), "the unit of 'frequency' is missing", True),
     "unknown unit": (dict(columns=POLAR, units={**POLAR_UNITS, "frequency": "rpm"}),
-                     "unknown unit 'rpm'; symid reads Hz, kHz, rad/s", False),
+                     "unknown unit 'rpm'; symid reads mHz, Hz, kHz, MHz, GHz, rad/s", False),
     "column not in file": (dict(columns={**POLAR, "phase": "phase"}, units=POLAR_UNITS),
                            "no column named 'phase' (it has: freq_Hz, mag_dB, phase_deg, comment)", True),
     "unknown role": (dict(columns={**POLAR, "freq": "freq_Hz"}, units=POLAR_UNITS),
@@ -697,3 +698,26 @@ def test_a_sparse_phase_in_radians_is_not_said_to_be_degrees(tmp_path):
         warnings.simplefilter("error")
         si.FrequencyData.from_table(path, columns={"frequency": "w", "magnitude": "mag", "phase": "ph"},
                                     units={"frequency": "rad/s", "magnitude": "linear", "phase": "rad"})
+
+
+def test_megahertz_and_gigahertz_are_read(tmp_path):
+    """A network analyzer exports in MHz (a new user's 10 kHz – 100 MHz sweep): "unknown unit 'MHz'", and a column
+    named f_MHz declared Hz was read silently (f_kHz was caught). MHz and GHz are read, MHz is not mHz, and 'mhz'
+    in lower case, mega or milli, is refused."""
+    path = tmp_path / "vna.csv"
+    np.savetxt(path, np.column_stack([[0.01, 1.0, 100.0], [1.0, 0.9, 0.1], [0.0, -10.0, -170.0]]), delimiter=",",
+               header="f_MHz,mag,ph", comments="")
+    cols = {"frequency": "f_MHz", "magnitude": "mag", "phase": "ph"}
+    frf = si.FrequencyData.from_table(path, columns=cols, units={"frequency": "MHz", "magnitude": "linear",
+                                                                 "phase": "deg"})
+    np.testing.assert_allclose(frf.w, 2 * np.pi * np.array([1e4, 1e6, 1e8]), rtol=1e-15)
+    with pytest.raises(si.DataError, match=r"'f_MHz', which states MHz, but the frequency unit declared is Hz"):
+        si.FrequencyData.from_table(path, columns=cols, units={"frequency": "Hz", "magnitude": "linear",
+                                                               "phase": "deg"})
+    with pytest.raises(si.DataError, match=r"unknown unit 'mhz' \(mega or milli\? write MHz or mHz\)"):
+        si.FrequencyData.from_table(path, columns=cols, units={"frequency": "mhz", "magnitude": "linear",
+                                                               "phase": "deg"})
+    from symid.data.units import canonical_unit
+
+    assert [canonical_unit(u, "frequency", "f") for u in ("MHz", "MHZ", "mHz", "GHz", "ghz")] == \
+        ["MHz", "MHz", "mHz", "GHz", "GHz"]

@@ -8,14 +8,15 @@ frequency response is a complex number; times are in the record's ``time_unit``
 =============  ==================================================  ==========================
 role           units                                               converted to
 =============  ==================================================  ==========================
-frequency      ``Hz``, ``kHz``, ``rad/s``                          rad/s (ω = 2π f for Hz)
+frequency      ``mHz``, ``Hz``, ``kHz``, ``MHz``, ``GHz``, ``rad/s``  rad/s (ω = 2π f for Hz)
 magnitude      ``dB`` (20 log10 |H|), ``linear`` (|H| itself)       |H|
 phase          ``deg``, ``rad``                                    radians
 time, dt       ``s``, ``ms``, ``us``, ``min``, ``h``, ``d``        the record's ``time_unit``
 =============  ==================================================  ==========================
 
-Spellings are matched without regard to case (but ``Ms``, mega, is not ``ms``; all capitals,
-``MS``, are), and a few aliases are accepted
+Spellings are matched without regard to case (but ``Ms``, mega, is not ``ms``, and ``MHz``,
+mega, is not ``mHz``, milli; all capitals, ``MS`` and ``MHZ``, are read as a logger or an
+analyzer writes them: ms and MHz), and a few aliases are accepted
 (``degrees``, ``µs``, ``sec``, ``hour``, ...); anything else is a
 :class:`~symid.errors.DataError` listing the units above.
 """
@@ -33,7 +34,8 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0, "h": 3600.0, "d": 8
 """Time units and their length in seconds."""
 
 DIMENSIONS = {
-    "frequency": {"Hz": 2 * math.pi, "kHz": 2e3 * math.pi, "rad/s": 1.0},
+    "frequency": {"mHz": 2e-3 * math.pi, "Hz": 2 * math.pi, "kHz": 2e3 * math.pi, "MHz": 2e6 * math.pi,
+                  "GHz": 2e9 * math.pi, "rad/s": 1.0},
     "magnitude": {"dB": None, "linear": None},
     "phase": {"deg": math.pi / 180, "rad": 1.0},
     "time": TIME_UNITS,
@@ -41,7 +43,8 @@ DIMENSIONS = {
 """Each dimension's units with the factor to symid's unit (``None``: converted by a formula)."""
 
 _ALIASES = {
-    "hz": "Hz", "hertz": "Hz", "khz": "kHz", "rad/s": "rad/s", "rad/sec": "rad/s", "rad s^-1": "rad/s",
+    "hz": "Hz", "hertz": "Hz", "khz": "kHz", "mhz": "MHz", "ghz": "GHz", "megahertz": "MHz", "gigahertz": "GHz",
+    "millihertz": "mHz", "kilohertz": "kHz", "rad/s": "rad/s", "rad/sec": "rad/s", "rad s^-1": "rad/s",
     "db": "dB", "decibel": "dB", "linear": "linear", "lin": "linear", "abs": "linear",
     "deg": "deg", "degree": "deg", "degrees": "deg", "°": "deg", "rad": "rad", "radian": "rad", "radians": "rad",
     "s": "s", "sec": "s", "second": "s", "seconds": "s", "ms": "ms", "millisecond": "ms", "milliseconds": "ms",
@@ -58,6 +61,10 @@ def _alias(text: str) -> str | None:
     name = _ALIASES.get(key)
     if name == "ms" and text.strip()[:1] == "M" and not text.strip().isupper():
         return None
+    if key == "mhz" and text.strip() == "mhz":  # mega or milli, 1e9 apart: not read (canonical_unit says so)
+        return None
+    if name == "MHz" and text.strip()[:1] == "m":  # milli, as written (an analyzer's MHz is "M")
+        return "mHz"
     return name
 
 
@@ -72,7 +79,7 @@ def canonical_unit(text: str, dimension: str, what: str) -> str:
     >>> canonical_unit("rpm", "frequency", "units of 'frequency'")
     Traceback (most recent call last):
     ...
-    symid.errors.DataError: units of 'frequency': unknown unit 'rpm'; symid reads Hz, kHz, rad/s
+    symid.errors.DataError: units of 'frequency': unknown unit 'rpm'; symid reads mHz, Hz, kHz, MHz, GHz, rad/s
     """
     if not isinstance(text, str):
         raise DataError(f"{what}: a unit is a name such as {', '.join(DIMENSIONS[dimension])}; got {text!r}")
@@ -80,7 +87,8 @@ def canonical_unit(text: str, dimension: str, what: str) -> str:
     if name is None or name not in DIMENSIONS[dimension]:
         shown = repr(text) if len(text) <= 40 else f"{text[:40]!r}..."
         mega = (" (M is mega: milliseconds are ms)" if name is None and text.strip()[:1] == "M"
-                and _ALIASES.get(text.strip().lower()) == "ms" else "")
+                and _ALIASES.get(text.strip().lower()) == "ms" else
+                " (mega or milli? write MHz or mHz)" if text.strip() == "mhz" else "")
         raise DataError(f"{what}: unknown unit {shown}{mega}; symid reads {', '.join(DIMENSIONS[dimension])}")
     return name
 
