@@ -184,3 +184,27 @@ def test_numeric_local_check_takes_each_rows_kind(mixed):
                                 K=[[k1 + k2, -k2], [-k2, k2]], B=[[0], [b]], C=[[1, 0], [0, g]],
                                 output=["position", "acceleration"])
     assert numeric_local_check(gains).rank == 7
+
+
+def test_a_first_order_network_in_second_order_form():
+    """E x' + F x = B u written as M = E, V = F, K = 0, measured in velocity (the form the singular-mass message
+    recommends; a new user's LC ladder): the response is finite at ω = 0 (it raised "singular"), equal to the
+    first-order form's elsewhere, and the modes are those of −E⁻¹F, not "n poles at 0" as well. Reference: the
+    first-order form's response C (jωI − A)⁻¹ B + D, and the DC gain C F⁻¹ B by hand."""
+    from symid.fit.modes import modes_line
+
+    c1, c2 = si.parameters("c1 c2", positive=True)
+    F = np.array([[0.02, -0.01], [-0.01, 0.02]])
+    model = si.SecondOrderModel(M=[[c1, 0], [0, c2]], V=F.tolist(), K=[[0, 0], [0, 0]], B=[[1], [0]],
+                                C=[[0, 1], [1, 0]], output=["velocity", "acceleration"])
+    theta = [1e-3, 2e-3]
+    w = np.array([0.0, 1.0, 10.0])
+    H = model.frequency_response(theta, w)
+    np.testing.assert_allclose(H[0, 0, 0], (np.linalg.solve(F, [1.0, 0.0]))[1], rtol=1e-12)  # C F⁻¹ B
+    assert H[0, 1, 0] == 0  # an acceleration's response vanishes at ω = 0
+    ss = model.state_space(theta)
+    H_ss = np.array([ss.C @ np.linalg.solve(1j * x * np.eye(4) - ss.A, ss.B) + ss.D for x in w[1:]])
+    np.testing.assert_allclose(H[1:], H_ss, rtol=1e-9)
+    poles = np.linalg.eigvals(-np.linalg.solve(np.diag(theta), F))
+    assert modes_line(model, theta, "s") == "modes of the estimate: " + "; ".join(
+        f"real pole {p:.4g} /s" for p in sorted(poles, key=abs))

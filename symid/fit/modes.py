@@ -32,6 +32,13 @@ def modes_line(model: Any, theta: Any, time_unit: str | None) -> str:
     """
     try:
         A = np.asarray(model.state_space(theta)[0], dtype=float)
+        if hasattr(model, "output_orders") and min(model.output_orders) >= 1:
+            mats = model.matrices(theta)
+            if not np.any(mats["K"]):
+                # a first-order system E x' + F x = B u written as M = E, V = F, K = 0 and measured in velocity: its
+                # poles are those of −M⁻¹V; the positions' n integrators are no pole of the response (a new user's
+                # LC ladder read "5 poles at 0")
+                A = -np.linalg.solve(np.asarray(mats["M"], dtype=float), np.asarray(mats["V"], dtype=float))
         poles = np.linalg.eigvals(A) if A.size and np.all(np.isfinite(A)) else np.array([])
     except Exception:  # an estimate where the model cannot be evaluated: nothing to say
         return ""

@@ -280,6 +280,17 @@ class SecondOrderModel(ParametricModel):
         w = as_frequencies(w)
         mats = self.matrices(theta)
         M, V, K, B, C = (mats[k] for k in "MVKBC")
+        if not np.any(K) and min(self.output_orders) >= 1:
+            # a first-order system E x' + F x = B u written as M = E, V = F, K = 0, measured in velocity (x): H =
+            # C (jωM + V)⁻¹ B, finite at ω = 0, where −ω²M + jωV is singular (a new user's LC ladder)
+            Z1 = 1j * w[:, None, None] * M + V
+            try:
+                X = np.linalg.solve(Z1, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
+            except np.linalg.LinAlgError:
+                raise ModelError("jωM + V is singular at one of the frequencies (K = 0: a pole at ω = 0?)") from None
+            reduced = np.stack([np.ones(w.size, dtype=complex) if d == 1 else 1j * w for d in self.output_orders],
+                               axis=1)  # (jω)^(d − 1): the velocity's jω cancelled
+            return (C @ X) * reduced[:, :, None]
         Z = -(w**2)[:, None, None] * M + 1j * w[:, None, None] * V + K
         try:
             X = np.linalg.solve(Z, np.broadcast_to(B.astype(complex), (w.size, *B.shape)))
