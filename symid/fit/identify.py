@@ -563,7 +563,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             f"io): output error models the hold exactly)")})
     if isinstance(estimator, FrfEstimator) and estimator.line_weights is None \
             and np.all(np.isfinite(result.theta_vector)):
-        weak = weak_lines_missed(model, estimator.data, result.theta_vector)
+        # of a fit the success rule accepted (a failed one misses every line: a new user's start at 1.0 was told
+        # "266 weak lines missed")
+        weak = weak_lines_missed(model, estimator.data, result.theta_vector) if result.success else None
         if weak is not None:
             result = dataclasses.replace(result, options={**result.options, "weak_lines_missed": weak})
             warnings.warn(weak, DataWarning, stacklevel=2)
