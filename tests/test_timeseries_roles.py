@@ -4,6 +4,8 @@ Reference: the records are built here, a two-level PRBS through a first-order la
 the test signal is known.
 """
 
+import warnings
+
 import numpy as np
 
 import symid as si
@@ -38,3 +40,23 @@ def test_levels_alone_are_not_enough():
     assert swapped_roles(si.IOData(io.u, io.u, io.dt)) is None
     assert swapped_roles(si.IOData(io.y[:40], io.u[:40], io.dt)) is None
     assert swapped_roles(io) is None
+
+
+def test_a_reversed_sensor_in_records_is_named(grounded_two_mass):
+    """A new user's building with one accelerometer mounted the other way, fitted from its samples: "more starts".
+    The frequency-response flips are tried on the response of an N4SID black box of the record (a fit of which is
+    judged by its misfit: a black box's response is exactly of the model's order), and the flip that fits is named.
+    Reference: the record is simulated here and output 1 negated."""
+    model = grounded_two_mass(B=[[0], [1]], C=[[1, 0], [0, 1]], output="acceleration")
+    truth = {"m1": 2.0, "m2": 1.0, "c1": 5.0, "c2": 3.0, "k1": 4e3, "k2": 2e3}
+    io = si.simulate_io(model, truth, np.random.default_rng(0).standard_normal((1500, 1)), 2e-3, noise=0.01, seed=1)
+    y = io.y.copy()
+    y[:, 1] *= -1
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = si.identify(model, si.IOData(io.u, y, io.dt), x0={k: 1.3 * v for k, v in truth.items()},
+                          time_limit=5.0, identifiability_check=False)
+    assert not res.success and res.options["polarity"]["flip"] == "output 1"
+    np.testing.assert_allclose(res.options["polarity"]["theta"], model.theta_vector(truth), rtol=0.02)
+    assert "NEXT: the response of a black box of the records fits with output 1 negated" in res.summary()
+    assert "MISFIT PER OUTPUT: " in res.summary()

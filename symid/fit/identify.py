@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from symid.errors import DataWarning, IdentifiabilityWarning, OptionError
+from symid.errors import DataWarning, IdentifiabilityWarning, OptionError, SymidError
 from symid.fit.frf.misfit import FrfEstimator, relative_noise_note, weak_lines_missed
 from symid.fit.modes import modes_line
 from symid.fit.options import check_bool, scale_by_name, without_known
@@ -39,6 +39,34 @@ _SEVERAL_INTERVALS = (
 MERGED = 1e-3
 """Another solution at the estimate within this relative difference in every parameter is the estimate itself: two
 solutions meet there (:func:`identify`'s uncertainty note says so)."""
+
+
+WORSE_THAN_ZERO = 1.0
+"""An output whose relative misfit exceeds this is predicted worse than by zero."""
+
+
+def _misfit_per_output(estimator: Any, theta: np.ndarray, records: list[Any]) -> dict[str, Any] | None:
+    """``{"names": [...], "misfit": [...], "worse_than_zero": [...]}``: each output's relative misfit
+    ‖yⱼ − ŷⱼ‖² / ‖yⱼ‖² over the records at θ, by the table's column names when read from one; None when the
+    simulation fails."""
+    try:
+        with np.errstate(all="ignore"):
+            sims = estimator.simulate(theta)
+    except (SymidError, ValueError, np.linalg.LinAlgError):
+        return None
+    p = sims[0].shape[1]
+    num, den = np.zeros(p), np.zeros(p)
+    for r, s, o in zip(estimator.records, sims, estimator.observed, strict=True):
+        y = np.where(o, r.y, 0.0)
+        num += np.sum(np.where(o, (r.y - s) ** 2, 0.0), axis=0)
+        den += np.sum(y**2, axis=0)
+    if not np.all(np.isfinite(num)):
+        return None
+    misfit = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.inf)
+    columns = (getattr(records[0], "stated_units", None) or {}).get("output", ())
+    names = [str(columns[j][0]) if len(columns) == p else str(j) for j in range(p)]
+    worse = [names[j] for j in range(p) if misfit[j] > WORSE_THAN_ZERO]
+    return {"names": names, "misfit": misfit.tolist(), "worse_than_zero": worse}
 
 
 def _idle_input_parameters(model: Any, records: list[Any]) -> str | None:
@@ -471,6 +499,12 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         # user's heater column left at 0: b2 = 3.8e-12, success, said only as a near-singular direction)
         extra["not_determined"] = idle
         warnings.warn(idle, DataWarning, stacklevel=2)
+    if (not result.success and hasattr(records[0], "t") and hasattr(estimator, "simulate")
+            and model.n_outputs > 1 and np.all(np.isfinite(result.theta_vector))):
+        # which output the misfit is in (a new user's building, one accelerometer reversed: nothing said which)
+        per = _misfit_per_output(estimator, result.theta_vector, records)
+        if per is not None:
+            extra["misfit_per_output"] = per
     if not result.success and hasattr(records[0], "t"):
         # the columns read the wrong way round: no start or offset fixes that (symid.fit.timeseries.roles)
         from symid.fit.timeseries.roles import swapped_roles
@@ -551,6 +585,25 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                                  start=x0s[0] if x0 is not None else None)
         if flip is not None:
             result = dataclasses.replace(result, options={**result.options, "polarity": flip})
+    if (hasattr(data, "t") and not result.success
+            and np.all(np.isfinite(result.theta_vector)) and not result.options.get("interrupted")
+            and not result.on_bounds and not result.fit.startswith("pulled beyond")
+            and not any(result.options.get(k) for k in ("swapped_roles", "initial_offset", "not_determined"))):
+        # one record of samples, unless what its set-up says explains the failure: the same flips, tried on the
+        # response of an N4SID black box of the record (sign-agnostic, fast to fit; a new user's building with one
+        # accelerometer reversed was told "more starts")
+        from symid.fit.frf.polarity import BLACK_BOX_FLOOR, polarity_flip
+        from symid.fit.timeseries.bbstart import black_box_response
+
+        with Heartbeat("the failed fit tried on the records' black-box response with outputs negated: a reversed "
+                       "sensor?", enabled=progress is not False):
+            bb = black_box_response(model, data)
+            flip = None if bb.frf is None else polarity_flip(
+                model, bb.frf, result.theta_vector, scale=options.get("scale"), bounds=options.get("bounds"),
+                start=x0s[0] if x0 is not None else None, misfit_below=BLACK_BOX_FLOOR)
+        if flip is not None:
+            result = dataclasses.replace(result, options={**result.options, "polarity": {
+                **flip, "via": "the response of a black box of the records"}})
     made = getattr(data, "estimated_from", None) or {}
     if isinstance(estimator, FrfEstimator) and not result.success and made and made.get("hold") is None:
         # a response estimated from held records without hold=: the sampled system's, not H(jω) (two new users'

@@ -129,6 +129,32 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
             f"estimated (guide: records around an operating point)")
 
 
+ONE_OUTPUT_FITS = 0.1
+"""The other outputs' misfits below which one output predicted worse than by zero is named alone in NEXT."""
+
+
+def _one_output_off(per: Mapping[str, Any] | None) -> str | None:
+    """The NEXT line when one output is predicted worse than by zero and the others nearly fit (a sensor of reversed
+    polarity, or of the wrong unit or kind on that row), else None.
+
+    Examples
+    --------
+    >>> from symid.fit.result import _one_output_off
+    >>> _one_output_off({"names": ["a1", "a2"], "misfit": [0.004, 3.9], "worse_than_zero": ["a2"]})[:45]
+    'output a2 is predicted worse than by zero (mi'
+    """
+    if not per or len(per["worse_than_zero"]) != 1:
+        return None
+    bad = per["worse_than_zero"][0]
+    others = [m for n, m in zip(per["names"], per["misfit"], strict=True) if n != bad]
+    if not others or max(others) >= ONE_OUTPUT_FITS:
+        return None
+    worst = per["misfit"][per["names"].index(bad)]
+    return (f"output {bad} is predicted worse than by zero (misfit {worst:.3g}) while the others come within "
+            f"{max(others):.2g}: a sensor of reversed polarity on that row (negate its column and fit again), or the "
+            f"wrong unit or output kind for it (outputs are counted from 0 in the order of C's rows)")
+
+
 def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
     """What to try when an estimate does not fit, from its ``fit`` text (``None`` when there is no advice);
     ``frf=False`` for data other than a frequency response (no ``method='auto'``, no ``variance=``);
@@ -470,15 +496,21 @@ class IdentificationResult:
         if not self.success:
             if (flip := self.options.get("polarity")) is not None:
                 # before anything else: no start, bound or unit fixes a response of reversed polarity
-                lines.append(f"NEXT: the data fit with {flip['flip']} negated (misfit {flip['misfit']:.3g}, against "
-                             f"{self.cost:.3g} as they are): an input or output of reversed polarity (a sensor "
-                             f"mounted the other way, a current measured backwards)? Negate it in the data and fit "
-                             f"again (.options['polarity'] holds that fit's estimate)")
+                what = (f"{flip['via']} fits with {flip['flip']} negated (misfit {flip['misfit']:.3g}; the records "
+                        f"as they are, {self.cost:.3g})" if flip.get("via") else
+                        f"the data fit with {flip['flip']} negated (misfit {flip['misfit']:.3g}, against "
+                        f"{self.cost:.3g} as they are)")
+                lines.append(f"NEXT: {what}: an input or output of reversed polarity (a sensor mounted the other "
+                             f"way, a current measured backwards)? Negate it in the data and fit again "
+                             f"(.options['polarity'] holds that fit's estimate; outputs and inputs are counted "
+                             f"from 0)")
             elif (sampled := self.options.get("sampled_response")) is not None:
                 lines.append(f"NEXT: {sampled}")
             elif (roles := self.options.get("swapped_roles")) is not None:
                 # before an offset or a bound, which swapped columns also produce (a new user's two tanks)
                 lines.append(f"NEXT: {roles}")
+            elif (row := _one_output_off(self.options.get("misfit_per_output"))) is not None:
+                lines.append(f"NEXT: {row}")
             elif self.polished is not None and self.polished.success:
                 lines.append("NEXT: the polished estimate fits the data: use .polished (below)")
             elif self.on_bounds:  # before the signs of an offset, which then follow: a new user's concentrations
@@ -519,6 +551,11 @@ class IdentificationResult:
                          f"own level, the maximum-likelihood fit for such noise")
         if (far := self.options.get("far_from_start")) is not None:
             lines.append(f"NOTE: {far['text']}")
+        if (per := self.options.get("misfit_per_output")) is not None and not self.success:
+            lines.append("MISFIT PER OUTPUT: " + ", ".join(f"{n} {m:.3g}" for n, m in zip(per["names"],
+                                                                                       per["misfit"], strict=True))
+                         + (" (predicted worse than by zero: " + ", ".join(per["worse_than_zero"]) + ")"
+                            if per["worse_than_zero"] else ""))
         if self.options.get("not_determined"):
             lines.append(f"NOT DETERMINED BY THESE DATA: {self.options['not_determined']}")
         if (bad := self.options.get("not_identifiable")) is not None:
