@@ -230,3 +230,16 @@ def test_auto_restarts_where_ipopt_alone_stops_short(grounded_two_mass):
     assert not first.success and np.max(np.abs(first.theta / model.theta_vector(truth) - 1)) > 1
     assert res.success and "from a draw around the typical values" in res.starts[0].message
     np.testing.assert_allclose(res.theta_vector, model.theta_vector(truth), rtol=1e-6)
+
+
+def test_auto_keeps_to_its_budget_and_ends(grounded_two_mass):
+    """A start whose first IPOPT pass fails, with no restarts and a budget SCR overruns: the polish after SCR still
+    runs (it crashed on a negative time limit in the benchmark) and the start ends with an outcome."""
+    from symid.fit.spectra.auto import AutoPSD
+
+    model = grounded_two_mass(B=[[0], [1]], C=[[1, 0], [0, 1]], output="acceleration")
+    truth = {"m1": 2.0, "m2": 1.0, "c1": 5.0, "c2": 3.0, "k1": 4e3, "k2": 2e3}
+    spec = si.simulate_spectra(model, truth, np.logspace(0, 2.5, 40), 1.0)
+    est = AutoPSD(model, spec, restarts=0, time_limit=0.5)
+    out = est.run(model.theta_vector({k: 0.01 * v for k, v in truth.items()}))
+    assert np.isfinite(out.cost) and "SCR (ADMM) and IPOPT from its estimate" in out.message

@@ -145,7 +145,8 @@ class AutoPSD(SpectraEstimator):
 
         def ipopt_from(start: np.ndarray) -> StartOutcome:
             start = np.clip(start, self.lower, self.upper)
-            return self._ipopt.run(start, time_limit=left())
+            rest = left()  # a pass begun with the budget nearly spent (a polish after SCR) still gets a second
+            return self._ipopt.run(start, time_limit=None if rest is None else max(rest, 1.0))
 
         out = ipopt_from(x0)
         passes.append(out)
