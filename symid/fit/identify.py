@@ -500,7 +500,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         extra["not_determined"] = idle
         warnings.warn(idle, DataWarning, stacklevel=2)
     if (not result.success and hasattr(records[0], "t") and hasattr(estimator, "simulate")
-            and model.n_outputs > 1 and np.all(np.isfinite(result.theta_vector))):
+            and hasattr(estimator, "observed") and model.n_outputs > 1 and np.all(np.isfinite(result.theta_vector))):
         # which output the misfit is in (a new user's building, one accelerometer reversed: nothing said which)
         per = _misfit_per_output(estimator, result.theta_vector, records)
         if per is not None:
@@ -585,7 +585,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                                  start=x0s[0] if x0 is not None else None)
         if flip is not None:
             result = dataclasses.replace(result, options={**result.options, "polarity": flip})
-    if (hasattr(data, "t") and not result.success
+    if (hasattr(data, "t") and not result.success and np.all(np.asarray(model.positive, dtype=bool))
             and np.all(np.isfinite(result.theta_vector)) and not result.options.get("interrupted")
             and not result.on_bounds and not result.fit.startswith("pulled beyond")
             and not any(result.options.get(k) for k in ("swapped_roles", "initial_offset", "not_determined"))):
