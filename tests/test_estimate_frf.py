@@ -354,8 +354,8 @@ def test_hold_zoh_removes_the_holds_response_from_a_held_input():
         warnings.simplefilter("ignore")
         failed = si.identify(model, plain, method="lm", x0=truth, identifiability_check=False)
     assert not failed.success
-    assert "NEXT: this response was estimated from sampled records (si.estimate_frf, dt = 0.05 s) without hold=" \
-        in failed.summary()
+    assert "NEXT (also): this response was estimated from sampled records (si.estimate_frf, dt = 0.05 s) without " \
+        "hold=" in failed.summary()
     assert "sampled_response" not in res.options  # the fit of the corrected response
 
 

@@ -607,7 +607,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     made = getattr(data, "estimated_from", None) or {}
     if isinstance(estimator, FrfEstimator) and not result.success and made and made.get("hold") is None:
         # a response estimated from held records without hold=: the sampled system's, not H(jω) (two new users'
-        # acceleration records, told "units, local minimum")
+        # acceleration records, told "units, local minimum"); said beside the other advice (summary)
         result = dataclasses.replace(result, options={**result.options, "sampled_response": (
             f"this response was estimated from sampled records (si.estimate_frf, dt = {made['dt']:.4g} s) without "
             f"hold=: if the input was held between samples (a DAC, a controller, si.simulate_io), it is the sampled "

@@ -504,8 +504,6 @@ class IdentificationResult:
                              f"way, a current measured backwards)? Negate it in the data and fit again "
                              f"(.options['polarity'] holds that fit's estimate; outputs and inputs are counted "
                              f"from 0)")
-            elif (sampled := self.options.get("sampled_response")) is not None:
-                lines.append(f"NEXT: {sampled}")
             elif (roles := self.options.get("swapped_roles")) is not None:
                 # before an offset or a bound, which swapped columns also produce (a new user's two tanks)
                 lines.append(f"NEXT: {roles}")
@@ -532,6 +530,10 @@ class IdentificationResult:
             elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
                                       time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
+        if not self.success and (sampled := self.options.get("sampled_response")) is not None:
+            # beside the other advice, not instead of it: a new user's steering in degrees, from a sampled (not held)
+            # input, was told only of the hold
+            lines.append(f"NEXT (also): {sampled}")
         if self.success and self.on_bounds:
             sides = ", ".join(f"{n} ({side})" for n, side in self.on_bounds.items())
             unc = self.uncertainty
