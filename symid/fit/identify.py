@@ -284,7 +284,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         reliable method on the generated population of ``benchmarks/population.py``) and
         for input/output records (:mod:`symid.fit.timeseries.auto`: output error on the
         samples, restarted, with a start from an N4SID black box; measured on
-        ``benchmarks/timeseries_population.py``), ``"scr"`` for spectra and black boxes.
+        ``benchmarks/timeseries_population.py``) and for spectra (:mod:`symid.fit.spectra.auto`:
+        IPOPT restarted around the typical values, then SCR; ``benchmarks/psd_auto.py``), ``"scr"``
+        for black boxes.
         Others: ``"scr"`` (sequential convex relaxation), ``"ipopt"`` (nonlinear least
         squares with CasADi/IPOPT), ``"ls"`` (a linear special case, where it applies),
         ``"lm"`` (one least-squares run, frequency response), for black-box data and

@@ -31,8 +31,9 @@ class DataKind:
         The :mod:`symid.fit` package.
     default_method : str
         What :func:`symid.identify` runs when no method is named: ``"auto"`` for a
-        frequency response (measured on ``benchmarks/population.py``) and for time
-        series (``benchmarks/timeseries_population.py``), ``"scr"`` for the others.
+        frequency response (measured on ``benchmarks/population.py``), for time
+        series (``benchmarks/timeseries_population.py``) and for spectra
+        (``benchmarks/psd_auto.py``), ``"scr"`` for black boxes.
     """
 
     name: str
@@ -58,7 +59,7 @@ class DataKind:
 
 _KINDS = (
     DataKind("frequency response", ("FrequencyData",), "symid.fit.frf", default_method="auto"),
-    DataKind("spectra", ("SpectralData",), "symid.fit.spectra"),
+    DataKind("spectra", ("SpectralData",), "symid.fit.spectra", default_method="auto"),
     DataKind("time series", ("IOData", "TimeSeries"), "symid.fit.timeseries", default_method="auto"),
     DataKind("black box", ("BlackBox",), "symid.fit.similarity"),
 )

@@ -11,7 +11,12 @@ first that fits ends the start. When none does and Algorithm 5.1 applies (a full
 known sensors, B known), SCR runs once (the ADMM back end) and IPOPT polishes its estimate:
 the relaxation does not depend on a start, which is what the restarts lack. Every pass
 counts against ``time_limit``, and the best pass is reported with the others in
-``passes``. ``benchmarks/psd_auto.py`` measures it against the single methods.
+``passes``. It is the default on spectra: on the buildings of ``benchmarks/psd_auto.py``
+(2 to 4 storeys in SI units, measured in position, in acceleration and in both; 18 problems,
+three starts each, exact and 2 % noise; 30 s a start) it met the success rule from 54 of 54
+exact and 53 of 54 noisy starts (the miss: its 30 s spent), IPOPT alone from 39 and 42, SCR
+(ADMM) from 51 and 21; median 0.36 s a start (IPOPT 0.28, SCR 4.4), time to solution 2.2 s
+(IPOPT 1.7, SCR 15).
 """
 
 from __future__ import annotations
