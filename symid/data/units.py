@@ -5,14 +5,14 @@ frequency response is a complex number; times are in the record's ``time_unit``
 (seconds unless chosen otherwise). A table may hold any of the units below; the reader
 (:mod:`symid.data.table`) converts them once, where the data come in.
 
-=============  ==================================================  ==========================
-role           units                                               converted to
-=============  ==================================================  ==========================
-frequency      ``mHz``, ``Hz``, ``kHz``, ``MHz``, ``GHz``, ``rad/s``  rad/s (ω = 2π f for Hz)
-magnitude      ``dB`` (20 log10 |H|), ``linear`` (|H| itself)       |H|
-phase          ``deg``, ``rad``                                    radians
-time, dt       ``s``, ``ms``, ``us``, ``min``, ``h``, ``d``        the record's ``time_unit``
-=============  ==================================================  ==========================
+=============  ========================================================  ==========================
+role           units                                                     converted to
+=============  ========================================================  ==========================
+frequency      ``mHz``, ``Hz``, ``kHz``, ``MHz``, ``GHz``, ``rad/s``     rad/s (ω = 2π f for Hz)
+magnitude      ``dB`` (20 log10 |H|), ``linear`` (|H| itself)             |H|
+phase          ``deg``, ``rad``                                          radians
+time, dt       ``s``, ``ms``, ``us``, ``min``, ``h``, ``d``              the record's ``time_unit``
+=============  ========================================================  ==========================
 
 Spellings are matched without regard to case (but ``Ms``, mega, is not ``ms``, and ``MHz``,
 mega, is not ``mHz``, milli; all capitals, ``MS`` and ``MHZ``, are read as a logger or an
