@@ -109,7 +109,7 @@ def polarity_flip(model: Any, data: FrequencyData, theta: np.ndarray, *, scale: 
         try:
             first = typical_scale(model, data) if scale is None else np.broadcast_to(
                 np.asarray(scale, dtype=float), (model.n_parameters,))
-        except (SymidError, ValueError, np.linalg.LinAlgError):
+        except (SymidError, ValueError, TypeError, np.linalg.LinAlgError):
             first = None
     points = [np.asarray(theta, dtype=float)] if first is None else [np.asarray(first, dtype=float),
                                                                    np.asarray(theta, dtype=float)]
