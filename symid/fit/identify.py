@@ -335,8 +335,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         Before estimating, run the cheap local identifiability test and emit an
         :class:`~symid.IdentifiabilityWarning` naming the parameters that no data of
         this kind can determine (default True); after an estimate that fits, the global
-        test within about a second (:func:`symid.structural.analyse.several_solutions`,
-        cached per model structure): where other parameter values give the same response
+        test within 3 s (:func:`symid.structural.analyse.global_check`, cached per model
+        structure; one that does not decide is said in ``summary()``, ``options["global_undecided"]``):
+        where other parameter values give the same response
         (a flip-flop of two rate constants), a warning says so, and ``summary()`` too,
         with the other values at the estimate (``options["solutions_at_estimate"]``).
         Where every one of them lies outside the fit's ``bounds``, the estimate is unique
