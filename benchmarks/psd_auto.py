@@ -19,11 +19,11 @@ from __future__ import annotations
 
 import argparse
 import time
-import warnings
 
 import numpy as np
 from _study import RESULTS, git_commit  # benchmarks/ (the script's folder) is on the path
 from psd_units import building
+from psd_units import fit as fit_variant
 
 import symid as si
 from symid.runlog import write_json_atomic
@@ -44,11 +44,7 @@ def measured(model: si.SecondOrderModel, sensors: str) -> si.SecondOrderModel:
 
 def fit(model: si.SecondOrderModel, spec: si.SpectralData, method: str, x0: list[float] | None, starts: int,
         time_limit: float) -> si.IdentificationResult:
-    name, opts = METHODS[method]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return si.identify(model, spec, method=name, x0=x0, starts=starts, seed=0, identifiability_check=False,
-                           time_limit=time_limit, **opts)
+    return fit_variant(model, spec, method, x0, starts, variants=METHODS, time_limit=time_limit)
 
 
 def main(argv: list[str] | None = None) -> int:

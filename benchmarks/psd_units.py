@@ -67,12 +67,14 @@ def building(n: int, draw: int) -> tuple[si.SecondOrderModel, np.ndarray, np.nda
 
 
 def fit(model: si.SecondOrderModel, spec: si.SpectralData, variant: str, x0: list[float] | None,
-        starts: int) -> si.IdentificationResult:
-    method, opts = VARIANTS[variant]
+        starts: int, *, variants: dict | None = None, time_limit: float = TIME_LIMIT) -> si.IdentificationResult:
+    """``si.identify`` with the variant's method and options (``variants``: this study's, or another's table),
+    seed 0, no identifiability check, warnings silenced."""
+    method, opts = (VARIANTS if variants is None else variants)[variant]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return si.identify(model, spec, method=method, x0=x0, starts=starts, seed=0, identifiability_check=False,
-                           time_limit=TIME_LIMIT, **opts)
+                           time_limit=time_limit, **opts)
 
 
 def main(argv: list[str] | None = None) -> int:
