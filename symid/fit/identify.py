@@ -69,6 +69,22 @@ def _misfit_per_output(estimator: Any, theta: np.ndarray, records: list[Any]) ->
     return {"names": names, "misfit": misfit.tolist(), "worse_than_zero": worse}
 
 
+def _offset_explains_most(offset: dict[str, Any] | None) -> bool:
+    """Whether an initial state, offsets or a drift (``OutputError.initial_offset``) take at least half the misfit
+    away: then they, not a sensor's sign, are what a failed fit's NEXT names.
+
+    Examples
+    --------
+    >>> _offset_explains_most({"kind": "initial_state", "misfit": 0.628, "after": 0.564})  # a 3-mass chain's 10 %
+    False
+    >>> _offset_explains_most({"kind": "offset", "misfit": 4.8e-4, "after": 1e-5}), _offset_explains_most(None)
+    (True, False)
+    """
+    if not offset or offset.get("after") is None or not offset.get("misfit"):
+        return bool(offset)  # a level or a first sample, with no share measured: taken as the explanation
+    return float(offset["after"]) <= 0.5 * float(offset["misfit"])
+
+
 def _idle_input_parameters(model: Any, records: list[Any]) -> str | None:
     """'b2 multiplies input 'heater_kW' alone, which is zero in every record: …' for the parameters found only in
     the columns of B (and D) of inputs that are zero throughout the records, or None."""
@@ -591,10 +607,12 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
     if (hasattr(data, "t") and not result.success and np.all(np.asarray(model.positive, dtype=bool))
             and np.all(np.isfinite(result.theta_vector)) and not result.options.get("interrupted")
             and not result.on_bounds and not result.fit.startswith("pulled beyond")
-            and not any(result.options.get(k) for k in ("swapped_roles", "initial_offset", "not_determined"))):
+            and not any(result.options.get(k) for k in ("swapped_roles", "not_determined"))
+            and not _offset_explains_most(result.options.get("initial_offset"))):
         # one record of samples, unless what its set-up says explains the failure: the same flips, tried on the
         # response of an N4SID black box of the record (sign-agnostic, fast to fit; a new user's building with one
-        # accelerometer reversed was told "more starts")
+        # accelerometer reversed was told "more starts"; on a 3-mass chain with a position sensor reversed, an
+        # initial state explaining 10 % of the misfit had kept the try from running)
         from symid.fit.frf.polarity import BLACK_BOX_FLOOR, polarity_flip
         from symid.fit.timeseries.bbstart import black_box_response
 
