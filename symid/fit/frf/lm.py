@@ -98,10 +98,12 @@ in physical units, whatever their scale (measured on the generated population of
    positive parameters saturated (their column of the log-scaled Jacobian below
    :data:`SATURATED` of the largest: a spring and a damper so stiff the axle is rigid,
    or so soft it is free), or has parameters run to the solver's limit (1e6 times their
-   start), no local step brings them back, and the black box's poles may start there
-   too. One pass each starts from the estimate with those parameters multiplied by
-   0.1, 10, 0.01, 100, 0.001 and 1000 (:data:`JUMPS`; a parameter at the limit from its
-   own start times the factor), the others kept; the best is kept. On the same half car
+   start), or more than :data:`FAR` times above or below their typical values
+   (``scale=``, else the start's magnitudes), no local step brings them back, and the
+   black box's poles may start there too. One pass each starts from the estimate with
+   those parameters multiplied by 0.1, 10, 0.01, 100, 0.001 and 1000 (:data:`JUMPS`; a
+   parameter at the limit from its own start times the factor, one far from its typical
+   value from that value times the factor), the others kept; the best is kept. On the same half car
    the black box's start had the rear spring 8 times its size, already rigid, and its
    passes ended at 1.031e-4 too (or not, by rounding: the derivatives computed in
    another order, 1e-14 apart, decided it); from the starts 10, 30, 100, 1000 and 0.001
@@ -178,6 +180,9 @@ _PRIOR = 0.1  # weight of φ − φ_pass-start in the band stages: what a partia
 SATURATED = 1e-3
 """A positive parameter whose log-scaled Jacobian column is below this fraction of the largest is one the response
 does not feel at the estimate (choice 9)."""
+
+FAR = 100.0
+"""A positive parameter more than this factor from its typical value at a noisy fit is moved too (choice 9)."""
 
 JUMPS = (0.1, 10.0, 0.01, 100.0, 0.001, 1000.0)
 """The factors the saturated parameters are multiplied by, one pass each (choice 9)."""
@@ -717,15 +722,21 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         if deadline is not None and time.perf_counter() >= deadline:
             return None
         edge = self._edge(best.theta, centre, unit)  # run to 1e6 × their start
-        which = edge | (self._saturated(best.theta) if self._near_singular(best.theta) else False)
+        far = self._far(best.theta, unit) & ~edge
+        unfelt = np.zeros_like(edge)
+        if self._near_singular(best.theta):
+            unfelt = self._saturated(best.theta) & ~edge & ~far
+        which = edge | far | unfelt
         if not which.any():
             return None
         tried, used = [], 0
         for factor in JUMPS:
             if deadline is not None and time.perf_counter() >= deadline:
                 break
-            # a saturated parameter moves from where it is; one run to the edge starts again from its own start
-            moved = np.where(edge, centre * factor, np.where(which, best.theta * factor, best.theta))
+            # an unfelt parameter moves from where it is; one run to the edge starts again from its own start, one
+            # far from the typical values from them
+            moved = np.where(edge, centre * factor,
+                             np.where(far, unit * factor, np.where(unfelt, best.theta * factor, best.theta)))
             if self._bounded:
                 moved = clip_into(moved, self.lower, self.upper)
             theta, count, spent = self._pass(self._phi(moved, centre, unit), centre, unit, deadline)
@@ -734,9 +745,21 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                                       iterations=nfev + used, wall_time=time.perf_counter() - t0))
         if not tried:
             return None
-        names = ", ".join(n for n, w in zip(self.model.parameter_names, which, strict=True) if w)
-        return (f"; {names} unfelt by the response or run 1e6 times from the start: {len(tried)} pass(es) with "
-                f"them × 0.1 … 1000 ended at best misfit ", tried, used)
+        groups = []
+        for mask, what in ((unfelt, "unfelt by the response"), (edge, "run 1e6 times from the start"),
+                           (far, f"more than {FAR:g} times from the typical values")):
+            names = ", ".join(n for n, w in zip(self.model.parameter_names, mask, strict=True) if w)
+            if names:
+                groups.append(f"{names} {what}")
+        return (f"; {'; '.join(groups)}: {len(tried)} pass(es) with them × 0.1 … 1000 ended at best misfit ",
+                tried, used)
+
+    def _far(self, theta: np.ndarray, unit: np.ndarray) -> np.ndarray:
+        """The positive parameters more than :data:`FAR` times above or below their typical values (``scale=``, else
+        the start's magnitudes): choice 9."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.abs(np.log(np.abs(theta) / unit))
+        return self._positive & ~(ratio <= math.log(FAR))
 
     def _black_box_theta(self) -> np.ndarray | None:
         """The black-box start of :func:`~symid.fit.frf.modal.black_box_start` (read once), or None."""
