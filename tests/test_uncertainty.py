@@ -16,6 +16,7 @@ import pytest
 
 import symid as si
 from symid.errors import DataError, OptionError
+from symid.fit.identify import FAILED_FIT_NOTE
 from symid.fit.sensitivity import frf_sensitivity, spectra_sensitivity
 
 W20 = np.linspace(0.5, 2.5, 20)
@@ -290,6 +291,20 @@ def test_a_failed_fit_shows_no_intervals():
     assert "uncertainty: not shown, the estimate does not fit the data" in text
     assert "std. error" not in text
     assert res.uncertainty is not None
+    # and none for a script to read either (a new user's shake-table record read 8 intervals, none holding the truth)
+    assert np.all(np.isnan(res.uncertainty.intervals))
+
+
+def test_a_failed_fit_at_the_least_squares_estimate_has_nan_intervals_and_says_why():
+    """The least-squares estimate of 1 % noisy data judged against a noise floor 1e4 times too small: a failed fit
+    whose intervals would otherwise be finite (shift 0). They are NaN, the note says why, the standard errors stay."""
+    model = one_dof()
+    frf = si.simulate_frf(model, T1, W20, noise=0.01, seed=3)
+    res = si.identify(model, frf, method="ipopt", noise_floor=1e-8, identifiability_check=False)
+    assert not res.success and res.uncertainty.shift < 1e-3  # at the minimum: only the failed fit withholds them
+    assert np.all(np.isnan(res.uncertainty.intervals))
+    assert np.all(np.isfinite(res.uncertainty.standard_errors))  # the Fisher information at the estimate is kept
+    assert res.uncertainty.note.endswith(FAILED_FIT_NOTE)
 
 
 def test_intervals_are_withheld_wherever_the_estimate_is_not_the_least_squares_one():

@@ -580,8 +580,8 @@ class IdentificationResult:
         unc = self.uncertainty
         if unc is not None and not self.success:
             # intervals describe an estimate that fits the data; around one that does not they mean nothing
-            lines.append("uncertainty: not shown, the estimate does not fit the data (.uncertainty still holds "
-                         "the Fisher information at it)")
+            lines.append("uncertainty: not shown, the estimate does not fit the data (.uncertainty holds the "
+                         "Fisher information at it, its intervals NaN)")
             unc = None
         if unc is not None:
             lines.append(unc.summary())
