@@ -98,8 +98,8 @@ in physical units, whatever their scale (measured on the generated population of
    positive parameters saturated (their column of the log-scaled Jacobian below
    :data:`SATURATED` of the largest: a spring and a damper so stiff the axle is rigid,
    or so soft it is free), or has parameters run to the solver's limit (1e6 times their
-   start), or more than :data:`FAR` times above or below their typical values
-   (``scale=``, else the start's magnitudes), no local step brings them back, and the
+   start), or more than :data:`FAR` times above or below the typical values given as
+   ``scale=``, no local step brings them back, and the
    black box's poles may start there too. One pass each starts from the estimate with
    those parameters multiplied by 0.1, 10, 0.01, 100, 0.001 and 1000 (:data:`JUMPS`; a
    parameter at the limit from its own start times the factor, one far from its typical
@@ -755,8 +755,10 @@ class LmFRF(NoiseWeighted, FrfEstimator):
                 tried, used)
 
     def _far(self, theta: np.ndarray, unit: np.ndarray) -> np.ndarray:
-        """The positive parameters more than :data:`FAR` times above or below their typical values (``scale=``, else
-        the start's magnitudes): choice 9."""
+        """The positive parameters more than :data:`FAR` times above or below their typical values (``scale=``; none
+        without it: a fit far from a start that was only a guess is no sign of a limit): choice 9."""
+        if self.scale is None:
+            return np.zeros(theta.size, dtype=bool)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.abs(np.log(np.abs(theta) / unit))
         return self._positive & ~(ratio <= math.log(FAR))
