@@ -655,3 +655,32 @@ def test_a_parameter_of_an_input_held_at_zero_is_not_determined(tmp_path):
         warnings.simplefilter("ignore")
         other = si.identify(model, driven, x0={"k": 0.2, "b1": 0.1, "b2": 0.1}, identifiability_check=False)
     assert "not_determined" not in other.options
+
+
+def test_a_failed_fit_with_the_default_hold_is_tried_band_limited_and_says_so(monkeypatch):
+    """The sampled sines fitted with the default hold (the user gave none): a misfit 37 times the noise's, success
+    False. The fit is tried once more with hold="bandlimited" from its estimate (symid.fit.timeseries.holdprobe),
+    which fits, and NEXT says so first (a new user's shake-table record: 161 s, failed, the hold named mid-paragraph).
+    With a hold the user gave, nothing is tried."""
+    model, truth, io = _sampled_sines_record()
+    res = si.identify(model, io, method="oe", x0=truth, initial_state="estimate", identifiability_check=False)
+    assert not res.success
+    probe = res.options["hold_probe"]
+    assert probe["hold"] == "bandlimited" and probe["misfit"] < 1.5 * 0.02**2 < res.cost
+    np.testing.assert_allclose(model.theta_vector(probe["theta"]), truth, rtol=2e-3)  # the band-limited fit's 0.1 %
+    text = res.summary()
+    assert "NEXT: the records fit with the input band-limited between samples" in text
+    assert "hold='bandlimited'" in text.split("NEXT:")[1]
+    import types
+
+    import symid.fit.timeseries.bbstart as bbstart
+    import symid.fit.timeseries.holdprobe as holdprobe
+
+    def never(*args, **kwargs):
+        raise AssertionError("the hold the user gave is tried again")
+
+    monkeypatch.setattr(holdprobe, "hold_probe", never)
+    monkeypatch.setattr(bbstart, "black_box_response", lambda *a, **k: types.SimpleNamespace(frf=None))  # (8 s)
+    given = si.identify(model, io, method="oe", x0=truth, initial_state="estimate", hold="zoh",
+                        identifiability_check=False)
+    assert not given.success and "hold_probe" not in given.options

@@ -125,8 +125,10 @@ class FrequencyData(DataContainer):
     _npz_keys: ClassVar[tuple[str, ...]] = ("w", "H")
     estimated_from: ClassVar[dict[str, Any]] = {}
     """How :func:`symid.estimate_frf` made this response from sampled records, ``{"dt": sample time, "hold": the
-    option}``; ``{}`` for a response from anywhere else. Set on the object made (not kept by a copy or a file):
-    :func:`symid.identify` names the hold when a fit of a response estimated without one fails."""
+    option}`` and, for a Welch estimate, ``"nperseg"``, ``"window"``, ``"resolution"`` (the line spacing, rad/s) and
+    ``"samples"`` (the shortest record); ``{}`` for a response from anywhere else. Set on the object made (not kept
+    by a copy or a file): :func:`symid.identify` names the hold when a fit of a response estimated without one
+    fails, and the window's bias when it moves the estimate (:mod:`symid.fit.frf.leakage`)."""
 
     def __init__(self, w: Any, H: Any, variance: Any = None, variance_dof: Any = None):
         w_ = checks.frequencies(w, "w")

@@ -12,7 +12,32 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["modes_line"]
+__all__ = ["estimate_poles", "modes_line"]
+
+
+def estimate_poles(model: Any, theta: Any) -> np.ndarray | None:
+    """The poles of the model at θ (the eigenvalues of its first-order form), or None where it cannot be evaluated.
+
+    A first-order system E x' + F x = B u written as M = E, V = F, K = 0 and measured in velocity has the poles of
+    −M⁻¹V: the positions' n integrators are no pole of its response (a new user's LC ladder read "5 poles at 0").
+
+    Examples
+    --------
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> sorted(estimate_poles(model, [1.0, 0.2, 100.0]).round(6).tolist(), key=lambda p: p.imag)
+    [(-0.1-9.9995j), (-0.1+9.9995j)]
+    """
+    try:
+        A = np.asarray(model.state_space(theta)[0], dtype=float)
+        if hasattr(model, "output_orders") and min(model.output_orders) >= 1:
+            mats = model.matrices(theta)
+            if not np.any(mats["K"]):
+                A = -np.linalg.solve(np.asarray(mats["M"], dtype=float), np.asarray(mats["V"], dtype=float))
+        return np.linalg.eigvals(A) if A.size and np.all(np.isfinite(A)) else np.array([])
+    except Exception:  # an estimate where the model cannot be evaluated
+        return None
 
 
 def modes_line(model: Any, theta: Any, time_unit: str | None) -> str:
@@ -30,17 +55,8 @@ def modes_line(model: Any, theta: Any, time_unit: str | None) -> str:
     >>> modes_line(model, [1.0, 0.2, 100.0], "s")
     'modes of the estimate: 1.592 Hz, 10 rad/s, ζ 0.01'
     """
-    try:
-        A = np.asarray(model.state_space(theta)[0], dtype=float)
-        if hasattr(model, "output_orders") and min(model.output_orders) >= 1:
-            mats = model.matrices(theta)
-            if not np.any(mats["K"]):
-                # a first-order system E x' + F x = B u written as M = E, V = F, K = 0 and measured in velocity: its
-                # poles are those of −M⁻¹V; the positions' n integrators are no pole of the response (a new user's
-                # LC ladder read "5 poles at 0")
-                A = -np.linalg.solve(np.asarray(mats["M"], dtype=float), np.asarray(mats["V"], dtype=float))
-        poles = np.linalg.eigvals(A) if A.size and np.all(np.isfinite(A)) else np.array([])
-    except Exception:  # an estimate where the model cannot be evaluated: nothing to say
+    poles = estimate_poles(model, theta)
+    if poles is None:  # an estimate where the model cannot be evaluated: nothing to say
         return ""
     unit = time_unit or "s"
     items = []

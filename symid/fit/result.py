@@ -494,7 +494,14 @@ class IdentificationResult:
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
         if not self.success:
-            if (flip := self.options.get("polarity")) is not None:
+            if (probe := self.options.get("hold_probe")) is not None:
+                # before anything else: no start or unit fixes an input taken as held that was measured
+                lines.append(f"NEXT: the records fit with the input band-limited between samples (misfit "
+                             f"{probe['misfit']:.3g}, against {self.cost:.3g} with it held): an input that was "
+                             f"measured (sampled from a continuous signal: a shake table, a road profile, a sensor) "
+                             f"rather than held by a DAC or a controller? Fit with hold='bandlimited' (--option "
+                             f"hold=bandlimited); .options['hold_probe'] holds that fit's estimate")
+            elif (flip := self.options.get("polarity")) is not None:
                 # before anything else: no start, bound or unit fixes a response of reversed polarity
                 what = (f"{flip['via']} fits with {flip['flip']} negated (misfit {flip['misfit']:.3g}; the records "
                         f"as they are, {self.cost:.3g})" if flip.get("via") else
@@ -530,6 +537,8 @@ class IdentificationResult:
             elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
                                       time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
+        if (leak := self.options.get("leakage")) is not None:  # of a fit or not: the data's own bias
+            lines.append(f"{'LEAKAGE' if self.success else 'NEXT (also)'}: {leak['text']}")
         if not self.success and (sampled := self.options.get("sampled_response")) is not None:
             # beside the other advice, not instead of it: a new user's steering in degrees, from a sampled (not held)
             # input, was told only of the hold

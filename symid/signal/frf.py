@@ -99,6 +99,8 @@ class _Estimate:
     input_separation: float = 1.0
     """Median over the lines of the smallest eigenvalue of the inputs' normalised spectral matrix (:func:`_separation`):
     1 for uncorrelated inputs, 0 for inputs that are one signal at every line."""
+    nperseg: int | None = None
+    """Welch: samples per segment (None for the periodic estimate, which has no window)."""
 
 
 COLLINEAR_INPUTS = 1e-2
@@ -310,7 +312,8 @@ def _welch(recs: list[IOData], estimator: str, nperseg: Any, window: Any, detren
             raise DataError(f"the coherence is zero at ω = {w[i]:.6g} rad/s: the H2 estimate and its variance do not "
                             "exist there; use estimator='h1' or narrow the band")
         var = (rel * np.abs(H[:, :, 0]) ** 2 / (n_eff - 1))[:, :, None]
-    return _Estimate(w, H, var, coh, 2.0 * float(dof if estimator == "h1" else n_eff - 1), _separation(Suu))
+    return _Estimate(w, H, var, coh, 2.0 * float(dof if estimator == "h1" else n_eff - 1), _separation(Suu),
+                     nperseg=nperseg)
 
 
 # -- periodic ------------------------------------------------------------------------------
@@ -552,7 +555,12 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         factor = _hold_factor(est.w, dt)[:, None, None]
         variance = None if est.variance is None else est.variance / np.abs(factor) ** 2
         out = FrequencyData(est.w, est.H / factor, variance, est.variance_dof)
-    object.__setattr__(out, "estimated_from", {"dt": float(dt), "hold": hold})  # metadata, not a field
+    made = {"dt": float(dt), "hold": hold}
+    if est.nperseg is not None:  # a windowed estimate: its resolution smooths lightly damped modes (fit/frf/leakage)
+        made.update(nperseg=int(est.nperseg), window=window if isinstance(window, (str, tuple)) else "given",
+                    resolution=2 * np.pi / (est.nperseg * float(dt)),
+                    samples=int(min(r.n_samples for r in _records(data))))
+    object.__setattr__(out, "estimated_from", made)  # metadata, not a field
     return out
 
 
