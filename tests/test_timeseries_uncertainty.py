@@ -59,6 +59,11 @@ def test_near_singular_fisher_information_is_flagged():
     assert unc.near_singular
     assert abs(abs(unc.weakest["a"]) - np.sqrt(0.5)) < 1e-3 and unc.weakest["a"] * unc.weakest["b"] < 0
     assert "NEAR-SINGULAR" in res.summary()
+    # and beside success, not only below it (a new user's roof-only record: success, masses 4 times the truth)
+    best = next(x for x in res.summary().splitlines() if x.startswith("best:"))
+    assert res.success and "do not determine every parameter" in best
+    determined = si.identify(model.with_known({"b": 0.2}), io, method="oe", x0=[0.2], identifiability_check=False)
+    assert determined.success and "do not determine" not in determined.summary()
 
 
 def test_fisher_uncertainty_matches_linear_regression():

@@ -482,8 +482,12 @@ class IdentificationResult:
     def summary(self, truth: dict[str, float] | None = None) -> str:
         """A readable table of the estimate (against ``truth`` when given)."""
         n_ok = sum(s.success for s in self.starts)
+        # a fit whose parameters the data hardly determine says so beside success (a new user's roof-only shake-table
+        # record: success True, masses 4 times the truth, said only in the uncertainty's lines below)
+        loose = (" (the data fit, but do not determine every parameter: NEAR-SINGULAR below)" if self.success
+                 and self.uncertainty is not None and self.uncertainty.near_singular else "")
         lines = [f"method: {self.method}   starts: {self.n_starts}   successful: {n_ok}/{self.n_starts}",
-                 f"best: success {self.success}   cost {self.cost:.3e} ({self.cost_kind})",
+                 f"best: success {self.success}{loose}   cost {self.cost:.3e} ({self.cost_kind})",
                  f"  fit: {self.fit}",
                  f"  solver: {self.status}, {self.iterations} iterations; {self.message}",
                  f"total time {self.wall_time:.3f} s" + (
