@@ -684,3 +684,24 @@ def test_a_failed_fit_with_the_default_hold_is_tried_band_limited_and_says_so(mo
     given = si.identify(model, io, method="oe", x0=truth, initial_state="estimate", hold="zoh",
                         identifiability_check=False)
     assert not given.success and "hold_probe" not in given.options
+
+
+def test_a_start_whose_modes_the_records_cannot_show_is_said_first():
+    """A new user's shake-table record with its times in ms read as s: the samples 5 s apart, the start's modes at
+    3–10 Hz far above the 0.1 Hz Nyquist frequency, and the failed fit was told about starts and units in general.
+    Now a DataWarning before the fit and NEXT first name the modes and the Nyquist frequency (reference: the
+    oscillator's 10 Hz). The same record in s gets neither."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    truth = np.array([1.0, 1.2566, 3947.8])  # 10 Hz, ζ 1 %
+    io = si.simulate_io(model, truth, np.random.default_rng(0).standard_normal(300), 0.005, noise=0.01, seed=1)
+    as_s = si.IOData(io.u, io.y, dt=5.0)  # the ms read as s
+    with pytest.warns(si.DataWarning, match=r"every mode of the start \(10 Hz\) lies above the records' Nyquist"):
+        res = si.identify(model, as_s, method="oe", x0=truth, identifiability_check=False, progress=False)
+    assert not res.success
+    assert next(x for x in res.summary().splitlines() if x.startswith("NEXT")).startswith(
+        "NEXT: every mode of the start (10 Hz)")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", si.DataWarning)
+        right = si.identify(model, io, method="oe", x0=truth, identifiability_check=False)
+    assert "time_scale" not in right.options

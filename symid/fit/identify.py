@@ -85,6 +85,58 @@ def _offset_explains_most(offset: dict[str, Any] | None) -> bool:
     return float(offset["after"]) <= 0.5 * float(offset["misfit"])
 
 
+def _time_scale_mismatch(model: Any, records: list[Any], x0: Any) -> str | None:
+    """A sentence when the user's start has no mode the records can show, else None: every mode above their Nyquist
+    frequency, or the fastest so slow that it moves by under 1 % over the longest record.
+
+    A time column in ms read as s puts a structure's modes (3–10 Hz) far above the records' Nyquist frequency
+    (0.1 Hz at dt = 5 s): a new user's shake-table record failed after 30 s with advice about starts and units in
+    general. A record's time unit is the one thing about it no data test can check; the start's modes can.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import symid as si
+    >>> m, c, k = si.parameters("m c k", positive=True)
+    >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    >>> io = si.IOData(np.ones(100), np.zeros(100), dt=5.0)                 # 5 ms samples read as s
+    >>> _time_scale_mismatch(model, [io], [1.0, 1.0, 3947.8])[:63]
+    "every mode of the start (10 Hz) lies above the records' Nyquist"
+    >>> _time_scale_mismatch(model, [si.IOData(np.ones(100), np.zeros(100), dt=0.005)], [1.0, 1.0, 3947.8]) is None
+    True
+    """
+    from symid.fit.modes import estimate_poles
+
+    poles = estimate_poles(model, np.asarray(x0, dtype=float))
+    if poles is None:
+        return None
+    size = np.abs(poles)
+    size = size[size > 1e-12 * max(float(size.max(initial=0.0)), 1e-300)]
+    dts = [float(r.dt) for r in records if getattr(r, "dt", None)]
+    if not size.size or not dts:
+        return None
+    nyquist = np.pi / min(dts)
+    span = max(float(np.ptp(np.asarray(r.t, dtype=float))) for r in records)
+    unit = getattr(records[0], "time_unit", None) or "s"
+    hz = "Hz" if unit == "s" else f"cycles/{unit}"
+
+    def f(w: float) -> str:
+        return f"{w / (2 * np.pi):.3g} {hz}"
+
+    modes = f(size.min()) if size.size == 1 or np.isclose(size.min(), size.max()) else \
+        f"{f(size.min())} … {f(size.max())}"
+    if size.min() > nyquist:
+        return (f"every mode of the start ({modes}) lies above the records' Nyquist frequency ({f(nyquist)}, "
+                f"samples {min(dts):.4g} {unit} apart): the records cannot show them. Are the times in the unit "
+                f"declared (milliseconds read as seconds make every sample interval 1000 times too long)? Else "
+                f"the start is far from the system")
+    if span > 0 and size.max() * span < 1e-2:
+        return (f"every mode of the start ({modes}) is so slow that it moves by under 1 % over the records "
+                f"({span:.4g} {unit}): are the times in the unit declared (seconds read as milliseconds or hours "
+                f"make the record 1000 or 1/3600 times as long)? Else the start is far from the system")
+    return None
+
+
 def _idle_input_parameters(model: Any, records: list[Any]) -> str | None:
     """'b2 multiplies input 'heater_kW' alone, which is zero in every record: …' for the parameters found only in
     the columns of B (and D) of inputs that are zero throughout the records, or None."""
@@ -453,6 +505,11 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                       bounds=options.get("bounds"), data_typical=getattr(estimator, "data_typical", None))
     if x0 is not None:
         estimator.check_start(x0s[0])  # the user's own start: refused with a reason (e.g. outside the bounds)
+    records = data if isinstance(data, (list, tuple)) else [data]
+    time_scale = (_time_scale_mismatch(model, records, x0s[0]) if x0 is not None and hasattr(records[0], "t")
+                  else None)
+    if time_scale is not None:  # said before the fit (the records' time unit, or a start far off), and in summary()
+        warnings.warn(time_scale, DataWarning, stacklevel=2)
     check_s, not_local = None, ()
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
@@ -512,7 +569,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         offset = estimator.initial_offset(result.theta_vector)
         if offset is not None:
             extra["initial_offset"] = offset
-    records = data if isinstance(data, (list, tuple)) else [data]
+    if time_scale is not None:
+        extra["time_scale"] = time_scale
     if hasattr(records[0], "t") and (idle := _idle_input_parameters(model, records)) is not None:
         # a parameter that multiplies only an input the records hold at zero: its estimate is arbitrary (a new
         # user's heater column left at 0: b2 = 3.8e-12, success, said only as a near-singular direction)

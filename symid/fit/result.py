@@ -498,7 +498,10 @@ class IdentificationResult:
         if self.options.get("interrupted"):
             lines.append("INTERRUPTED: only the finished starts are reported")
         if not self.success:
-            if (probe := self.options.get("hold_probe")) is not None:
+            if (scale := self.options.get("time_scale")) is not None:
+                # before anything else: no start, hold or sign fixes a record read in the wrong time unit
+                lines.append(f"NEXT: {scale}")
+            elif (probe := self.options.get("hold_probe")) is not None:
                 # before anything else: no start or unit fixes an input taken as held that was measured
                 lines.append(f"NEXT: the records fit with the input band-limited between samples (misfit "
                              f"{probe['misfit']:.3g}, against {self.cost:.3g} with it held): an input that was "
