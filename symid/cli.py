@@ -696,9 +696,16 @@ def _cmd_identifiability(args: argparse.Namespace) -> int:
     spec = load_model(args.model)
     known = {**spec.known, **_known_values(args.known, "identifiability")}
     positive = {"declared": None, "all": True, "ignore": False}[args.positive]
+    at = None
+    if args.at == ["start"]:
+        if not spec.start:
+            raise _UsageError("symid identifiability: error: --at start, but the model file gives no start")
+        at = {k: v for k, v in spec.start.items() if k not in known}
+    elif args.at:
+        at = _numbers(args.at, "--at", "identifiability")
     report = identifiability(spec.model, known=known, positive=positive,
                              timeout=args.timeout, exact_count=args.exact_count, seed=args.seed,
-                             engine=args.engine)
+                             engine=args.engine, at=at)
     if args.json:
 
         _print_json(report.to_dict())
@@ -871,6 +878,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="keep the Gröbner step running for the exact number of solutions even when certified "
                         "numerical solutions already prove the model locally but not globally identifiable")
     p.add_argument("--known", nargs="*", metavar="NAME=VALUE", help="parameters taken as known")
+    p.add_argument("--at", nargs="+", metavar="NAME=VALUE",
+                   help="your own values of the free parameters (or `--at start`: the model file's start): the "
+                        "report also lists every other admissible set of values with the same response at them")
     p.add_argument("--positive", choices=("declared", "all", "ignore"), default="declared",
                    help="discard solutions with non-positive values of the parameters declared positive "
                         "(default), of all parameters, or ignore positivity")

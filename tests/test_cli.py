@@ -760,3 +760,25 @@ def test_the_modes_line_shows_one_rigid_body_pole_as_zero():
     m, c = si.parameters("m c", positive=True)
     model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[0]], B=[[1]], C=[[1]])
     assert modes_line(model, [2.0, 3.0], "s") == "modes of the estimate: 1 pole at 0; real pole -1.5 /s"
+
+
+def test_identifiability_at_your_own_values(tmp_path, capsys):
+    """--at NAME=VALUE (or --at start, the model file's start) lists the other solutions at those values (an oral
+    dose's flip-flop: ka and ke swap, reference 1.2 · 0.025 = 0.15 · 0.2); a file without a start is named."""
+    (tmp_path / "oral.py").write_text(
+        "import symid as si\n"
+        "ka, ke, q = si.parameters('ka ke q', positive=True)\n"
+        "model = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])\n"
+        "start = {'ka': 1.2, 'ke': 0.15, 'q': 0.025}\n")
+    path = str(tmp_path / "oral.py")
+    assert main(["identifiability", path, "--at", "ka=1.2", "ke=0.15", "q=0.025"]) == 0
+    out = capsys.readouterr().out
+    assert "1 other admissible set(s) of values" in out and "1: ka = 0.15, ke = 1.2, q = 0.2" in out
+    assert main(["identifiability", path, "--at", "start"]) == 0
+    assert "1: ka = 0.15, ke = 1.2, q = 0.2" in capsys.readouterr().out
+    (tmp_path / "bare.py").write_text(
+        "import symid as si\n"
+        "ka, ke, q = si.parameters('ka ke q', positive=True)\n"
+        "model = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])\n")
+    assert main(["identifiability", str(tmp_path / "bare.py"), "--at", "start"]) == 2
+    assert "the model file gives no start" in capsys.readouterr().err

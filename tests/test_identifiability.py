@@ -880,3 +880,30 @@ def test_a_locally_identifiable_report_says_how_the_solutions_differ_and_what_ke
     assert "another solution differs in k1, k2 (the same values, swapped)" in text
     assert "to keep one: bounds that leave only it" in text
     assert "telling the solutions apart" not in si.identifiability(tanks.with_known({"k1": 3e-3})).summary()
+
+
+def test_the_solutions_at_your_own_values():
+    """``at=`` lists every other admissible set of values with the response at the user's values (two new users
+    asked: the report's random θ* gave magnitudes that meant nothing to them). An oral dose's flip-flop: ka and ke
+    swap, and q follows (reference: ka ke / (V…) invariants, 1.2 · 0.025 = 0.15 · 0.2). A globally identifiable
+    model and one that is not locally identifiable say so without solving; bad values are named errors."""
+    ka, ke, q = si.parameters("ka ke q", positive=True)
+    oral = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])
+    rep = si.identifiability(oral, at={"ka": 1.2, "ke": 0.15, "q": 0.025})
+    assert rep.verdict == "local" and len(rep.solutions_at) == 1
+    other = rep.solutions_at[0]
+    np.testing.assert_allclose([other["ka"], other["ke"], other["q"]], [0.15, 1.2, 0.2], rtol=1e-9)
+    text = rep.summary()
+    assert "at the values given (at=): ka = 1.2, ke = 0.15, q = 0.025" in text
+    assert "1 other admissible set(s) of values" in text and "1: ka = 0.15, ke = 1.2, q = 0.2" in text
+    a, b, c = si.parameters("a b c", positive=True)
+    first = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[c]])
+    assert si.identifiability(first, known={"b": 2}, at={"a": 1.0, "c": 3.0}).at_status.startswith("none: the model "
+                                                                                                   "is globally")
+    assert si.identifiability(first, at={"a": 1.0, "b": 2.0, "c": 3.0}).at_status.startswith("infinitely many")
+    with pytest.raises(si.ModelError, match="at must give every free parameter; q missing"):
+        si.identifiability(oral, at={"ka": 1.2, "ke": 0.15})
+    with pytest.raises(si.ModelError, match=r"at\['ke'\] = -0.15: a finite number, > 0 \(declared positive\)"):
+        si.identifiability(oral, at={"ka": 1.2, "ke": -0.15, "q": 0.025})
+    with pytest.raises(si.ModelError, match="at names 'V', not a parameter"):
+        si.identifiability(oral, at={"ka": 1.2, "ke": 0.15, "q": 0.025, "V": 1.0})

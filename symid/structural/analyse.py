@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -108,7 +109,8 @@ def _positive_flags(model, positive: bool | None, known) -> list[bool]:
 
 def identifiability(model, *, known: Mapping[str, float] | None = None, positive: bool | None = None,
                     timeout: float | None = DEFAULT_TIMEOUT, exact_count: bool = False,
-                    seed: int = 0, engine: str = "auto") -> IdentifiabilityReport:
+                    seed: int = 0, engine: str = "auto", at: Mapping[str, float] | None = None
+                    ) -> IdentifiabilityReport:
     """Structural identifiability of a model's parameters from its input-output map.
 
     Local identifiability comes from the exact rank of the Jacobian of an exhaustive
@@ -210,14 +212,23 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
         is multi-modular with a probabilistic stopping criterion (Monte Carlo, as the
         confirmation modulo a random prime at θ** is for both); see
         :mod:`symid.structural.msolve`.
+    at : dict of str to float, optional
+        Your own values of the free parameters (nominal values, an estimate): the report
+        then also lists every other admissible set of values with the same response *at
+        these values* (``rep.solutions_at``; the global step run at them, with its own
+        ``timeout``), for a model that is locally but not proven globally identifiable
+        (a globally identifiable one has none at generic values; a model that is not
+        locally identifiable has infinitely many, and ``fix`` says what to make known).
+        The structural verdicts stay those of the random points.
 
     Raises
     ------
     ModelError
-        A model or ``known`` that cannot be analysed: not a model, no parameter at all,
-        ``known`` not a dict, an unknown or repeated name, a value that is not a finite
-        real number, every parameter known; or a model found degenerate during the
-        analysis (det M(θ) ≡ 0).
+        A model, ``known`` or ``at`` that cannot be analysed: not a model, no parameter
+        at all, ``known`` not a dict, an unknown or repeated name, a value that is not a
+        finite real number, every parameter known, ``at`` missing a free parameter or
+        negative for a positive one; or a model found degenerate during the analysis
+        (det M(θ) ≡ 0).
     OptionError
         A bad ``timeout``, ``positive``, ``exact_count``, ``seed`` or ``engine`` (or
         ``engine="msolve"`` with no msolve program found).
@@ -246,6 +257,69 @@ def identifiability(model, *, known: Mapping[str, float] | None = None, positive
     >>> si.identifiability(model, known={"b": 2}).verdict
     'global'
     """
+    point = None if at is None else _checked_point(model, known, at)
+    rep = _identifiability(model, known=known, positive=positive, timeout=timeout, exact_count=exact_count,
+                           seed=seed, engine=engine)
+    return rep if point is None else _with_point(model, rep, point, timeout)
+
+
+_AT_SKIPPED = {
+    "global": "none: the model is globally identifiable (no other values give the response at generic values)",
+    "none": "infinitely many: the model is not locally identifiable (make the parameters of `fix` known)",
+}
+
+
+def _checked_point(model, known: Mapping[str, float] | None, at: Mapping[str, float]) -> dict[str, float]:
+    """``at`` as {free name: float}, checked (a ModelError names what is wrong)."""
+    if not isinstance(at, Mapping):
+        raise ModelError(f"at must be a dict of parameter values by name; got {type(at).__name__}")
+    given_known = {getattr(k, "name", k) for k in (known or {})}
+    free = [n for n in model.parameter_names if n not in given_known]
+    names = {getattr(k, "name", k): v for k, v in at.items()}
+    unknown = [n for n in names if n not in model.parameter_names]
+    if unknown:
+        raise ModelError(f"at names {', '.join(map(repr, unknown))}, not a parameter of the model "
+                         f"({', '.join(model.parameter_names)})")
+    missing = [n for n in free if n not in names]
+    if missing:
+        raise ModelError(f"at must give every free parameter; {', '.join(missing)} missing")
+    out = {}
+    positive = dict(zip(model.parameter_names, model.positive, strict=True))
+    for n in free:
+        try:
+            v = float(names[n])
+        except (TypeError, ValueError):
+            raise ModelError(f"at[{n!r}] must be a real number; got {names[n]!r}") from None
+        if not math.isfinite(v) or (positive[n] and v <= 0):
+            raise ModelError(f"at[{n!r}] = {v!r}: a finite number{', > 0 (declared positive)' if positive[n] else ''}"
+                             " is needed")
+        out[n] = v
+    return out
+
+
+def _with_point(model, rep: IdentifiabilityReport, point: dict[str, float], timeout) -> IdentifiabilityReport:
+    """The report with the other admissible solutions at the user's values (``at=``)."""
+    if rep.verdict in _AT_SKIPPED:
+        return dataclasses.replace(rep, at=point, at_status=_AT_SKIPPED[rep.verdict])
+    reduced = model.with_known(rep.known) if rep.known else model
+    t0 = time.perf_counter()
+    others = solutions_at(reduced, [point[n] for n in reduced.parameter_names], timeout=timeout)
+    spent = time.perf_counter() - t0
+    if others is None:
+        status = (f"not decided (the global step at these values did not finish within {timeout:g} s, or they are "
+                  f"special: two solutions merging, a pole cancelling a zero)" if timeout is not None else
+                  "not decided (these values are special: two solutions merging, a pole cancelling a zero)")
+    elif not others:
+        status = "none: no other admissible values give the response at these values"
+    else:
+        status = f"{len(others)} other admissible set(s) of values give the response at these values"
+    return dataclasses.replace(rep, at=point, at_status=status,
+                               solutions_at=None if others is None else tuple(others),
+                               timing={**rep.timing, "at": spent})
+
+
+def _identifiability(model, *, known, positive, timeout, exact_count, seed, engine) -> IdentifiabilityReport:
+    """:func:`identifiability` without ``at``."""
     t0 = time.perf_counter()
     args = checked_arguments(model, known=known, timeout=timeout, positive=positive, exact_count=exact_count,
                              seed=seed, engine=engine)

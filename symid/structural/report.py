@@ -49,6 +49,9 @@ class NecessaryCondition:
         return f"{self.n_parameters} free parameters {sign} {count} = {self.bound}: {mark}"
 
 
+_APART_SHOWN = 3  # other solutions compared with θ*'s in the summary (every one is in rep.solutions)
+
+
 @dataclass(frozen=True)
 class IdentifiabilityReport:
     """Structural identifiability of a model's parameters from its input-output map.
@@ -153,6 +156,13 @@ class IdentifiabilityReport:
         checked rational formulas decided every verdict. Like ``timing``, a record of how the
         report was made: the rest of the report is the same whichever ran (the floats of
         ``solutions`` agree to rounding).
+    at : dict of str to float
+        The values given as ``at=`` (empty without).
+    at_status : str
+        What is known of other solutions at those values (empty without ``at=``).
+    solutions_at : tuple of dict or None
+        The other admissible solutions with the response at those values (every one), ``()`` when there is none,
+        None when not computed (see ``at_status``).
     """
 
     model: str
@@ -185,6 +195,9 @@ class IdentifiabilityReport:
     theta_confirm: dict[str, str] = field(default_factory=dict)
     solution_count: str = ""
     engine: str = ""
+    at: dict[str, float] = field(default_factory=dict)
+    at_status: str = ""
+    solutions_at: tuple[dict[str, float], ...] | None = None
 
     @property
     def identifiable(self) -> tuple[str, ...]:
@@ -272,6 +285,9 @@ class IdentifiabilityReport:
         if apart:
             L.append("")
             L.extend(apart)
+        if self.at:
+            L.append("")
+            L.extend(self._at_lines())
         if self.combinations:
             L.append("")
             L.append("identifiable combinations:")
@@ -298,6 +314,17 @@ class IdentifiabilityReport:
                      + (f" (exact step: {self.engine})" if self.engine else ""))
         return "\n".join(L)
 
+    def _at_lines(self) -> list[str]:
+        """The section of the values given as ``at=``: every other admissible solution there."""
+        lines = ["at the values given (at=): " + ", ".join(f"{k} = {v:.6g}" for k, v in self.at.items()),
+                 f"  other solutions: {self.at_status}"]
+        names = [p for p in self.parameters if p in self.at]
+        for k, other in enumerate(self.solutions_at or (), start=1):
+            diff = [p for p in names if abs(other[p] - self.at[p]) > 1e-9 * max(1.0, abs(self.at[p]))]
+            lines.append(f"  {k}: " + ", ".join(f"{p} = {other[p]:.6g}" for p in diff)
+                         + ("" if len(diff) == len(names) else " (the rest as given)"))
+        return lines
+
     def _telling_apart(self) -> list[str]:
         """For a model that is locally, not globally identifiable: how the admissible solutions at θ* differ (which
         parameters; a swap said as one) and what keeps one of them."""
@@ -311,7 +338,7 @@ class IdentifiabilityReport:
         else:
             return []
         lines = ["telling the solutions apart (at θ*):"]
-        for other in others[:3]:
+        for other in others[:_APART_SHOWN]:
             diff = [p for p in self.parameters if p in first and p in other
                     and abs(other[p] - first[p]) > 1e-9 * max(1.0, abs(first[p]))]
             if not diff:
@@ -324,6 +351,9 @@ class IdentifiabilityReport:
                          + ", ".join(f"{p} {first[p]:.4g} or {other[p]:.4g}" for p in diff))
         if len(lines) == 1:
             return []
+        if len(others) > _APART_SHOWN:  # a new user counted 3 of 8 and took them for all
+            lines.append(f"  … and {len(others) - _APART_SHOWN} more (rep.solutions holds every one; at your own "
+                         f"values: si.identifiability(model, at={{...}}))")
         lines.append("  to keep one: bounds that leave only it (si.identify(..., bounds=...) then says UNIQUE WITHIN "
                      "THE BOUNDS), a known value (model.with_known), or another output that separates them")
         return lines
