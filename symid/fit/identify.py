@@ -662,7 +662,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             result = dataclasses.replace(result, options={**result.options, "polarity": flip})
     explained = (result.success or not np.all(np.isfinite(result.theta_vector)) or result.options.get("interrupted")
                  or result.on_bounds or result.fit.startswith("pulled beyond")
-                 or any(result.options.get(k) for k in ("swapped_roles", "not_determined"))
+                 or any(result.options.get(k) for k in ("swapped_roles", "not_determined", "time_scale"))
                  or _offset_explains_most(result.options.get("initial_offset")))
     if (hasattr(records[0], "t") and not explained and estimator.method in ("oe", "auto") and "hold" not in options
             and estimator.options.get("hold") == "zoh"):
