@@ -435,3 +435,27 @@ def test_a_fit_the_data_pull_beyond_its_bounds_is_not_a_success():
     assert wrong.fit.startswith("pulled beyond the bounds: the data pull R2")
     assert set(wrong.uncertainty.beyond_bounds) == {"R2"} and wrong.uncertainty.shift > 5.78
     assert "a frequency in Hz read as rad/s" in wrong.summary().split("NEXT: ")[1]
+
+
+def test_nuisance_unknowns_do_not_make_theta_near_singular():
+    """Two nuisance columns (initial states, say) nearly collinear, θ's two well determined and independent of them:
+    θ's conditioning is that of its information with the nuisance profiled out, F_θθ − F_θn F_nn⁺ F_nθ (the flag
+    and the weakest direction said "NEAR-SINGULAR" for the nuisance alone before). The standard errors are the same
+    either way (the marginal covariance); a θ that trades off against a nuisance column is still flagged.
+    Reference: the regression by hand, cov = σ² (JᵀJ)⁻¹."""
+    from symid.fit.uncertainty import fisher_uncertainty
+
+    rng = np.random.default_rng(0)
+    N = 400
+    t1, t2, n1 = rng.standard_normal((3, N))
+    n2 = n1 + 1e-7 * rng.standard_normal(N)  # the nuisance columns agree to 1e-7
+    J = np.column_stack([t1, t2, n1, n2])
+    r = 0.1 * rng.standard_normal(N)
+    unc = fisher_uncertainty(np.array([1.0, 2.0]), ("a", "b"), r, J, np.zeros(N, dtype=int))
+    assert not unc.near_singular and unc.condition < 10  # θ's own: two nearly orthogonal unit-variance columns
+    sigma2 = float(r @ r) / (N - 4)
+    expected = np.sqrt(np.diag(np.linalg.pinv(J.T @ J))[:2] * sigma2)
+    # (symid's noise level per channel differs from r·r/(N − 4) by 0.15 % here: measured)
+    np.testing.assert_allclose(unc.standard_errors, expected, rtol=5e-3)
+    tied = np.column_stack([t1, t2, t1 + 1e-7 * rng.standard_normal(N), n1])  # a depends on a nuisance column
+    assert fisher_uncertainty(np.array([1.0, 2.0]), ("a", "b"), r, tied, np.zeros(N, dtype=int)).near_singular

@@ -45,9 +45,12 @@ estimate, which IPOPT reached from the same start, has 4.8 /s: 3.4 standard erro
 
 A Fisher information that is near-singular means the data hardly determine some
 combination of the parameters — practically non-identifiable even when structurally
-identifiable: the flag ``near_singular`` is set when the smallest eigenvalue of the
-correlation-scaled F (unit diagonal) is below 1e-8 of its largest; the weakest
-direction is reported. Where F is singular (to 1e-15), a parameter whose unit vector lies
+identifiable: the flag ``near_singular`` is set when the smallest eigenvalue of θ's
+information with the nuisance unknowns (initial states, offsets) profiled out,
+F_θθ − F_θn F_nn⁺ F_nθ, scaled by θ's own diagonal of F, is below 1e-8 of its largest;
+the weakest direction is reported. (Two nearly collinear nuisance columns alone no longer
+set it; a parameter that trades off against a nuisance unknown still does:
+``tests/test_uncertainty.py``.) Where F is singular (to 1e-15), a parameter whose unit vector lies
 in the row space of J is still determined to first order and gets the standard error of
 the pseudo-inverse; one with a part in the null space gets ``inf`` (before, every
 parameter got ``inf``, the well-determined ones too).
@@ -637,11 +640,22 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     F = Jn.T @ (Jn / vn[:, None])
     d = np.sqrt(np.clip(np.diag(F), 0, None))
     safe = np.where(d > 0, d, 1.0)
-    Fs = F / np.outer(safe, safe)
-    ev, vec = np.linalg.eigh(Fs)
+    # the conditioning and the weakest direction are θ's, with the nuisance unknowns (initial states, offsets)
+    # profiled out: the information about θ once they are estimated too, F_θθ − F_θn F_nn⁺ F_nθ (the whole F's
+    # smallest eigenvalue could be two nuisance unknowns the records hardly tell apart, and the summary then says the
+    # data do not determine every parameter)
+    Fp = F[:l, :l]
+    if F.shape[0] > l:
+        Fn = F[l:, l:] / np.outer(safe[l:], safe[l:])
+        cross = F[:l, l:] / safe[None, l:]
+        Fp = Fp - cross @ np.linalg.pinv(Fn, rcond=1e-12, hermitian=True) @ cross.T
+        Fp = 0.5 * (Fp + Fp.T)
+    # scaled by θ's own information (unprofiled): what a nuisance unknown takes from a parameter shows as a small
+    # eigenvalue, as it did in the whole F
+    ev, vec = np.linalg.eigh(Fp / np.outer(safe[:l], safe[:l]))
     cond = float(ev[-1] / ev[0]) if ev[0] > 0 else float("inf")
-    near = not (ev[0] > NEAR_SINGULAR * ev[-1]) or bool(np.any(d == 0))
-    w = vec[:, 0][:l] / safe[:l]
+    near = not (ev[0] > NEAR_SINGULAR * ev[-1]) or bool(np.any(d[:l] == 0))
+    w = vec[:, 0] / safe[:l]
     w = w / (np.linalg.norm(w) or 1.0)
     weakest = dict(zip(names, np.round(w, 6).tolist(), strict=True))
     with np.errstate(divide="ignore", invalid="ignore"):
