@@ -786,7 +786,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("model", metavar="MODEL", help="zoo name (see `symid models`) or path to a .py model file")
     _add_data_arguments(p, "simulate the zoo recipe")
     p.add_argument("--method", choices=all_methods(), default=None,
-                   help="estimator (default: auto for a frequency response or time series, scr for spectra and "
+                   help="estimator (default: auto for a frequency response, spectra or time series, scr for "
                         "black boxes); als and gb "
                         "(alternating least squares, gradient-based BFGS, thesis appendix C) take black-box or I/O "
                         "data, oe (output error) time series")

@@ -435,19 +435,25 @@ def _wide_one_mass(noise: str | None, seed: int = 0):
 
 @pytest.mark.parametrize("method", ["lm", "auto", "ipopt", "scr"])
 def test_variance_relative_weighs_each_line_by_its_level(method):
-    """variance="relative" is the fit weighted by σ ∝ |H| at any level: the same estimate as variance=(ε·|H|)² for
-    any ε (the weights are scaled to mean 1), said in the options; a zero value of H cannot be weighed so and is
-    refused by name."""
+    """variance="relative" is the fit weighted by σ ∝ |H| at any level: for ipopt and scr the same estimate as
+    variance=(ε·|Hᵢ|)² for any ε (the weights are scaled to mean 1), for lm and auto the same as variance=(ε·|H(ωᵢ,
+    θ̂)|)², the model's response at their own estimate (weights from the measured values correlate with the noise:
+    symid.fit.frf.misfit.NoiseWeighted.reweigh_relative); said in the options; a zero value of H cannot be weighed
+    so and is refused by name."""
     model, frf = _wide_one_mass("relative")
     kw = dict(method=method, x0=[1.2, 0.12, 0.9], identifiability_check=False)
     rel = si.identify(model, frf, variance="relative", **kw)
-    given = si.identify(model, frf, variance=(0.02 * np.abs(np.asarray(frf.H))) ** 2, **kw)
+    Hm = model.frequency_response(rel.theta_vector, frf.w)
+    level = np.abs(Hm) if method in ("lm", "auto") else np.abs(np.asarray(frf.H))
+    given = si.identify(model, frf, variance=(0.02 * level) ** 2, **kw)
     assert rel.options["variance"] == "relative" and given.options["variance"] == "given"
     np.testing.assert_allclose(rel.theta_vector, given.theta_vector, rtol=1e-6)
-    # the cost is the mean relative misfit, and named so (a new user read it under the unweighted misfit's name)
-    Hm = model.frequency_response(rel.theta_vector, frf.w)
-    np.testing.assert_allclose(rel.cost, np.mean(np.abs(frf.H - Hm) ** 2 / np.abs(frf.H) ** 2), rtol=1e-9)
-    assert rel.cost_kind.startswith("mean relative FRF misfit") and given.cost_kind.startswith("noise-weighted")
+    # the cost is the relative misfit in those weights, and named so (a new user read it under the unweighted
+    # misfit's name)
+    np.testing.assert_allclose(rel.cost, np.sum(np.abs(frf.H - Hm) ** 2 / level**2) / np.sum(np.abs(frf.H) ** 2
+                                                                                       / level**2), rtol=1e-9)
+    assert rel.cost_kind.startswith("relative FRF misfit weighted by the model" if method in ("lm", "auto") else
+                                    "mean relative FRF misfit") and given.cost_kind.startswith("noise-weighted")
     H = np.asarray(frf.H).copy()
     for tiny in (0.0, 1e-300):  # 1/|H|² overflows for the second (a new user's: NaN misfits, no reason given)
         H[3] = tiny

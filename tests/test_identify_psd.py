@@ -243,3 +243,28 @@ def test_auto_keeps_to_its_budget_and_ends(grounded_two_mass):
     est = AutoPSD(model, spec, restarts=0, time_limit=0.5)
     out = est.run(model.theta_vector({k: 0.01 * v for k, v in truth.items()}))
     assert np.isfinite(out.cost) and "SCR (ADMM) and IPOPT from its estimate" in out.message
+
+
+def test_output_spectra_say_their_scale_is_the_input_spectrums():
+    """A new user's footbridge from ambient vibration: a force intensity 4 times too large gave every parameter 2.08
+    times too large, with success and nothing said. Φyy = H Φuu Hᴴ: with Φuu × a² the same spectra fit every mass,
+    damper and spring × a (here a = 2, exactly, on exact spectra), and the fit now says where its scale comes from;
+    with a mass known there is no such direction and nothing is said."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    truth = np.array([2.0, 0.5, 300.0])
+    psd = si.simulate_spectra(model, truth, np.linspace(5.0, 20.0, 30), Phi_uu=1.0)
+    with pytest.warns(si.DataWarning, match="the estimate's scale is that of the input spectrum given"):
+        res = si.identify(model, psd, x0=[1.5, 0.4, 250.0], identifiability_check=False)
+    assert res.success and res.options["output_only_scale"]["direction"] == {"m": -1.0, "c": -1.0, "k": -1.0}
+    assert "SCALE: from output spectra" in res.summary()
+    four = si.SpectralData(psd.w, psd.Phi_yy, np.asarray(psd.Phi_uu) * 4.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", si.DataWarning)
+        scaled = si.identify(model, four, x0=[3.0, 0.8, 500.0], identifiability_check=False)
+    np.testing.assert_allclose(scaled.theta_vector, 2.0 * truth, rtol=1e-6)
+    known = model.with_known({"m": 2.0})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", si.DataWarning)
+        fixed = si.identify(known, psd, x0=[0.4, 250.0], identifiability_check=False)
+    assert fixed.success and "output_only_scale" not in fixed.options

@@ -544,6 +544,8 @@ class IdentificationResult:
             elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
                                       time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
+        if (scale := self.options.get("output_only_scale")) is not None:  # of a fit or not: what spectra cannot say
+            lines.append(f"SCALE: {scale['text']}")
         if (leak := self.options.get("leakage")) is not None:  # of a fit or not: the data's own bias
             lines.append(f"{'LEAKAGE' if self.success else 'NEXT (also)'}: {leak['text']}")
         if not self.success and (sampled := self.options.get("sampled_response")) is not None:

@@ -160,7 +160,7 @@ from scipy.optimize import least_squares
 
 from symid.errors import ModelError, OptionError
 from symid.fit.bounded import bounds_option, clip_into, log_box, named_bounds, on_bounds
-from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted
+from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted, frf_weights
 from symid.fit.options import (
     check_bool,
     check_float,
@@ -190,6 +190,9 @@ FAR = 100.0
 
 JUMPS = (0.1, 10.0, 0.01, 100.0, 0.001, 1000.0)
 """The factors the saturated parameters are multiplied by, one pass each (choice 9)."""
+
+RELATIVE_ROUNDS = 3
+"""With ``variance="relative"``: at most this many passes reweighted by the model's response at the estimate."""
 
 _REPEATS = 3  # restarts stop once this many passes have ended at the best misfit (to 1e-6): a confirmed minimum
 
@@ -320,9 +323,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         H = np.asarray(data.H)
         self._H = H
         self._mask = np.abs(H) > 0
-        wts = np.ones(H.shape) if self.line_weights is None else self.line_weights
-        self._sqrtw = np.sqrt(wts)
-        self._hnorm = float(np.sqrt(np.sum(wts * np.abs(H) ** 2)))
+        self._weights_changed()
         self._positive = np.asarray(model.positive, dtype=bool) & positivity
         self._w = np.asarray(data.w, dtype=float)
         self._chain: Any = None  # the chain's values (chain_start), read once per estimator
@@ -331,6 +332,41 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         self._bb_theta: np.ndarray | None = None  # the black-box start (_black_box_theta), read once
         self._bb_read = False
         self._rescuing = False  # within the start from the black box's poles of a near-singular fit
+
+    def _weights_changed(self) -> None:
+        """The pass's √w and ‖√w H‖ from ``line_weights``."""
+        wts = np.ones(self._H.shape) if self.line_weights is None else self.line_weights
+        self._sqrtw = np.sqrt(wts)
+        self._hnorm = float(np.sqrt(np.sum(wts * np.abs(self._H) ** 2)))
+
+    def reweigh_relative(self, theta: Any) -> None:
+        """As :meth:`NoiseWeighted.reweigh_relative`, for the passes too."""
+        super().reweigh_relative(theta)
+        self._weights_changed()
+
+    def _relative_rounds(self, best: StartOutcome, start: np.ndarray, centre: np.ndarray, unit: np.ndarray,
+                         deadline: float | None, t0: float, nfev: int) -> tuple[StartOutcome, int, int]:
+        """With ``variance="relative"``: passes from the estimate with the weights from the model's response there
+        (:meth:`reweigh_relative`), until the estimate moves by under 1e-6 of itself (at most
+        :data:`RELATIVE_ROUNDS`); (the last outcome, passes, evaluations)."""
+        rounds = used = 0
+        theta = best.theta
+        for _ in range(RELATIVE_ROUNDS):
+            if deadline is not None and time.perf_counter() >= deadline:
+                break
+            self.reweigh_relative(theta)
+            new, count, spent = self._pass(self._phi(theta, centre, unit), centre, unit, deadline)
+            rounds, used = rounds + 1, used + count
+            moved = float(np.max(np.abs(new - theta) / np.maximum(np.abs(theta), 1e-300)))
+            theta = new
+            if spent or moved < 1e-6:
+                break
+        if not rounds:
+            return best, 0, 0
+        self.reweigh_relative(theta)  # the weights the outcome (and the uncertainty) are judged in
+        out = self.outcome(start, theta, finished=True, status="converged", message="", iterations=nfev + used,
+                           wall_time=time.perf_counter() - t0)
+        return out, rounds, used
 
     # -- parametrisation ------------------------------------------------------------------------
     def _units(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -512,6 +548,9 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             moved = moved_onto_bounds(x0, self.lower, self.upper, self.model.parameter_names)
             x0 = clip_into(x0, self.lower, self.upper)
         centre, unit = self._units(x0)
+        if self.options["variance"] == "relative":  # every start from the measured |H|'s weights
+            self.line_weights = frf_weights(self.data, "relative")
+            self._weights_changed()
         self._box = None
         if self._bounded:
             self._box = log_box(self.lower, self.upper, centre, unit, self._positive, _LOG_BOX)
@@ -658,6 +697,13 @@ class LmFRF(NoiseWeighted, FrfEstimator):
             if top.cost < best.cost * (1 - 1e-6):
                 best = top
                 rescue += ", kept"
+        if self.options["variance"] == "relative" and np.all(np.isfinite(best.theta)):
+            # weights from the model's response at the estimate, not the measured one's (reweigh_relative)
+            best, rounds, used = self._relative_rounds(best, start, centre, unit, deadline, t0, total_nfev)
+            total_nfev += used
+            passes += rounds
+            if rounds:
+                rescue += f"; {rounds} pass(es) weighted by the model's |H| at the estimate (variance='relative')"
         if status == "max_restarts" and best.success:
             status = "fits"
         wall = time.perf_counter() - t0
