@@ -126,15 +126,13 @@ def leakage_note(estimator: Any, data: Any, theta: Any, standard_errors: Any) ->
     --------
     >>> import numpy as np
     >>> import symid as si
-    >>> from symid.fit.frf.leakage import leakage_note
-    >>> from symid.fit.registry import prepare
     >>> m, c, k = si.parameters("m c k", positive=True)
     >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
     >>> truth = [1.0, 1.2566, 3947.8]                                        # 10 Hz, ζ 1 %
     >>> u = np.random.default_rng(0).standard_normal(8192)
     >>> io = si.simulate_io(model, truth, u, 0.005, noise=0.02, seed=1)      # 200 Hz, 41 s
     >>> frf = si.estimate_frf(io, nperseg=512, hold="zoh")                  # lines 0.39 Hz apart
-    >>> res = si.identify(model, frf, x0=truth, identifiability_check=False)
+    >>> res = si.identify(model, frf, x0=truth, identifiability_check=False)   # calls leakage_note
     >>> note = res.options["leakage"]
     >>> round(note["lines"], 1), note["suggested"], sorted(note["shifts"], key=note["shifts"].get)[-1]
     (0.6, 2048, 'c')
