@@ -81,3 +81,26 @@ def test_a_fit_of_coarse_welch_lines_names_the_bias_and_longer_segments_silence_
     assert "leakage" not in si.identify(model, periodic, x0=TRUTH, identifiability_check=False).options
     simulated = si.simulate_frf(model, TRUTH, 2 * np.pi * np.linspace(2.0, 30.0, 50), noise=0.01, seed=0)
     assert "leakage" not in si.identify(model, simulated, x0=TRUTH, identifiability_check=False).options
+
+
+def test_spectra_from_coarse_welch_lines_name_the_bias_too():
+    """The same for output spectra (a new user's footbridge: the default segments of a short record gave masses
+    34-44 % low, unsaid): an oscillator in acceleration, 2 min at 200 Hz, 2 % noise; with 512-sample segments
+    (0.5 lines across the bandwidth) m and k came out 26 % low and are named, moved by several standard errors;
+    with 4096 (2 % off) nothing is said. Reference: the values simulated."""
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]], output="acceleration")
+    u = np.random.default_rng(0).standard_normal(24000)
+    io = si.simulate_io(model, TRUTH, u, DT, noise=0.02, seed=1)
+    band = (2 * np.pi * 2, 2 * np.pi * 30)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", si.DataWarning)
+        coarse = si.identify(model, si.estimate_spectra(io, nperseg=512, band=band), x0=TRUTH,
+                             identifiability_check=False)
+        fine = si.identify(model, si.estimate_spectra(io, nperseg=4096, band=band), x0=TRUTH,
+                           identifiability_check=False)
+    note = coarse.options["leakage"]
+    assert note["shifts"]["m"] > 3 * LEAKAGE_SHIFT and note["shifts"]["k"] > 3 * LEAKAGE_SHIFT
+    assert "LEAKAGE: the spectra were estimated by Welch segments of 512 samples" in coarse.summary()
+    assert abs(coarse.theta_vector[0] / TRUTH[0] - 1) > 0.1  # the bias it names (measured: 26 % low)
+    assert "leakage" not in fine.options and abs(fine.theta_vector[0] / TRUTH[0] - 1) < 0.05

@@ -90,6 +90,11 @@ class SpectralData(DataContainer):
 
     _kind: ClassVar[str] = "SpectralData"
     _npz_keys: ClassVar[tuple[str, ...]] = ("w", "Phi_yy", "Phi_uu")
+    estimated_from: ClassVar[dict[str, Any]] = {}
+    """How :func:`symid.estimate_spectra` made these spectra from sampled records: ``{"dt", "nperseg", "window",
+    "resolution" (the line spacing, rad/s), "samples"}``; ``{}`` for spectra from anywhere else. Set on the object
+    made (not kept by a copy or a file): :func:`symid.identify` names the window's bias when it moves the estimate
+    (:mod:`symid.fit.frf.leakage`)."""
 
     def __init__(self, w: Any, Phi_yy: Any, Phi_uu: Any):
         w_ = checks.frequencies(w, "w")

@@ -708,7 +708,7 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             result = dataclasses.replace(result, options={**result.options, "output_only_scale": scale_note})
             warnings.warn(scale_note["text"], DataWarning, stacklevel=2)
     made = getattr(data, "estimated_from", None) or {}
-    if (isinstance(estimator, FrfEstimator) and made.get("nperseg") and np.all(np.isfinite(result.theta_vector))
+    if (hasattr(estimator, "data_shift") and made.get("nperseg") and np.all(np.isfinite(result.theta_vector))
             and result.uncertainty is not None):
         # a Welch estimate whose lines are too coarse for a fitted mode's bandwidth (symid.fit.frf.leakage): a new
         # user's shake-table frame, c3 11.6 % high at 5.2 standard errors, with success

@@ -246,4 +246,9 @@ def estimate_spectra(data: Any, *, dt: float | None = None, Phi_uu: Any = None, 
         Phi_u = _cross_spectra(u, 1.0 / dt_, nperseg, window, detrend)[1][inner][keep]
     else:
         Phi_u = _given_input(Phi_uu, w, None if u is None else u.shape[1])
-    return SpectralData(w, Phi_yy, Phi_u)
+    out = SpectralData(w, Phi_yy, Phi_u)
+    # a windowed estimate: its resolution smooths lightly damped modes (symid.fit.frf.leakage)
+    object.__setattr__(out, "estimated_from", {"dt": float(dt_), "nperseg": int(nperseg),
+                                               "window": window if isinstance(window, (str, tuple)) else "given",
+                                               "resolution": 2 * np.pi / (nperseg * float(dt_)), "samples": int(N)})
+    return out

@@ -42,7 +42,7 @@ import scipy.signal
 
 from symid.fit.modes import estimate_poles
 
-__all__ = ["KERNEL_LINES", "LEAKAGE_SHIFT", "leakage_note", "smoothed_response"]
+__all__ = ["KERNEL_LINES", "LEAKAGE_SHIFT", "leakage_note", "smoothed_response", "smoothed_spectra"]
 
 LEAKAGE_SHIFT = 1.0
 """The window's smoothing of the fitted response is named when it moves some parameter, to first order, by more than
@@ -88,6 +88,22 @@ def smoothed_response(model: Any, theta: Any, w: Any, nperseg: int, dt: float, w
     H = H.reshape(*at.shape, *H.shape[1:])
     H = np.where((at < 0)[:, :, None, None], np.conj(H), H)  # H(−ω) = conj H(ω) for a real system
     return np.einsum("j,sjpm->spm", weights, H)
+
+
+def smoothed_spectra(model: Any, theta: Any, w: Any, Phi_uu: Any, nperseg: int, dt: float,
+                     window: Any = "hann") -> np.ndarray:
+    """The model's output spectra H Φuu Hᴴ at ``w`` as a Welch estimate sees them: each line's Φuu (taken flat
+    across the kernel) through the response at the kernel's offsets, weighted by the window's power spectrum."""
+    w = np.asarray(w, dtype=float)
+    offsets, weights = _kernel(window, int(nperseg))
+    step = 2 * np.pi / (int(nperseg) * float(dt))
+    at = w[:, None] + offsets[None, :] * step
+    H = np.asarray(model.frequency_response(theta, np.abs(at).ravel()))
+    H = H.reshape(*at.shape, *H.shape[1:])
+    H = np.where((at < 0)[:, :, None, None], np.conj(H), H)
+    P = np.asarray(Phi_uu, dtype=complex)
+    Phi = np.einsum("sjpm,smn,sjqn->sjpq", H, P, np.conj(H))
+    return np.einsum("j,sjpq->spq", weights, Phi)
 
 
 def _fewest_lines(model: Any, theta: Any, w: np.ndarray, step: float) -> tuple[float, float, float] | None:
@@ -144,8 +160,15 @@ def leakage_note(estimator: Any, data: Any, theta: Any, standard_errors: Any) ->
     model, w = estimator.model, np.asarray(estimator.data.w, dtype=float)
     se = np.asarray(standard_errors, dtype=float)
     try:
-        dH = smoothed_response(model, theta, w, nperseg, dt, window) - np.asarray(model.frequency_response(theta, w))
-        shift = np.abs(estimator.data_shift(theta, dH)) / se
+        if hasattr(estimator.data, "Phi_yy"):  # output spectra: H Φuu Hᴴ smoothed alike
+            P = np.asarray(estimator.data.Phi_uu)
+            H = np.asarray(model.frequency_response(theta, w))
+            dX = smoothed_spectra(model, theta, w, P, nperseg, dt, window) - np.einsum("spm,smn,sqn->spq", H, P,
+                                                                                       np.conj(H))
+        else:
+            dX = smoothed_response(model, theta, w, nperseg, dt, window) - np.asarray(model.frequency_response(theta,
+                                                                                                             w))
+        shift = np.abs(estimator.data_shift(theta, dX)) / se
     except Exception:  # an estimate where the model cannot be evaluated: nothing to say
         return None
     shift = np.where(np.isfinite(shift), shift, 0.0)
@@ -167,11 +190,15 @@ def leakage_note(estimator: Any, data: Any, theta: Any, standard_errors: Any) ->
                  f"half-power bandwidth")
     record = made.get("samples")
     longer = f"; the records have {record} samples, so a longer record" if record and suggested > record // 2 else ""
-    text = (f"the response was estimated by Welch segments of {nperseg} samples (si.estimate_frf; lines "
+    spectra = hasattr(estimator.data, "Phi_yy")
+    what = "spectra were estimated" if spectra else "response was estimated"
+    how = "si.estimate_spectra" if spectra else "si.estimate_frf"
+    periodic = "" if spectra else (" or with periodic excitation (estimate_frf(period=...)), whose lines have no "
+                                   "window")
+    text = (f"the {what} by Welch segments of {nperseg} samples ({how}; lines "
             f"{step / (2 * np.pi):.3g} Hz apart){where}: the window smooths the resonances, and the fit takes that "
             f"for the model's (more damping), a bias of about {moved} standard errors that the intervals do not "
-            f"include. Estimate the response with longer segments (nperseg={suggested}{longer}) or with periodic "
-            f"excitation (estimate_frf(period=...)), whose lines have no window")
+            f"include. Estimate them with longer segments (nperseg={suggested}{longer}){periodic}")
     return {"text": text, "shifts": dict(zip(names, shift.tolist(), strict=True)),
             "lines": None if mode is None else float(mode[0]), "frequency": None if mode is None else float(mode[1]),
             "zeta": None if mode is None else float(mode[2]), "nperseg": int(nperseg), "suggested": suggested}

@@ -75,6 +75,14 @@ class SpectraFisher(FisherInformation):
         wt = self._weights()
         return self._pack(Phi - Pm) * wt, -self._pack(dP) * wt[:, None]
 
+    def data_shift(self, theta: Any, dPhi: Any) -> np.ndarray:
+        """How far the estimate θ moves, to first order (one Gauss–Newton step), when the data Φyy change by ``dPhi``
+        (an array shaped like Φyy): the bias a systematic error of the spectra leaves in θ̂ (symid.fit.frf.leakage;
+        as :meth:`symid.fit.frf.fisher.FrfFisher.data_shift`)."""
+        _, J = self.jacobian(theta)
+        step, *_ = np.linalg.lstsq(J, self._pack(np.asarray(dPhi)) * self._weights(), rcond=None)
+        return -step[: np.asarray(theta).size]
+
     def residual_channels(self) -> np.ndarray:
         """One channel: a relative noise level shared by every entry."""
         return np.zeros(self._weights().size, dtype=int)
