@@ -104,3 +104,12 @@ def test_spectra_from_coarse_welch_lines_name_the_bias_too():
     assert "LEAKAGE: the spectra were estimated by Welch segments of 512 samples" in coarse.summary()
     assert abs(coarse.theta_vector[0] / TRUTH[0] - 1) > 0.1  # the bias it names (measured: 26 % low)
     assert "leakage" not in fine.options and abs(fine.theta_vector[0] / TRUTH[0] - 1) < 0.05
+    # a failed fit says it first, before the noise advice that would accept the biased estimate (the footbridge
+    # from 20 s: "give noise_floor= about this misfit")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", si.DataWarning)
+        failed = si.identify(model, si.estimate_spectra(io, nperseg=512, band=band), x0=TRUTH, noise_floor=1e-12,
+                             identifiability_check=False)
+    assert not failed.success
+    first = next(x for x in failed.summary().splitlines() if x.startswith("NEXT"))
+    assert first.startswith("NEXT: the spectra were estimated by Welch segments of 512 samples")

@@ -535,6 +535,10 @@ class IdentificationResult:
                     lines.append("NEXT (also): " + _offset_advice(offset))
             elif (offset := self.options.get("initial_offset")) is not None:
                 lines.append("NEXT: " + _offset_advice(offset))
+            elif self.options.get("leakage") is not None:
+                # before the noise advice, which would accept the biased fit (a new user's footbridge from a 20 s
+                # record: told to give noise_floor= at a misfit the window's smoothing explains)
+                lines.append(f"NEXT: {self.options['leakage']['text']}")
             elif self.method == "scr" and self.polished is None and not self.fit.startswith("pulled beyond"):
                 # SCR solves the bilinear equations, not the misfit: its polish is the remedy measured first (a new
                 # user's building from output spectra: misfit 0.098 from every start, 3.6e-4 and a fit polished)
@@ -546,8 +550,8 @@ class IdentificationResult:
                 lines.append(f"NEXT: {advice}")
         if (scale := self.options.get("output_only_scale")) is not None:  # of a fit or not: what spectra cannot say
             lines.append(f"SCALE: {scale['text']}")
-        if (leak := self.options.get("leakage")) is not None:  # of a fit or not: the data's own bias
-            lines.append(f"{'LEAKAGE' if self.success else 'NEXT (also)'}: {leak['text']}")
+        if (leak := self.options.get("leakage")) is not None and not any(leak["text"] in x for x in lines):
+            lines.append(f"{'LEAKAGE' if self.success else 'NEXT (also)'}: {leak['text']}")  # the data's own bias
         if not self.success and (sampled := self.options.get("sampled_response")) is not None:
             # beside the other advice, not instead of it: a new user's steering in degrees, from a sampled (not held)
             # input, was told only of the hold
