@@ -160,7 +160,13 @@ from scipy.optimize import least_squares
 
 from symid.errors import ModelError, OptionError
 from symid.fit.bounded import bounds_option, clip_into, log_box, named_bounds, on_bounds
-from symid.fit.frf.misfit import VARIANCE_OPTION_DOC, FrfEstimator, NoiseWeighted, frf_weights
+from symid.fit.frf.misfit import (
+    RELATIVE_COST_KIND,
+    VARIANCE_OPTION_DOC,
+    FrfEstimator,
+    NoiseWeighted,
+    frf_weights,
+)
 from symid.fit.options import (
     check_bool,
     check_float,
@@ -550,6 +556,7 @@ class LmFRF(NoiseWeighted, FrfEstimator):
         centre, unit = self._units(x0)
         if self.options["variance"] == "relative":  # every start from the measured |H|'s weights
             self.line_weights = frf_weights(self.data, "relative")
+            self.cost_kind = RELATIVE_COST_KIND  # type: ignore[misc]
             self._weights_changed()
         self._box = None
         if self._bounded:
