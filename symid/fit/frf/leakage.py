@@ -63,6 +63,17 @@ def _kernel(window: Any, nperseg: int) -> tuple[np.ndarray, np.ndarray]:
     return offsets, weights / weights.sum()
 
 
+def _across_kernel(model: Any, theta: Any, w: Any, nperseg: int, dt: float, window: Any
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """(the kernel's weights (k,), the response at each line's k offsets (s, k, p, m)): what both smoothings share."""
+    w = np.asarray(w, dtype=float)
+    offsets, weights = _kernel(window, int(nperseg))
+    at = w[:, None] + offsets[None, :] * (2 * np.pi / (int(nperseg) * float(dt)))
+    H = np.asarray(model.frequency_response(theta, np.abs(at).ravel()))
+    H = H.reshape(*at.shape, *H.shape[1:])
+    return weights, np.where((at < 0)[:, :, None, None], np.conj(H), H)  # H(−ω) = conj H(ω) for a real system
+
+
 def smoothed_response(model: Any, theta: Any, w: Any, nperseg: int, dt: float, window: Any = "hann") -> np.ndarray:
     """The model's response at ``w`` as a Welch H1 estimate with a flat input spectrum sees it: smoothed by the
     window's power spectrum over ±:data:`KERNEL_LINES` lines of 2π/(nperseg·dt) (module notes).
@@ -80,13 +91,7 @@ def smoothed_response(model: Any, theta: Any, w: Any, nperseg: int, dt: float, w
     >>> np.round(np.abs(smooth / exact), 3).tolist()                              # the peak flattened
     [1.003, 0.339]
     """
-    w = np.asarray(w, dtype=float)
-    offsets, weights = _kernel(window, int(nperseg))
-    step = 2 * np.pi / (int(nperseg) * float(dt))
-    at = w[:, None] + offsets[None, :] * step
-    H = np.asarray(model.frequency_response(theta, np.abs(at).ravel()))
-    H = H.reshape(*at.shape, *H.shape[1:])
-    H = np.where((at < 0)[:, :, None, None], np.conj(H), H)  # H(−ω) = conj H(ω) for a real system
+    weights, H = _across_kernel(model, theta, w, nperseg, dt, window)
     return np.einsum("j,sjpm->spm", weights, H)
 
 
@@ -94,13 +99,7 @@ def smoothed_spectra(model: Any, theta: Any, w: Any, Phi_uu: Any, nperseg: int, 
                      window: Any = "hann") -> np.ndarray:
     """The model's output spectra H Φuu Hᴴ at ``w`` as a Welch estimate sees them: each line's Φuu (taken flat
     across the kernel) through the response at the kernel's offsets, weighted by the window's power spectrum."""
-    w = np.asarray(w, dtype=float)
-    offsets, weights = _kernel(window, int(nperseg))
-    step = 2 * np.pi / (int(nperseg) * float(dt))
-    at = w[:, None] + offsets[None, :] * step
-    H = np.asarray(model.frequency_response(theta, np.abs(at).ravel()))
-    H = H.reshape(*at.shape, *H.shape[1:])
-    H = np.where((at < 0)[:, :, None, None], np.conj(H), H)
+    weights, H = _across_kernel(model, theta, w, nperseg, dt, window)
     P = np.asarray(Phi_uu, dtype=complex)
     Phi = np.einsum("sjpm,smn,sjqn->sjpq", H, P, np.conj(H))
     return np.einsum("j,sjpq->spq", weights, Phi)
@@ -163,8 +162,7 @@ def leakage_note(estimator: Any, data: Any, theta: Any, standard_errors: Any) ->
         if hasattr(estimator.data, "Phi_yy"):  # output spectra: H Φuu Hᴴ smoothed alike
             P = np.asarray(estimator.data.Phi_uu)
             H = np.asarray(model.frequency_response(theta, w))
-            dX = smoothed_spectra(model, theta, w, P, nperseg, dt, window) - np.einsum("spm,smn,sqn->spq", H, P,
-                                                                                       np.conj(H))
+            dX = smoothed_spectra(model, theta, w, P, nperseg, dt, window) - H @ P @ np.conj(np.swapaxes(H, 1, 2))
         else:
             dX = smoothed_response(model, theta, w, nperseg, dt, window) - np.asarray(model.frequency_response(theta,
                                                                                                              w))
