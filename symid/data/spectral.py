@@ -92,9 +92,10 @@ class SpectralData(DataContainer):
     _npz_keys: ClassVar[tuple[str, ...]] = ("w", "Phi_yy", "Phi_uu")
     estimated_from: ClassVar[dict[str, Any]] = {}
     """How :func:`symid.estimate_spectra` made these spectra from sampled records: ``{"dt", "nperseg", "window",
-    "resolution" (the line spacing, rad/s), "samples"}``; ``{}`` for spectra from anywhere else. Set on the object
-    made (not kept by a copy or a file): :func:`symid.identify` names the window's bias when it moves the estimate
-    (:mod:`symid.fit.frf.leakage`)."""
+    "resolution" (the line spacing, rad/s), "samples", "noverlap", "input" ("given" or "measured")}``; ``{}`` for
+    spectra from anywhere else. Set on the object made (not kept by a copy or a file): :func:`symid.identify` names
+    the window's bias when it moves the estimate (:mod:`symid.fit.frf.leakage`), and ``method="auto"`` weighs the
+    spectra by their scatter and judges the fit against it (:mod:`symid.fit.spectra.welch`)."""
 
     def __init__(self, w: Any, Phi_yy: Any, Phi_uu: Any):
         w_ = checks.frequencies(w, "w")

@@ -548,8 +548,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                           f"the finished starts are in the exception's .partial result", partial) from None
     result = IdentificationResult.from_starts(estimator.method, model.parameter_names, outcomes,
                                               cost_kind=estimator.cost_kind, options=options_used)
-    if estimator.method in ("lm", "auto") and hasattr(estimator, "reweigh_relative") and np.all(
-            np.isfinite(result.theta_vector)):  # variance="relative": the weights of the best start's own estimate
+    reweighs = estimator.method in ("lm", "auto") or estimator.options.get("weighting") == "variance"
+    if reweighs and hasattr(estimator, "reweigh_relative") and np.all(np.isfinite(result.theta_vector)):
+        # variance="relative" (weighting="variance" on spectra): the weights of the best start's own estimate
         estimator.reweigh_relative(result.theta_vector)
     if (isinstance(estimator, FisherInformation) and np.all(np.isfinite(result.theta_vector))
             and np.isfinite(result.cost)):  # not where the model cannot be evaluated (e.g. a mass on its bound 0)
@@ -717,6 +718,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         if scale_note is not None:
             result = dataclasses.replace(result, options={**result.options, "output_only_scale": scale_note})
             warnings.warn(scale_note["text"], DataWarning, stacklevel=2)
+        if getattr(estimator, "sensor_noise", False) and (nu := estimator.sensor_noise_at(result.theta_vector)) \
+                is not None:  # the nuisance fitted beside the model (symid.fit.spectra.welch): what it took
+            result = dataclasses.replace(result, options={**result.options, "sensor_noise_levels": nu.tolist()})
     made = getattr(data, "estimated_from", None) or {}
     if (hasattr(estimator, "data_shift") and made.get("nperseg") and np.all(np.isfinite(result.theta_vector))
             and result.uncertainty is not None):

@@ -550,6 +550,9 @@ class IdentificationResult:
                 lines.append(f"NEXT: {advice}")
         if (scale := self.options.get("output_only_scale")) is not None:  # of a fit or not: what spectra cannot say
             lines.append(f"SCALE: {scale['text']}")
+        if (nu := self.options.get("sensor_noise_levels")) is not None:
+            lines.append("sensor noise (white, fitted beside the model's spectra): "
+                         + ", ".join(f"output {j + 1} {v:.3g}" for j, v in enumerate(nu)) + " (spectral density)")
         if (leak := self.options.get("leakage")) is not None and not any(leak["text"] in x for x in lines):
             lines.append(f"{'LEAKAGE' if self.success else 'NEXT (also)'}: {leak['text']}")  # the data's own bias
         if not self.success and (sampled := self.options.get("sampled_response")) is not None:

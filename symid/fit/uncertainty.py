@@ -322,6 +322,11 @@ class FisherInformation(abc.ABC):
         """What the covariance describes for this method ('' when the method minimises the misfit)."""
         return ""
 
+    def residual_correlation(self, theta: Any) -> Any:
+        """The correlation (N, N) of the entries of r, dense or sparse, where they are not independent; ``None``
+        (default): independent."""
+        return None
+
     def estimate_sensitivity(self, theta: Any) -> np.ndarray | None:
         """For a method that does not minimise ‖r‖²: G (l, N) with dθ̂ = G e to first order for noise e on
         the entries of r; ``None`` (default) for a least-squares minimiser of ‖r‖²."""
@@ -334,13 +339,14 @@ class FisherInformation(abc.ABC):
         channels = self.residual_channels()
         G = self.estimate_sensitivity(theta)
         note = self.uncertainty_note()
+        correlation = self.residual_correlation(theta)
         if noise_std is None:
             unc = fisher_uncertainty(theta, parameter_names, r, J, channels, shape=self.noise_shape(theta),
-                                     units=self.noise_units, sensitivity=G, note=note)
+                                     units=self.noise_units, sensitivity=G, note=note, correlation=correlation)
         else:
             std, given = self.given_noise(noise_std)
             unc = fisher_uncertainty(theta, parameter_names, r, J, channels, given_std=std, given_values=given,
-                                     sensitivity=G, note=note)
+                                     sensitivity=G, note=note, correlation=correlation)
         if G is not None:
             return unc
         lower, upper = getattr(self, "lower", None), getattr(self, "upper", None)
@@ -557,13 +563,18 @@ def _noise_levels(r: np.ndarray, J: np.ndarray, channels: np.ndarray, s: np.ndar
 def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: np.ndarray, J: np.ndarray,
                        channels: np.ndarray, *, shape: np.ndarray | None = None, units: str = "data units",
                        given_std: np.ndarray | None = None, given_values: np.ndarray | None = None,
-                       sensitivity: np.ndarray | None = None, note: str = "") -> Uncertainty:
+                       sensitivity: np.ndarray | None = None, note: str = "", correlation: Any = None
+                       ) -> Uncertainty:
     """Covariance (JᵀJ)⁻¹ JᵀVJ (JᵀJ)⁻¹ with V from the residuals or given (module text).
 
     The first ``len(theta)`` columns of J are θ; entries with zero noise shape (or given
     standard deviation) carry no noise and are left out. ``sensitivity`` (l, N), when
     given, is the method's own first-order map from the noise on the entries of r to
     θ̂ (dθ̂ = G e), for a method that does not minimise ‖r‖²; the covariance is then G V Gᵀ.
+    ``correlation`` (N, N), dense or sparse, when given, is the correlation of the entries
+    of r (1 on its diagonal): V = D R D with D the standard deviations (the sandwich's
+    middle; the Fisher information's conditioning stays that of independent entries). It
+    is used where every entry carries noise.
 
     Examples
     --------
@@ -590,6 +601,8 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     if given_std is not None:
         s = np.asarray(given_std, dtype=float).reshape(-1)
     keep = s > 0
+    if not np.all(keep):
+        correlation = None  # given for every entry: not for a subset
     r, J, channels, s = r[keep], J[keep], channels[keep], s[keep]
     Gm = None if sensitivity is None else np.asarray(sensitivity, dtype=float)[:, keep]
     if J.shape[1] > l:  # a nuisance unknown the residual does not depend on at all (an estimated initial position
@@ -636,7 +649,17 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
         return singular()
     # Fisher information F = Jᵀ V⁻¹ J; entries with no noise estimate (var = 0) carry no information here
     noisy = var > 0
+    if not np.all(noisy):
+        correlation = None
     Jn, vn = J[noisy], var[noisy]
+
+    def middle(X: np.ndarray) -> np.ndarray:
+        """Xᵀ V X for the entries' covariance V (diagonal, or with ``correlation``)."""
+        if correlation is None:
+            return X.T @ (X * vn[:, None])
+        Xs = X * np.sqrt(vn)[:, None]
+        return Xs.T @ np.asarray(correlation @ Xs)
+
     F = Jn.T @ (Jn / vn[:, None])
     d = np.sqrt(np.clip(np.diag(F), 0, None))
     safe = np.where(d > 0, d, 1.0)
@@ -668,10 +691,10 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
     gev, gvec = np.linalg.eigh(G)
     if not np.any(d == 0) and gev[0] > gev[-1] * 1e-15 and ev[0] > ev[-1] * 1e-15:
         if Gm is not None and np.all(np.isfinite(Gm)):
-            cov = (Gm * var[None, :]) @ Gm.T
+            cov = middle(Gm.T) if correlation is not None else (Gm * var[None, :]) @ Gm.T
         else:
             Ginv = (gvec / gev) @ gvec.T
-            cov_all = Ginv @ (Js.T @ (Js * vn[:, None])) @ Ginv / np.outer(safe, safe)
+            cov_all = Ginv @ middle(Js) @ Ginv / np.outer(safe, safe)
             cov = cov_all[:l, :l]
         cov = 0.5 * (cov + cov.T)
     else:
@@ -684,7 +707,7 @@ def fisher_uncertainty(theta: np.ndarray, parameter_names: tuple[str, ...], r: n
                                cond, True, weakest, units, result.noise_source, ratio, note,
                                weakest_relative=weakest_relative)
         Gpinv = (gvec[:, ~null] / gev[~null]) @ gvec[:, ~null].T
-        cov_all = Gpinv @ (Js.T @ (Js * vn[:, None])) @ Gpinv / np.outer(safe, safe)
+        cov_all = Gpinv @ middle(Js) @ Gpinv / np.outer(safe, safe)
         free = np.linalg.norm(gvec[:, null], axis=1) > _NULL_PART
         cov = 0.5 * (cov_all + cov_all.T)[:l, :l]
         cov[free[:l], :] = np.inf

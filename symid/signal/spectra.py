@@ -250,5 +250,7 @@ def estimate_spectra(data: Any, *, dt: float | None = None, Phi_uu: Any = None, 
     # a windowed estimate: its resolution smooths lightly damped modes (symid.fit.frf.leakage)
     object.__setattr__(out, "estimated_from", {"dt": float(dt_), "nperseg": int(nperseg),
                                                "window": window if isinstance(window, (str, tuple)) else "given",
-                                               "resolution": 2 * np.pi / (nperseg * float(dt_)), "samples": int(N)})
+                                               "resolution": 2 * np.pi / (nperseg * float(dt_)), "samples": int(N),
+                                               "noverlap": int(nperseg) // 2,
+                                               "input": "measured" if Phi_uu is None else "given"})
     return out

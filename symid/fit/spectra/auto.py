@@ -29,9 +29,18 @@ from typing import Any, ClassVar
 import numpy as np
 
 from symid.errors import ModelError, SymidError
-from symid.fit.options import check_bool, check_float, check_int, check_scale, check_seed, check_time_limit
+from symid.fit.options import (
+    check_bool,
+    check_choice,
+    check_float,
+    check_int,
+    check_scale,
+    check_seed,
+    check_time_limit,
+)
 from symid.fit.result import StartOutcome
 from symid.fit.spectra.equations import SpectraEstimator, check_spectral
+from symid.fit.spectra.welch import VARIANCE_ROUNDS, data_weights, spectra_averages
 
 __all__ = ["AutoPSD"]
 
@@ -58,6 +67,21 @@ class AutoPSD(SpectraEstimator):
         Run SCR (ADMM back end) when no IPOPT pass fits and Algorithm 5.1 applies (default True).
     seed : int
         Seeds the draws (with the start, so every start draws its own).
+    weighting : {"auto", "none", "variance"}
+        The misfit's weights (as IPOPT's, :class:`~symid.fit.spectra.ipopt.IpoptPSD`):
+        ``"variance"`` weighs each entry by its scatter in a Welch estimate and judges the
+        fit against the noise of the averages; the passes run in the measured
+        auto-spectra's weights, the best is then reweighted at its estimate
+        (:mod:`symid.fit.spectra.welch`). ``"auto"`` (default): ``"variance"`` where the
+        number of averages is known (``averages=``, or the spectra estimated by
+        :func:`symid.estimate_spectra` from output records with a given input spectrum),
+        else ``"none"``, the equal weights of (5-13).
+    averages : float, optional
+        The independent averages behind each line (as IPOPT's).
+    sensor_noise : {"auto", True, False}
+        Fit a white noise on each output's auto-spectrum beside the model's (as IPOPT's);
+        ``"auto"`` (default): with ``weighting="variance"``, whose weights let the lines
+        where sensor noise dominates carry the fit otherwise.
     pass_iter : int
         IPOPT's iteration limit in each pass (default 500; IPOPT's own default for one
         run is 3000).
@@ -80,7 +104,8 @@ class AutoPSD(SpectraEstimator):
     method: ClassVar[str] = "auto"
 
     def __init__(self, model: Any, data: Any, *, scale: Any = None, bounds: Any = None, positivity: bool = True,
-                 restarts: int = 8, spread: float = 10.0, scr: bool = True, seed: int = 0, pass_iter: int = 500,
+                 restarts: int = 8, spread: float = 10.0, scr: bool = True, seed: int = 0, weighting: str = "auto",
+                 averages: float | None = None, sensor_noise: Any = "auto", pass_iter: int = 500,
                  time_limit: float | None = 300.0):
         from symid.fit.spectra.ipopt import IpoptPSD
 
@@ -94,15 +119,37 @@ class AutoPSD(SpectraEstimator):
         self.seed = check_seed("seed", seed)
         self.time_limit = check_time_limit("time_limit", time_limit)
         self.pass_iter = check_int("pass_iter", pass_iter, low=1, high=10**7)
+        weighting = check_choice("weighting", weighting, ("auto", "none", "variance"))
+        if averages is not None:
+            averages = check_float("averages", averages, low=1.0)
+        known = averages if averages is not None else spectra_averages(data)
+        if weighting == "auto":
+            weighting = "variance" if known is not None else "none"
+        if isinstance(sensor_noise, str):
+            sensor_noise = check_choice("sensor_noise", sensor_noise, ("auto",)) and weighting == "variance"
         self._ipopt = IpoptPSD(model, data, scale=self.scale, bounds=bounds, positivity=positivity,
-                               max_iter=self.pass_iter)
+                               max_iter=self.pass_iter, weighting=weighting, averages=averages,
+                               sensor_noise=check_bool("sensor_noise", sensor_noise))
+        self.averages, self.sensor_noise = self._ipopt.averages, self._ipopt.sensor_noise
         self.lower, self.upper = self._ipopt.lower, self._ipopt.upper
         self.options = {"scale": None if self.scale is None else self.scale.tolist(),
                         "bounds": self._ipopt.options["bounds"], "positivity": positivity,
                         "restarts": self.restarts, "spread": self.spread, "scr": self.use_scr, "seed": self.seed,
-                        "pass_iter": self.pass_iter, "time_limit": self.time_limit}
+                        "weighting": weighting, "averages": self.averages, "sensor_noise": self.sensor_noise,
+                        "pass_iter": self.pass_iter,
+                        "time_limit": self.time_limit}
         self._typical: np.ndarray | None = self.scale
         self._scr_estimator: Any = None
+        self._share_weights()
+
+    def _share_weights(self) -> None:
+        """This estimator's misfit (and success rule, and uncertainty) in the weights its IPOPT passes have."""
+        self.set_entry_weights(self._ipopt.entry_weights)
+
+    def reweigh_relative(self, theta: Any) -> None:
+        """With ``weighting="variance"``: the weights of the model's spectra at θ, here and in the passes."""
+        self._ipopt.reweigh_relative(theta)
+        self._share_weights()
 
     def check_start(self, x0: Any) -> None:
         """Refuse a start outside the bounds (an :class:`OptionError` naming the parameter)."""
@@ -148,11 +195,15 @@ class AutoPSD(SpectraEstimator):
             rest = left()
             return rest is not None and rest <= 0
 
-        def ipopt_from(start: np.ndarray) -> StartOutcome:
+        def ipopt_from(start: np.ndarray, rounds: int = 0) -> StartOutcome:
             start = np.clip(start, self.lower, self.upper)
             rest = left()  # a pass begun with the budget nearly spent (a polish after SCR) still gets a second
-            return self._ipopt.run(start, time_limit=None if rest is None else max(rest, 1.0))
+            return self._ipopt.run(start, time_limit=None if rest is None else max(rest, 1.0), rounds=rounds)
 
+        variance = self.options["weighting"] == "variance"
+        if variance:  # every start from the measured auto-spectra's weights
+            self._ipopt.set_entry_weights(data_weights(self.data))
+            self._share_weights()
         out = ipopt_from(x0)
         passes.append(out)
         words.append("pass 0 from the start")
@@ -176,10 +227,22 @@ class AutoPSD(SpectraEstimator):
             with warnings.catch_warnings():  # its own warnings (many lines for Clarabel) are not this method's
                 warnings.simplefilter("ignore")
                 relaxed = scr.run(min(passes, key=lambda p: p.cost).theta)
+            if variance:  # SCR's own misfit is the unweighted one: compared with the passes in theirs
+                relaxed = self.outcome(relaxed.start, relaxed.theta, finished=relaxed.finished, status=relaxed.status,
+                                       message=relaxed.message, iterations=relaxed.iterations,
+                                       wall_time=relaxed.wall_time)
             polished = ipopt_from(relaxed.theta) if np.all(np.isfinite(relaxed.theta)) else relaxed
             passes.extend([relaxed, polished])
             words.append("SCR (ADMM) and IPOPT from its estimate")
         best = next((p for p in passes if p.success), None) or min(passes, key=lambda p: p.cost)
+        if variance and np.all(np.isfinite(best.theta)) and not spent():
+            # weights from the model's spectra at the best estimate, not the measured ones (symid.fit.spectra.welch)
+            # it replaces the pass it started from: that estimate, in other weights, is no alternative to it
+            reweighted = ipopt_from(best.theta, rounds=VARIANCE_ROUNDS)
+            passes[next(i for i, p in enumerate(passes) if p is best)] = reweighted
+            best = reweighted
+            words.append("the best reweighted by the model's spectra at its estimate")
+            self._share_weights()
         others = tuple(p for p in passes if p is not best)
         message = (f"{len(passes)} pass(es); " + "; ".join(words) + f"; best: {best.status}")
         result = self.outcome(x0, best.theta, finished=best.finished, status=best.status, message=message,

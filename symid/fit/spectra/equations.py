@@ -21,8 +21,8 @@ from symid.fit.base import Estimator
 from symid.fit.spectra.fisher import SpectraFisher
 from symid.model.secondorder import SecondOrderModel, output_factor
 
-__all__ = ["SpectraEstimator", "SpectralEquations", "check_spectral", "model_spectra", "spectral_equations",
-           "spectral_misfit", "spectral_residuals"]
+__all__ = ["VARIANCE_COST_KIND", "SpectraEstimator", "SpectralEquations", "check_spectral", "model_spectra",
+           "spectral_equations", "spectral_misfit", "spectral_residuals"]
 
 
 @dataclass(frozen=True)
@@ -152,19 +152,32 @@ def model_spectra(model: Any, theta: Any, w: Any, Phi_uu: np.ndarray) -> np.ndar
     return H @ Phi_uu @ np.conj(np.swapaxes(H, 1, 2))
 
 
-def _model_spectra_or_none(model: Any, data: Any, theta: Any) -> np.ndarray | None:
+def _model_spectra_or_none(model: Any, data: Any, theta: Any, weights: Any = None,
+                           sensor_noise: bool = False) -> np.ndarray | None:
+    """H Φuu Hᴴ at θ (with ``sensor_noise``, plus the profiled white noise on each auto-spectrum), or None."""
     try:
         with np.errstate(all="ignore"):
             Pm = model_spectra(model, theta, data.w, np.asarray(data.Phi_uu))
     except (ModelError, np.linalg.LinAlgError, FloatingPointError):
         return None
-    return Pm if np.all(np.isfinite(Pm)) else None
+    if not np.all(np.isfinite(Pm)):
+        return None
+    if sensor_noise:
+        from symid.fit.spectra.welch import profiled_sensor_noise
+
+        nu = profiled_sensor_noise(data, Pm, weights)
+        Pm = Pm + np.diag(nu)[None, :, :]
+    return Pm
 
 
-def spectral_misfit(model: Any, data: Any, theta: Any) -> float:
+def spectral_misfit(model: Any, data: Any, theta: Any, weights: Any = None, sensor_noise: bool = False) -> float:
     """Relative squared misfit Σᵢ‖Φyyᵢ − H Φuuᵢ Hᴴ‖²_F / Σᵢ‖Φyyᵢ‖²_F (the objective of (5-13), normalised).
 
-    Returns ``inf`` when the model cannot be evaluated at θ.
+    With ``weights`` (s, p, p) w, the weighted Σ w|Φyy − H Φuu Hᴴ|² / Σ w|Φyy|², entry by
+    entry (:mod:`symid.fit.spectra.welch`); with ``sensor_noise``, the model's spectra
+    plus the white noise on each output that fits best
+    (:func:`~symid.fit.spectra.welch.profiled_sensor_noise`). Returns ``inf`` when the
+    model cannot be evaluated at θ.
 
     Examples
     --------
@@ -177,40 +190,87 @@ def spectral_misfit(model: Any, data: Any, theta: Any) -> float:
     True
     """
     Phi = np.asarray(data.Phi_yy)
-    Pm = _model_spectra_or_none(model, data, theta)
+    Pm = _model_spectra_or_none(model, data, theta, weights, sensor_noise)
     if Pm is None:
         return float("inf")
     scale = float(np.max(np.abs(Phi)))  # sums on Φ / max|Φ|: no under- or overflow
     if scale == 0.0:
         return 0.0 if not np.any(Pm) else float("inf")
-    return float(np.sum(np.abs((Phi - Pm) / scale) ** 2) / np.sum(np.abs(Phi / scale) ** 2))
+    w = 1.0 if weights is None else np.asarray(weights, dtype=float)
+    return float(np.sum(w * np.abs((Phi - Pm) / scale) ** 2) / np.sum(w * np.abs(Phi / scale) ** 2))
 
 
-def spectral_residuals(model: Any, data: Any, theta: Any) -> np.ndarray | None:
-    """The residuals whose sum of squares is :func:`spectral_misfit`: (Φyyᵢ − H Φuuᵢ Hᴴ) / √Σ‖Φyyᵢ‖²_F,
-    frequency first; ``None`` if not evaluable. The success rule's whiteness test takes these
-    (:func:`symid.fit.success.whiteness`)."""
+def spectral_residuals(model: Any, data: Any, theta: Any, weights: Any = None,
+                       sensor_noise: bool = False) -> np.ndarray | None:
+    """The residuals whose sum of squares is :func:`spectral_misfit`: (Φyyᵢ − H Φuuᵢ Hᴴ) / √Σ‖Φyyᵢ‖²_F (each
+    entry times √w with ``weights``), frequency first; ``None`` if not evaluable. The success rule's whiteness
+    test takes these (:func:`symid.fit.success.whiteness`)."""
     Phi = np.asarray(data.Phi_yy)
-    Pm = _model_spectra_or_none(model, data, theta)
+    Pm = _model_spectra_or_none(model, data, theta, weights, sensor_noise)
     if Pm is None:
         return None
     scale = float(np.max(np.abs(Phi))) or 1.0  # as in spectral_misfit: no under- or overflow
-    return (Phi - Pm) / scale / (float(np.sqrt(np.sum(np.abs(Phi / scale) ** 2))) or 1.0)
+    w = 1.0 if weights is None else np.asarray(weights, dtype=float)
+    return (Phi - Pm) / scale * np.sqrt(w) / (float(np.sqrt(np.sum(w * np.abs(Phi / scale) ** 2))) or 1.0)
+
+
+VARIANCE_COST_KIND = ("relative spectral misfit weighted by the scatter, Σ w|Φyy − H Φuu Hᴴ|² / Σ w|Φyy|², "
+                      "w = 1/(Φⱼⱼ Φₖₖ) of the model")
+"""What the misfit measures with ``weighting="variance"`` (:mod:`symid.fit.spectra.welch`)."""
 
 
 class SpectraEstimator(Estimator, SpectraFisher):
     """Base of the spectral methods: their data misfit (relative, squared, on Φyy), and its Fisher
-    information for the uncertainty of θ̂ (:mod:`symid.fit.spectra.fisher`)."""
+    information for the uncertainty of θ̂ (:mod:`symid.fit.spectra.fisher`).
+
+    ``entry_weights`` (s, p, p), when set (:meth:`set_entry_weights`), weighs each entry of the
+    misfit (``weighting="variance"``, :mod:`symid.fit.spectra.welch`); with the number of
+    averages behind Welch spectra known, the noise floor the fit is judged against follows
+    (unless one is given)."""
 
     cost_kind = "relative spectral misfit Σ‖Φyyᵢ − H Φuuᵢ Hᴴ‖²_F / Σ‖Φyyᵢ‖²_F"
+    entry_weights: np.ndarray | None = None
+    averages: float | None = None
+    sensor_noise: bool = False
+    _given_floor: float | None = None
+    _welch_floor: float | None = None
+
+    @property  # type: ignore[override]
+    def noise_floor(self) -> float | None:
+        """The floor given (``noise_floor=``), else that of the Welch averages with ``weighting="variance"``."""
+        return self._given_floor if self._given_floor is not None else self._welch_floor
+
+    @noise_floor.setter
+    def noise_floor(self, value: float | None) -> None:
+        self._given_floor = value
+
+    def set_entry_weights(self, weights: np.ndarray | None) -> None:
+        """Weigh the misfit's entries by ``weights`` (s, p, p) (``None``: equally), its name and the Welch noise
+        floor (with ``averages`` known) with them."""
+        from symid.fit.spectra.welch import WELCH_FLOOR_MARGIN, welch_noise_floor
+
+        self.entry_weights = None if weights is None else np.asarray(weights, dtype=float)
+        self.cost_kind = type(self).cost_kind if weights is None else VARIANCE_COST_KIND  # type: ignore[misc]
+        self._welch_floor = (None if weights is None or self.averages is None else
+                             WELCH_FLOOR_MARGIN * welch_noise_floor(self.data, self.entry_weights, self.averages))
 
     def misfit(self, theta: np.ndarray) -> float:
         """:func:`spectral_misfit` of the model at θ."""
-        return spectral_misfit(self.model, self.data, theta)
+        return spectral_misfit(self.model, self.data, theta, self.entry_weights, self.sensor_noise)
 
     def residuals(self, theta: np.ndarray) -> np.ndarray | None:
         """:func:`spectral_residuals` at θ."""
-        return spectral_residuals(self.model, self.data, theta)
+        return spectral_residuals(self.model, self.data, theta, self.entry_weights, self.sensor_noise)
+
+    def sensor_noise_at(self, theta: Any) -> np.ndarray | None:
+        """With ``sensor_noise``: the white noise on each output's auto-spectrum that fits best at θ (p,); else
+        None."""
+        if not self.sensor_noise:
+            return None
+        from symid.fit.spectra.welch import profiled_sensor_noise
+
+        Pm = _model_spectra_or_none(self.model, self.data, theta)
+        return None if Pm is None else profiled_sensor_noise(self.data, Pm, self.entry_weights)
 
     def n_data(self) -> int:
         """s·p² real values (a Hermitian p×p spectrum per frequency)."""
