@@ -417,7 +417,7 @@ def _independence(rho_e: np.ndarray, rho_u: np.ndarray, rho: np.ndarray, N: int)
 
 
 def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, max_lag: int | None = None,
-             confidence: float = 0.99, hold: str = "zoh", variance: Any = None) -> Validation:
+             confidence: float = 0.99, hold: Any = "zoh", variance: Any = None) -> Validation:
     """Simulate the model at θ on measured records and test what is left (module text).
 
     The simulation holds the input constant between samples (zero-order hold), as
@@ -455,8 +455,9 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         says so.
     confidence : {0.99, 0.95}
         Level of the bands and tests.
-    hold : {"zoh", "foh", "bandlimited"}
-        How the input moves between samples in the simulation: held (``"zoh"``, default, as
+    hold : {"zoh", "foh", "bandlimited"} or list of them
+        How the input moves between samples in the simulation (one per input where they
+        differ, :func:`symid.fit.timeseries.oe.parse_hold`): held (``"zoh"``, default, as
         :class:`~symid.data.IOData` defines a record), linear (``"foh"``) or band-limited
         (``"bandlimited"``, for a sampled band-limited input: its band-limited interpolation,
         :func:`symid.fit.timeseries.records.band_limited`), as ``si.identify``'s option of
@@ -610,14 +611,19 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
                       t_fine=fine[0], y_fine=fine[1], channel_names=_record_columns(data))
 
 
-def _fine_curves(model: Any, theta: np.ndarray, recs: Any, x0s: Any, hold: str
+def _fine_curves(model: Any, theta: np.ndarray, recs: Any, x0s: Any, hold: Any
                  ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
     """(t_fine, y_fine) per record (class notes): each sample interval cut into equal steps, the input held (or
-    linear, ``hold="foh"``) between samples as in the simulation, from the record's initial state."""
+    linear, ``hold="foh"``, one per input where they differ) between samples as in the simulation, from the record's
+    initial state."""
+    from symid.fit.timeseries.oe import parse_hold
     from symid.fit.timeseries.response import simulate_output
 
-    if hold == "bandlimited":
+    kinds = parse_hold(list(hold) if isinstance(hold, (list, tuple)) else hold, recs[0].u.shape[1])
+    kinds = kinds if isinstance(kinds, tuple) else (kinds,) * recs[0].u.shape[1]
+    if "bandlimited" in kinds:
         return (), ()
+    held = np.array([k == "zoh" for k in kinds])
     A, B, C, D = model.state_space(theta)
     ts, ys = [], []
     for r, x0 in zip(recs, x0s, strict=True):
@@ -629,10 +635,9 @@ def _fine_curves(model: Any, theta: np.ndarray, recs: Any, x0s: Any, hold: str
         q = max(1, FINE_POINTS // (N - 1))  # steps per interval: equal within it, few distinct lengths overall
         frac = np.arange(q) / q
         t = np.concatenate([(r.t[:-1, None] + frac[None, :] * np.diff(r.t)[:, None]).ravel(), r.t[-1:]])
-        if hold == "foh":
-            u = np.column_stack([np.interp(t, r.t, r.u[:, i]) for i in range(r.u.shape[1])])
-        else:  # held from each sample to the next
-            u = np.concatenate([np.repeat(r.u[:-1], q, axis=0), r.u[-1:]])
+        linear = np.column_stack([np.interp(t, r.t, r.u[:, i]) for i in range(r.u.shape[1])])
+        steps = np.concatenate([np.repeat(r.u[:-1], q, axis=0), r.u[-1:]])  # held from each sample to the next
+        u = np.where(held[None, :], steps, linear)
         ts.append(t)
-        ys.append(simulate_output(A, B, C, D, t, u, x0, hold=hold))
+        ys.append(simulate_output(A, B, C, D, t, u, x0, hold="foh", held=held))
     return tuple(ts), tuple(ys)

@@ -157,7 +157,7 @@ class AutoOutputError(OutputError):
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = 120.0, callback: Any = None, verbose: bool = False,
                  restarts: int = 10, spread: float = 10.0, seed: int = 0, black_box_start: bool = True,
-                 solver: str = "trf", bounds: Any = None, variance: Any = None, hold: str = "zoh",
+                 solver: str = "trf", bounds: Any = None, variance: Any = None, hold: Any = "zoh",
                  black_box_decimation: bool = False):
         budget = check_time_limit("time_limit", time_limit)
         super().__init__(model, data, initial_state=initial_state, scale=scale, positivity=positivity,

@@ -79,8 +79,9 @@ from symid.fit.timeseries.response import balancing, casadi_output, simulate_out
 from symid.fit.timeseries.sensitivity import output_sensitivity, state_space_derivatives
 from symid.fit.uncertainty import FisherInformation, broadcast_noise
 
-__all__ = ["ERROR_MODEL_WEIGHTS", "EXACT_BUILD_RATE", "REWEIGHTS", "REWEIGHT_TOL", "SOLVERS", "SQUARING_MARGIN",
-           "WEIGHTED_COST_KIND", "OutputError", "error_model_parts", "error_model_variance"]
+__all__ = ["ERROR_MODEL_WEIGHTS", "EXACT_BUILD_RATE", "HOLDS", "REWEIGHTS", "REWEIGHT_TOL", "SOLVERS",
+           "SQUARING_MARGIN", "WEIGHTED_COST_KIND", "OutputError", "error_model_parts", "error_model_variance",
+           "parse_hold"]
 
 SOLVERS = ("ipopt", "trf")
 """The ``solver`` choices of :class:`OutputError`."""
@@ -167,6 +168,32 @@ def _known_states(value: Any, n: int, n_records: int) -> list[np.ndarray]:
 
 HOLDS = ("zoh", "foh", "bandlimited")
 """How the input moves between samples (``hold=``): held, linear, or band-limited (:func:`band_limited`)."""
+
+
+def parse_hold(hold: Any, n_inputs: int) -> str | tuple[str, ...]:
+    """``hold=`` as one of :data:`HOLDS` for every input, or a tuple of one per input where they differ.
+
+    A list or tuple gives one per input, in the records' input order; a string may join them with commas
+    (``"zoh,foh"``, as the command line passes it). A new user's room model (heater power switched by a controller,
+    outdoor temperature measured): with the one hold of all inputs, the intervals of two conductances held the truth
+    in 1 and 4 of 12 records with ``success`` (held, the temperature's ramps between samples were steps; linear or
+    band-limited, the heater's steps were ramps, and the fit failed).
+
+    Examples
+    --------
+    >>> from symid.fit.timeseries.oe import parse_hold
+    >>> parse_hold("zoh,foh", 2), parse_hold(["foh", "foh"], 2), parse_hold("bandlimited", 3)
+    (('zoh', 'foh'), 'foh', 'bandlimited')
+    """
+    if isinstance(hold, str) and "," in hold:
+        hold = [h.strip() for h in hold.split(",")]
+    if isinstance(hold, (list, tuple)):
+        if len(hold) != n_inputs:
+            raise OptionError(f"hold gives {len(hold)} hold(s) for {n_inputs} input(s): one per input, in the "
+                              f"records' order (each one of {', '.join(map(repr, HOLDS))}), or one for all")
+        kinds = tuple(check_choice(f"hold[{j}]", h, HOLDS) for j, h in enumerate(hold))
+        return kinds[0] if len(set(kinds)) == 1 else kinds
+    return check_choice("hold", hold, HOLDS)
 
 _HOLD_WORDS = {"foh": "linear between samples", "bandlimited": "band-limited between samples"}
 
@@ -379,7 +406,10 @@ class OutputError(Estimator, FisherInformation):
         (linear interpolation attenuates a band-limited input by about (ω dt)²/12), 22 standard
         errors; band-limited, within 0.035 %, 0.6 standard errors at most, and a residual
         white and independent of the input (``tests/test_timeseries_fit.py``). Equally spaced
-        samples only; four times the work of ``"foh"``.
+        samples only; four times the work of ``"foh"``. One per input (a list, or the names
+        joined by commas, ``"zoh,foh"``) where the inputs differ: a heater switched by a
+        controller (held) beside a measured outdoor temperature (linear or band-limited)
+        (:func:`parse_hold`).
     max_iter : int, optional
         IPOPT iteration limit, or residual evaluations of ``"trf"`` (default 500).
     tol : float, optional
@@ -426,16 +456,20 @@ class OutputError(Estimator, FisherInformation):
     def __init__(self, model: Any, data: Any, *, initial_state: Any = None, scale: Any = None,
                  positivity: bool = True, hessian: str = "auto", max_iter: int = 500, tol: float = 1e-12,
                  time_limit: float | None = None, callback: Any = None, verbose: bool = False,
-                 solver: str = "trf", bounds: Any = None, variance: Any = None, hold: str = "zoh"):
+                 solver: str = "trf", bounds: Any = None, variance: Any = None, hold: Any = "zoh"):
         self._x0_mode, self._x0_known = _initial_state_mode(model, initial_state)
         self.records = as_records(model, data, estimate_x0=self._x0_mode == "estimate")
         # outputs not measured (NaN in a TimeSeries) are left out of the misfit: weight 0, the value 0 in their place
         self._observed = [~np.isnan(r.y) for r in self.records]
         self.n_missing = sum(int(np.count_nonzero(~o)) for o in self._observed)
-        self.hold = check_choice("hold", hold, HOLDS)
+        self.hold = parse_hold(hold, self.records[0].n_inputs)
+        kinds = self.hold if isinstance(self.hold, tuple) else (self.hold,)
+        self._upsampled = "bandlimited" in kinds  # the input at points between the samples, where no output is
+        self._held = (np.array([k == "zoh" for k in kinds]) if isinstance(self.hold, tuple) else None)
         self._sample_counts = [r.n_samples for r in self.records]  # the user's, before any points between them
-        if self.hold == "bandlimited":  # the input at points between the samples, where no output is measured
-            self.records = tuple(band_limited(r, f"record {e}" if len(self.records) > 1 else "the record")
+        if self._upsampled:  # measured
+            self.records = tuple(band_limited(r, f"record {e}" if len(self.records) > 1 else "the record",
+                                              holds=self.hold if isinstance(self.hold, tuple) else None)
                                  for e, r in enumerate(self.records))
             self._observed = [~np.isnan(r.y) for r in self.records]
         if any(not np.all(o) for o in self._observed):
@@ -460,7 +494,9 @@ class OutputError(Estimator, FisherInformation):
         self._solver_kind = check_choice("solver", solver, SOLVERS)
         self._hold = "zoh" if self.hold == "zoh" else "foh"  # the simulation's: linear between the (fine) points
         if self._hold == "foh" and self._solver_kind != "trf":
-            raise OptionError(f"hold={self.hold!r} (the input {_HOLD_WORDS[self.hold]}) is simulated by "
+            words = (_HOLD_WORDS[self.hold] if isinstance(self.hold, str) else
+                     "not held throughout: " + ", ".join(f"input {j} {k}" for j, k in enumerate(self.hold)))
+            raise OptionError(f"hold={self.hold!r} (the input {words}) is simulated by "
                               "solver='trf' only; IPOPT's graph holds the input: leave solver out")
         if self._solver_kind == "trf" and self._hessian != "auto":
             raise OptionError(f"hessian={self._hessian!r} is IPOPT's; solver='trf' builds no Hessian (its steps use "
@@ -482,7 +518,8 @@ class OutputError(Estimator, FisherInformation):
                         "positivity": self._positivity, "solver": self._solver_kind, "hessian": self._hessian,
                         "max_iter": self._max_iter, "tol": self._tol, "time_limit": self._time_limit,
                         "callback": None if callback is None else "given", "verbose": verbose,
-                        "records": len(self.records), "hold": self.hold,
+                        "records": len(self.records),
+                        "hold": list(self.hold) if isinstance(self.hold, tuple) else self.hold,
                         "initial_state": self._x0_mode if self._x0_mode != "model" else model.initial_state_kind}
         self._energy = sum(np.sum(r.y**2, axis=0) for r in self.records)
         self._rms = np.sqrt(self._energy / sum(np.sum(o, axis=0) for o in self._observed))
@@ -629,7 +666,7 @@ class OutputError(Estimator, FisherInformation):
     def _on_points(self, value: Any, e: int) -> Any:
         """A per-sample array given for record ``e`` (its first axis the record's samples) placed on the points of
         ``hold="bandlimited"`` (1 between the samples, where nothing is measured); anything else as it is."""
-        if self.hold != "bandlimited" or isinstance(value, dict):
+        if not self._upsampled or isinstance(value, dict):
             return value
         arr = np.asarray(value, dtype=float) if not isinstance(value, (list, tuple)) or np.ndim(value) else value
         n = self._sample_counts[e]
@@ -657,7 +694,8 @@ class OutputError(Estimator, FisherInformation):
         A, B, C, D = self._matrices(theta)
         out = []
         for r, sw in zip(self.records, self._sw, strict=True):
-            forced = simulate_output(A, B, C, D, r.t, r.u, np.zeros(A.shape[0]), hold=self._hold)
+            forced = simulate_output(A, B, C, D, r.t, r.u, np.zeros(A.shape[0]), hold=self._hold,
+                                     held=self._held)
             Phi = state_transitions(A, r.t)  # (N, n, n)
             O = np.einsum("pn,knr->kpr", C, Phi) * sw[:, :, None]
             rhs = (r.y - forced) * sw
@@ -670,7 +708,7 @@ class OutputError(Estimator, FisherInformation):
         :meth:`initial_states`)."""
         theta = self.model.theta_vector(theta)
         A, B, C, D = self._matrices(theta)
-        return [simulate_output(A, B, C, D, r.t, r.u, x0, hold=self._hold)
+        return [simulate_output(A, B, C, D, r.t, r.u, x0, hold=self._hold, held=self._held)
                 for r, x0 in zip(self.records, self.initial_states(theta), strict=True)]
 
     def initial_offset(self, theta: Any) -> dict[str, Any] | None:
@@ -815,7 +853,7 @@ class OutputError(Estimator, FisherInformation):
     def uncertainty_note(self) -> str:
         """With ``hold="foh"``: the intervals do not include the bias of taking a band-limited input as linear
         between samples (a gain low by about (ω dt)²/12 at the input's frequencies)."""
-        if self.hold != "foh":
+        if "foh" not in (self.hold if isinstance(self.hold, tuple) else (self.hold,)):
             return ""
         return ("the input is taken as linear between samples: a band-limited input's interpolation lowers the gain "
                 "by about (ω dt)²/12 at frequency ω, a bias the intervals do not include (a gain 1.3 % low with "
@@ -1224,7 +1262,7 @@ class OutputError(Estimator, FisherInformation):
                 dx0[:, l + n * e: l + n * (e + 1)] = np.eye(n)
             elif self._x0_mode == "model" and self.model.initial_state_map is not None:
                 dx0[:, :l] = self.model.initial_state_map.Xi[:, :, 0].T
-            Y, dY = output_sensitivity(mats, dmats, r.t, r.u, x0, dx0, hold=self._hold)
+            Y, dY = output_sensitivity(mats, dmats, r.t, r.u, x0, dx0, hold=self._hold, held=self._held)
             sw = self._sw[e]
             rs.append(((r.y - Y) * sw).T.reshape(-1))
             Js.append((-dY * sw[:, :, None]).transpose(1, 0, 2).reshape(-1, v.size))

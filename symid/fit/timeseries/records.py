@@ -88,8 +88,8 @@ coloured (median whiteness p 2e-4); with it 0.7–1.2 (up to 1.8), p 0.44, as wi
 emphasis at four times the work; sines up to 0.8 of the Nyquist frequency: 0.9–1.1, as with 16 points."""
 
 
-def band_limited(record: TimeSeries, where: str, factor: int | None = None, emphasis: float | None = None
-                 ) -> TimeSeries:
+def band_limited(record: TimeSeries, where: str, factor: int | None = None, emphasis: float | None = None,
+                 holds: tuple[str, ...] | None = None) -> TimeSeries:
     """The record with its input interpolated as a band-limited signal at ``factor`` points per sample interval.
 
     A measured input (a shaker's force, a road profile, anti-alias filtered) is band-limited: between its samples
@@ -103,6 +103,9 @@ def band_limited(record: TimeSeries, where: str, factor: int | None = None, emph
     record's own samples only: the points between them carry no output (NaN), so the misfit, the residual tests
     and the intervals count the same samples as before. Equally spaced samples only (a ``DataError`` naming the
     record otherwise); the first and last few samples' interpolation extends the input linearly (``padtype``).
+    With ``holds`` (one of ``"zoh"``, ``"foh"``, ``"bandlimited"`` per input), only the band-limited inputs are
+    interpolated so; at the points between samples a held input keeps its sample's value (the simulation then
+    holds it: :func:`symid.fit.timeseries.response.held_differences`) and a linear one lies on the line.
 
     Examples
     --------
@@ -135,6 +138,12 @@ def band_limited(record: TimeSeries, where: str, factor: int | None = None, emph
         # (1 + 2a) − 2a cos(ωh) with a = 1/12 cancels that term, leaving O((ωh)⁴)
         inner = u[1:-1] + emphasis * (2.0 * u[1:-1] - u[:-2] - u[2:])
         u = np.concatenate([u[:1], inner, u[-1:]])
+    fine = t[0] + np.arange(n) * (step[0] / factor)
+    for j, kind in enumerate(holds or ()):
+        if kind == "zoh":  # each sample's value up to the next sample
+            u[:, j] = np.concatenate([np.repeat(record.u[:-1, j], factor), record.u[-1:, j]])
+        elif kind == "foh":
+            u[:, j] = np.interp(fine, t, record.u[:, j])
     y = np.full((n, record.n_outputs), np.nan)
     y[::factor] = record.y
-    return TimeSeries(t[0] + np.arange(n) * (step[0] / factor), u, y, time_unit=record.time_unit)
+    return TimeSeries(fine, u, y, time_unit=record.time_unit)

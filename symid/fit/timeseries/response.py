@@ -33,7 +33,8 @@ from scipy.linalg import matrix_balance
 
 from symid.signal.simulate import foh_discretize, zoh_discretize
 
-__all__ = ["balancing", "casadi_output", "interval_groups", "simulate_output", "squarings", "state_transitions"]
+__all__ = ["balancing", "casadi_output", "held_differences", "interval_groups", "simulate_output", "squarings",
+           "state_transitions"]
 
 _TAYLOR_DEGREE = 14
 _GROUP_RTOL = 1e-9
@@ -98,15 +99,33 @@ def squarings(A: np.ndarray, B: np.ndarray, h_max: float, balance: tuple[np.ndar
     return max(0, math.ceil(math.log2(8.0 * norm))) if norm > 0 else 0
 
 
+def held_differences(u: np.ndarray, held: np.ndarray | None) -> np.ndarray:
+    """u_{k+1} − u_k of every input, 0 for the inputs ``held`` marks: x⁺ = Ad x + G1 u + G2 (u⁺ − u) is then exact for
+    those held between samples (G1 is the zero-order hold's input matrix) and the others linear.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.timeseries.response import held_differences
+    >>> held_differences(np.array([[0.0, 1.0], [2.0, 4.0]]), np.array([True, False])).tolist()
+    [[0.0, 3.0]]
+    """
+    du = np.diff(u, axis=0)
+    if held is not None:
+        du[:, np.asarray(held, dtype=bool)] = 0.0
+    return du
+
+
 def simulate_output(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, t: np.ndarray, u: np.ndarray,
-                    x0: np.ndarray, hold: str = "zoh") -> np.ndarray:
+                    x0: np.ndarray, hold: str = "zoh", held: np.ndarray | None = None) -> np.ndarray:
     """ŷ(t_k), shape (N, p), from x(t_0) = x0 (shape (n,)); exact for the input held between samples
-    (``hold="zoh"``) or linear between them (``"foh"``) (scipy expm)."""
+    (``hold="zoh"``) or linear between them (``"foh"``; with ``held``, a mask of the inputs, those held) (scipy
+    expm)."""
     reps, group = interval_groups(t)
     if hold == "foh":
         three = [foh_discretize(A, B, h) for h in reps]
         mats = [(Ad, None) for Ad, _, _ in three]
-        du = np.diff(u, axis=0)
+        du = held_differences(u, held)
         Bu = [u[:-1] @ G1.T + du @ G2.T for _, G1, G2 in three]
     else:
         mats = [zoh_discretize(A, B, h) for h in reps]

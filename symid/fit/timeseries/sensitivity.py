@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from scipy.linalg import expm, expm_frechet
 
-from symid.fit.timeseries.response import interval_groups
+from symid.fit.timeseries.response import held_differences, interval_groups
 
 __all__ = ["output_sensitivity", "state_space_derivatives"]
 
@@ -132,7 +132,8 @@ def _foh_derivatives(A: np.ndarray, B: np.ndarray, dA: np.ndarray, dB: np.ndarra
 
 
 def output_sensitivity(mats: tuple[np.ndarray, ...], dmats: tuple[np.ndarray, ...], t: np.ndarray, u: np.ndarray,
-                       x0: np.ndarray, dx0: np.ndarray, hold: str = "zoh") -> tuple[np.ndarray, np.ndarray]:
+                       x0: np.ndarray, dx0: np.ndarray, hold: str = "zoh", held: np.ndarray | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
     """ŷ (N, p) and ∂ŷ/∂v (N, p, k) on one record from x(t₀) = x0.
 
     Parameters
@@ -142,7 +143,8 @@ def output_sensitivity(mats: tuple[np.ndarray, ...], dmats: tuple[np.ndarray, ..
         (:func:`state_space_derivatives`).
     t, u : ndarray
         Sample times (N,) and inputs (N, m), the input held between samples (``hold="zoh"``) or linear
-        between them (``"foh"``).
+        between them (``"foh"``; with ``held``, a mask of the inputs, those held:
+        :func:`symid.fit.timeseries.response.held_differences`).
     x0 : ndarray
         Initial state (n,).
     dx0 : ndarray
@@ -182,7 +184,7 @@ def output_sensitivity(mats: tuple[np.ndarray, ...], dmats: tuple[np.ndarray, ..
     Bu, dBu = np.zeros((N - 1, n)), np.zeros((N - 1, n * l))
     steps = []
     if hold == "foh":
-        du = np.diff(u, axis=0)
+        du = held_differences(u, held)
         for g, (Ad, G1, G2, dAd, dG1, dG2) in enumerate(_foh_derivatives(A, B, dA, dB, h) for h in reps):
             at = np.flatnonzero(group == g)
             Bu[at] = u[at] @ G1.T + du[at] @ G2.T
