@@ -705,3 +705,36 @@ def test_a_start_whose_modes_the_records_cannot_show_is_said_first():
         warnings.simplefilter("error", si.DataWarning)
         right = si.identify(model, io, method="oe", x0=truth, identifiability_check=False)
     assert "time_scale" not in right.options
+
+
+def test_an_output_in_another_unit_is_named_with_its_factor():
+    """A new user's encoder logged in degrees beside a tachometer in rad/s, the model in radians: told to estimate
+    the initial state. Now NEXT says the angle is about 57 times the model's prediction (degrees read as radians)
+    (reference: the values simulated, the angle column multiplied by 180/π)."""
+    J, c = si.parameters("J c", positive=True)
+    motor = si.SecondOrderModel(M=[[J]], V=[[c]], K=[[0]], B=[[1]], C=[[1], [1]],
+                                output=["position", "velocity"])
+    u = np.repeat(np.random.default_rng(4).choice([-1.0, 1.0], 40), 25)
+    io = si.simulate_io(motor, {"J": 0.01, "c": 0.05}, u, dt=0.01, noise=0.005, seed=5)
+    degrees = si.IOData(io.u, io.y * [180 / np.pi, 1.0], dt=0.01)
+    res = si.identify(motor, degrees, method="oe", x0={"J": 0.02, "c": 0.1}, identifiability_check=False)
+    assert not res.success
+    factor = res.options["misfit_per_output"]["factor"][0]
+    assert 40 < factor < 70  # the failed fit's compromise: near 180/π
+    assert "NEXT: output 0 is" in res.summary() and "degrees read as radians" in res.summary()
+
+
+def test_a_drift_is_named_as_a_drift_when_the_initial_state_is_estimated():
+    """A new user's encoder with an offset and a drift, the initial state estimated: told of "a constant offset"
+    with a mean residual of -1.8e-14. A ramp that explains most of what the offsets leave is named as a drift
+    (reference: the values simulated, 0.3 + 0.2·t added to the position)."""
+    m, c, k = si.parameters("m c k", positive=True)
+    mass = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    u = np.random.default_rng(6).standard_normal(600)
+    io = si.simulate_io(mass, {"m": 1.0, "c": 0.6, "k": 40.0}, u, dt=0.02, noise=0.01, seed=7)
+    t = np.arange(600) * 0.02
+    drifting = si.IOData(io.u, io.y + (0.3 + 0.2 * t)[:, None] * float(np.std(io.y)), dt=0.02)
+    res = si.identify(mass, drifting, method="oe", x0={"m": 1.0, "c": 0.6, "k": 40.0}, identifiability_check=False,
+                      initial_state="estimate")
+    assert not res.success and res.options["initial_offset"]["kind"] == "drift"
+    assert "NEXT: the residual drifts" in res.summary()

@@ -55,18 +55,27 @@ def _misfit_per_output(estimator: Any, theta: np.ndarray, records: list[Any]) ->
     except (SymidError, ValueError, np.linalg.LinAlgError):
         return None
     p = sims[0].shape[1]
-    num, den = np.zeros(p), np.zeros(p)
+    num, den, cross, model = np.zeros(p), np.zeros(p), np.zeros(p), np.zeros(p)
     for r, s, o in zip(estimator.records, sims, estimator.observed, strict=True):
         y = np.where(o, r.y, 0.0)
+        sim = np.where(o, s, 0.0)
         num += np.sum(np.where(o, (r.y - s) ** 2, 0.0), axis=0)
         den += np.sum(y**2, axis=0)
+        cross += np.sum(y * sim, axis=0)
+        model += np.sum(sim**2, axis=0)
     if not np.all(np.isfinite(num)):
         return None
     misfit = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.inf)
+    # each output's least-squares factor on the model's prediction, and the misfit it leaves: an output in another
+    # unit than the model's (degrees against radians) is the model's shape times a factor
+    with np.errstate(all="ignore"):
+        factor = np.where(model > 0, cross / np.where(model > 0, model, 1.0), np.nan)
+        scaled = np.where((den > 0) & (model > 0), 1.0 - cross**2 / (den * np.where(model > 0, model, 1.0)), np.inf)
     columns = (getattr(records[0], "stated_units", None) or {}).get("output", ())
     names = [str(columns[j][0]) if len(columns) == p else str(j) for j in range(p)]
     worse = [names[j] for j in range(p) if misfit[j] > WORSE_THAN_ZERO]
-    return {"names": names, "misfit": misfit.tolist(), "worse_than_zero": worse}
+    return {"names": names, "misfit": misfit.tolist(), "worse_than_zero": worse, "factor": factor.tolist(),
+            "scaled_misfit": np.clip(scaled, 0.0, None).tolist()}
 
 
 def _offset_explains_most(offset: dict[str, Any] | None) -> bool:

@@ -8,6 +8,7 @@ never instead of it: a start stopped by its budget whose estimate fits is a succ
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -102,9 +103,9 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
                 f"(initial_state=\"estimate\"; --option initial_state=estimate) or remove the offset from the data")
         if (level := offset.get("level")) is not None:
             text += (f". Output {level['output']} also sits at a level (mean {level['mean']:.6g}, standard deviation "
-                     f"{level['std']:.3g}): if the record lies around an operating point, the initial state alone "
-                     f"will not fit it; subtract the operating point (deviation variables) or model it (guide: "
-                     f"records around an operating point)")
+                     f"{level['std']:.3g}): if the record lies around an operating point that the model's inputs do "
+                     f"not produce, the initial state alone will not fit it; subtract the operating point (deviation "
+                     f"variables) or model it (guide: records around an operating point)")
         return text
     if offset.get("kind") == "drift":
         return (f"the residual drifts ({where}output {offset['output']}: {offset['slope']:.3g} per "
@@ -153,6 +154,46 @@ def _one_output_off(per: Mapping[str, Any] | None) -> str | None:
     return (f"output {bad} is predicted worse than by zero (misfit {worst:.3g}) while the others come within "
             f"{max(others):.2g}: a sensor of reversed polarity on that row (negate its column and fit again), or the "
             f"wrong unit or output kind for it (outputs are counted from 0 in the order of C's rows)")
+
+
+UNIT_FACTORS = {"degrees read as radians": 180 / math.pi, "radians read as degrees": math.pi / 180,
+                "mm read as m (or g as kg, ms as s)": 1e3, "m read as mm (or kg as g)": 1e-3,
+                "g read as m/s²": 1 / 9.80665, "m/s² read as g": 9.80665, "rpm read as rad/s": 60 / (2 * math.pi),
+                "rad/s read as rpm": 2 * math.pi / 60, "Hz read as rad/s": 1 / (2 * math.pi),
+                "rad/s read as Hz": 2 * math.pi, "km/h read as m/s": 3.6, "m/s read as km/h": 1 / 3.6,
+                "percent read as a fraction": 100.0, "a fraction read as percent": 0.01}
+"""Factors between units a column is often logged in and the model's, named when an output is that factor times the
+model's prediction (within 10 %)."""
+
+
+def _one_output_scaled(per: Mapping[str, Any] | None) -> str | None:
+    """The NEXT line when an output is predicted badly (relative misfit above 0.5) but is, to a tenth of that misfit,
+    the model's prediction times a factor away from 1 (beyond 2 either way): a unit or a sensor gain (a new user's
+    encoder in degrees against a model in radians, told of the initial state); else None.
+
+    Examples
+    --------
+    >>> from symid.fit.result import _one_output_scaled
+    >>> _one_output_scaled({"names": ["angle", "speed"], "misfit": [0.964, 0.002], "factor": [57.1, 1.0],
+    ...                     "scaled_misfit": [0.004, 0.002]})[:86]
+    'output angle is 57.1 times the model's prediction (misfit 0.964; scaled by that factor'
+    """
+    if not per or "factor" not in per:
+        return None
+    rows = [(n, m, f, sm) for n, m, f, sm in zip(per["names"], per["misfit"], per["factor"], per["scaled_misfit"],
+                                                 strict=True)
+            if f and np.isfinite(f) and m > 0.5 and sm < 0.1 * m and abs(math.log(abs(f))) > math.log(2)]
+    if not rows:
+        return None
+    name, misfit, factor, scaled = max(rows, key=lambda r: r[1])
+    known = min(UNIT_FACTORS.items(), key=lambda kv: abs(math.log(abs(factor) / kv[1])))
+    unit = (f" (near {known[1]:.4g}: {known[0]}?)" if abs(math.log(abs(factor) / known[1])) < math.log(1.1)
+            else "")  # the failed fit's compromise leaves the factor a few % off (53.2 for degrees)
+    sign = "; negative: also of reversed polarity" if factor < 0 else ""
+    return (f"output {name} is {factor:.3g} times the model's prediction (misfit {misfit:.3g}; scaled by that factor "
+            f"{scaled:.2g}){sign}: its unit is not the model's{unit}, or a sensor gain the model does not hold. "
+            f"Convert the column (or state its unit: a '# units:' line, --units) or give the output's gain a "
+            f"parameter")
 
 
 def next_step(fit: str, frf: bool = True, time: bool = False) -> str | None:
@@ -521,6 +562,8 @@ class IdentificationResult:
             elif (roles := self.options.get("swapped_roles")) is not None:
                 # before an offset or a bound, which swapped columns also produce (a new user's two tanks)
                 lines.append(f"NEXT: {roles}")
+            elif (row := _one_output_scaled(self.options.get("misfit_per_output"))) is not None:
+                lines.append(f"NEXT: {row}")
             elif (row := _one_output_off(self.options.get("misfit_per_output"))) is not None:
                 lines.append(f"NEXT: {row}")
             elif self.polished is not None and self.polished.success:
