@@ -570,10 +570,20 @@ def _known_values(value: Any, model: Any, what: str) -> dict[str, float]:
     return out
 
 
+def _equal_number(value: Any, known: float) -> bool:
+    """Whether ``value`` is a number equal to ``known`` (to 1e-12 of it)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return False
+    return math.isclose(float(value), float(known), rel_tol=1e-12, abs_tol=0.0)
+
+
 def _check_free(given: Mapping[str, Any], free: Sequence[str], known: Mapping[str, float], what: str
                 ) -> dict[str, Any]:
-    """``given`` without the known parameters (a ModelWarning names them: their known value is used); a name that is
-    no parameter at all is a ModelError."""
+    """``given`` without the known parameters (a ModelWarning names those given another value than the known one,
+    which is used); a name that is no parameter at all is a ModelError."""
+    # an entry that gives the known value itself is set aside without a word (a new user's file serves the fits
+    # with Km known and free alike: start = {..., "Km": 0.08}, known = {"Km": 0.08})
+    given = {k: v for k, v in given.items() if not (k in known and _equal_number(v, known[k]))}
     on_known = [k for k in given if k in known]
     if on_known:
         # two new users added `known` to a file whose start named the parameter, and were refused: the known value

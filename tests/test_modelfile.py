@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import textwrap
+import warnings
 
 import numpy as np
 import pytest
@@ -502,3 +503,20 @@ def test_a_start_scale_or_bounds_entry_on_a_known_parameter_is_left_out_and_said
                    "left out" in text for text in said), what
     assert "m1" not in spec.start and "m1" not in spec.scale and "m1" not in spec.bounds
     assert spec.known == {"m1": 1.0}
+
+
+def test_a_start_giving_the_known_value_itself_is_set_aside_quietly(tmp_path):
+    """A new user's model file for a drive, its start listing every parameter and `known` fixing the motor constant
+    at the same value (so that one file serves the fits with it free and known): a ModelWarning on every load. An
+    entry equal to the known value is left out without a word; one that differs is still said."""
+    path = tmp_path / "chain.py"
+    path.write_text(CHAIN + "known = {'m1': 1.0}\nstart = dict(m1=1.0, m2=1, c1=1, c2=1, k1=1, k2=1)\n",
+                    encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        spec = si.load_model(path)
+    assert "m1" not in spec.start and spec.known == {"m1": 1.0}
+    path.write_text(CHAIN + "known = {'m1': 1.0}\nstart = dict(m1=1.5, m2=1, c1=1, c2=1, k1=1, k2=1)\n",
+                    encoding="utf-8")
+    with pytest.warns(si.ModelWarning, match="start gives m1, declared known"):
+        si.load_model(path)
