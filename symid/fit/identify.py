@@ -529,6 +529,12 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
                   else None)
     if time_scale is not None:  # said before the fit (the records' time unit, or a start far off), and in summary()
         warnings.warn(time_scale, DataWarning, stacklevel=2)
+    gap = None
+    if hasattr(records[0], "t"):
+        from symid.fit.timeseries.records import sampling_gap
+
+        if (gap := sampling_gap(records)) is not None:  # before the fit, and in summary()
+            warnings.warn(gap, DataWarning, stacklevel=2)
     check_s, not_local = None, ()
     if identifiability_check:
         from symid.structural.analyse import warn_if_not_identifiable
@@ -594,6 +600,8 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
             extra["initial_offset"] = offset
     if time_scale is not None:
         extra["time_scale"] = time_scale
+    if gap is not None:
+        extra["sampling_gap"] = gap
     if hasattr(records[0], "t") and (idle := _idle_input_parameters(model, records)) is not None:
         # a parameter that multiplies only an input the records hold at zero: its estimate is arbitrary (a new
         # user's heater column left at 0: b2 = 3.8e-12, success, said only as a near-singular direction)

@@ -591,6 +591,8 @@ class IdentificationResult:
             elif (advice := next_step(self.fit, frf="FRF" in self.cost_kind,
                                       time="samples" in self.cost_kind)) is not None:
                 lines.append(f"NEXT: {advice}")
+        if (gap := self.options.get("sampling_gap")) is not None:  # of a fit or not: what the records hide
+            lines.append(f"{'GAP' if self.success else 'NEXT (also)'}: {gap}")
         if (scale := self.options.get("output_only_scale")) is not None:  # of a fit or not: what spectra cannot say
             lines.append(f"SCALE: {scale['text']}")
         if (nu := self.options.get("sensor_noise_levels")) is not None:

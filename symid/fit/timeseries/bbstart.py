@@ -209,7 +209,9 @@ def black_box_response(model: Any, data: Any, decimate: bool = False) -> BlackBo
         dss, misfit, q = _best_black_box(data, model.n_states, model_has_feedthrough(model), decimate)
         _, poles = modal_response(dss.A, dss.B, dss.C, dss.D, dss.dt, np.zeros(0))
     except (SymidError, np.linalg.LinAlgError, ValueError) as exc:
-        return BlackBoxResponse(None, f"no black-box start: {exc}")
+        # its first clause: the advice after it is for a user of N4SID, not of this start (a new user's every
+        # successful summary carried five lines on an unstable N4SID pole, "harmless when the fit succeeds")
+        return BlackBoxResponse(None, f"no black-box start: {str(exc).split('; ')[0]}")
     size = np.abs(poles)
     size = size[np.isfinite(size) & (size > 0)]
     if size.size == 0:

@@ -17,7 +17,11 @@ from symid.data import IOData
 from symid.data.timeseries import TimeSeries
 from symid.errors import DataError, ModelError
 
-__all__ = ["as_records", "is_time_series"]
+__all__ = ["GAP_STEPS", "as_records", "band_limited", "is_time_series", "sampling_gap"]
+
+GAP_STEPS = 10.0
+"""A record sampled on an even grid (90 % of its steps the typical one) with a jump of more than this many steps is
+said to have a gap: the input is taken as held (or linear) across it."""
 
 
 def is_time_series(data: Any) -> bool:
@@ -147,3 +151,38 @@ def band_limited(record: TimeSeries, where: str, factor: int | None = None, emph
     y = np.full((n, record.n_outputs), np.nan)
     y[::factor] = record.y
     return TimeSeries(fine, u, y, time_unit=record.time_unit)
+
+
+def sampling_gap(records: Any) -> str | None:
+    """A sentence naming the first record sampled on an even grid with a gap of more than :data:`GAP_STEPS` steps,
+    else None. :class:`~symid.data.IOData` refuses such a record when it is read from a table (samples missing); a
+    :class:`~symid.data.TimeSeries` takes it as it is, the input held or linear from the sample before the gap to the
+    one after (a new user's room with 6 hours of a 5-minute log missing: the fit failed, told of a drift).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.data.timeseries import TimeSeries
+    >>> from symid.fit.timeseries.records import sampling_gap
+    >>> t = np.concatenate([np.arange(100.0), 172.0 + np.arange(100.0)])
+    >>> sampling_gap([TimeSeries(t, np.ones(200), np.ones(200))])[:72]
+    'the record is sampled every 1 s but has a gap of 73 s (from 99 to 172 s,'
+    """
+    recs = list(records) if isinstance(records, (list, tuple)) else [records]
+    for e, r in enumerate(recs):
+        t = np.asarray(getattr(r, "t", ()), dtype=float)
+        if t.size < 3:
+            continue
+        d = np.diff(t)
+        typical = float(np.median(d))
+        k = int(np.argmax(d))
+        even = np.abs(d - typical) <= 1e-3 * typical
+        if typical > 0 and d[k] > GAP_STEPS * typical and np.mean(even) >= 0.9:
+            unit = getattr(r, "time_unit", "s")
+            which = f"record {e}" if len(recs) > 1 else "the record"
+            return (f"{which} is sampled every {typical:.6g} {unit} but has a gap of {d[k]:.6g} {unit} (from "
+                    f"{t[k]:.6g} to {t[k + 1]:.6g} {unit}, {d[k] / typical:.3g} steps): the input is taken as held "
+                    f"(or linear) across it, and an input that changed inside it is wrong there. Split the record at "
+                    f"the gap (a list of records, each with its own initial state) unless the input was truly "
+                    f"constant there")
+    return None
