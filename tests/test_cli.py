@@ -782,3 +782,18 @@ def test_identifiability_at_your_own_values(tmp_path, capsys):
         "model = si.StateSpaceModel(A=[[-ka, 0], [ka, -ke]], B=[[1], [0]], C=[[0, q]])\n")
     assert main(["identifiability", str(tmp_path / "bare.py"), "--at", "start"]) == 2
     assert "the model file gives no start" in capsys.readouterr().err
+
+
+def test_kelvin_against_celsius_is_said_to_be_an_offset():
+    """A new user's temperatures logged in K beside a model file in °C were told "a factor between them goes into the
+    estimates": K against °C is an offset. Other units are still a factor."""
+    from symid.fit.identify import unit_mismatches
+
+    k, g = si.parameters("k g", positive=True)
+    model = si.StateSpaceModel(A=[[-k]], B=[[g]], C=[[1]])
+    model.io_units = {"input": ("W",), "output": ("°C",)}
+    io = si.IOData([[1.0], [0.0], [0.0]], [[290.0], [291.0], [290.5]], 0.1)
+    object.__setattr__(io, "stated_units", {"input": (("P", "kW"),), "output": (("Ti", "K"),)})
+    said = unit_mismatches(model, io)
+    assert any("Ti" in s and "an offset between them" in s for s in said)
+    assert any("'P'" in s and "a factor between them" in s for s in said)

@@ -255,6 +255,12 @@ def _same_unit(a: str, b: str) -> bool:
 _CASELESS = frozenset({"deg", "rad", "degree", "degrees", "radian", "radians"})
 
 
+def _temperature(unit: str) -> str | None:
+    """The temperature scale a unit names: "K", "C" or "F" (any spelling: °C, degC, kelvin), else None."""
+    u = unit.strip().replace("°", "").replace("deg", "").replace(" ", "").lower()
+    return {"k": "K", "kelvin": "K", "c": "C", "celsius": "C", "f": "F", "fahrenheit": "F"}.get(u)
+
+
 def unit_mismatches(model: Any, data: Any) -> list[str]:
     """What a data file's stated input and output units (``data.stated_units``) say against the model's declared
     ones (``model.io_units``, from a model file): one sentence per channel whose units differ; [] when either
@@ -284,9 +290,13 @@ def unit_mismatches(model: Any, data: Any) -> list[str]:
             for (column, have), want in zip(stated.get(role, ()), declared.get(role, ()), strict=False):
                 if have and want and not _same_unit(have, want):
                     where = f" (in {stated['file']})" if len(records) > 1 and stated.get("file") else ""
+                    # kelvin against degrees Celsius (or Fahrenheit) is an offset, not a factor (a new user's
+                    # temperatures in K beside a model in °C were told of a factor)
+                    offset = {_temperature(have), _temperature(want)} in ({"K", "C"}, {"K", "F"}, {"C", "F"})
+                    what = ("an offset between them (and for °F a factor) goes into the estimates and the initial "
+                            "state" if offset else "a factor between them goes into the estimates")
                     text = (f"the file states {have} for {role} {column!r}; the model file's {role} unit is {want}: "
-                            f"symid converts neither, so a factor between them goes into the estimates; convert "
-                            f"the data or the model{where}")
+                            f"symid converts neither, so {what}; convert the data or the model{where}")
                     if text not in out:
                         out.append(text)
         time_unit = getattr(record, "time_unit", None) if hasattr(record, "t") else None
@@ -858,7 +868,9 @@ def _far_from_start(result: IdentificationResult, x0: Any, scale: Any, model: An
     text = (f"the estimate fits, but lies far from {what}: {off} of {len(names)} parameters more than "
             f"{FAR_FROM_START:g} times off (median factor {10 ** median:.3g}; {names[k]} {10 ** logs[k]:.3g} times "
             f"its value there). If {what} is right, check the data's units: a time column in s read as h makes every "
-            f"rate 3600 times off, ms read as s 1000 times, a frequency in Hz read as rad/s 2π")
+            f"rate 3600 times off, ms read as s 1000 times, a frequency in Hz read as rad/s 2π; an input or output "
+            f"in other units than the model's (kW for W, mm for m, degrees for radians) moves the parameters that "
+            f"scale it by that factor")
     return {"median_factor": 10 ** median, "parameters_off": off, "text": text}
 
 
