@@ -318,8 +318,45 @@ def _welch(recs: list[IOData], estimator: str, nperseg: Any, window: Any, detren
 
 # -- periodic ------------------------------------------------------------------------------
 
+PERIODIC_DRIFT = 0.05
+"""With ``period=``, an output whose mean moves over the periods used by more than this fraction of its periodic
+part's rms (and by more than 4 standard deviations of the noise's) is said not to be periodic yet
+(:func:`_not_periodic`)."""
+
+
+def _not_periodic(y: np.ndarray, k: int, detrended: bool) -> str | None:
+    """A sentence when an output's mean over each period (``y`` (P, period, p), record ``k``) moves by more than
+    :data:`PERIODIC_DRIFT` of the rms of its average period from the first period used to the last: a transient
+    longer than the periods skipped (a slow or rigid-body mode) or a drift, which the averaged spectra take for
+    response at every line while the period-to-period variance does not see it (a new user's drive: the motor
+    angle's period means 0.25, 0.62, 0.87, 1.03 rad, its response 10-30 times off at every line, the plotted band
+    tight)."""
+    P, L = y.shape[0], y.shape[1]
+    if P < 2:
+        return None
+    means = y.mean(axis=1)  # (P, p)
+    periodic = y.mean(axis=0)
+    rms = np.sqrt(np.mean((periodic - periodic.mean(axis=0)) ** 2, axis=0))
+    move = np.abs(means[-1] - means[0])
+    # beyond what the noise moves a period's mean: σ/√L per period for white noise of the spread σ between periods
+    spread = np.sqrt(np.sum((y - periodic) ** 2, axis=(0, 1)) / ((P - 1) * L))
+    noise = 4.0 * np.sqrt(2.0) * spread / np.sqrt(L)
+    bad = np.flatnonzero((move > PERIODIC_DRIFT * np.where(rms > 0, rms, np.inf)) & (move > noise))
+    if not bad.size:
+        return None
+    j = int(bad[np.argmax(move[bad] / rms[bad])])
+    where = f"record {k}, " if k else ""
+    path = ", ".join(f"{v:.4g}" for v in means[:, j][:6]) + (", …" if P > 6 else "")
+    fix = ("" if detrended else ", or detrend='linear' (a line fitted over the periods used is taken off each "
+                                "input and output first)")
+    return (f"{where}output {j} is not periodic over the periods used: its mean per period moves ({path}), "
+            f"{move[j] / rms[j]:.3g} times the rms of its periodic part: a transient longer than the periods skipped "
+            f"(a slow or rigid-body mode) or a drift, which every line takes for response while the variance between "
+            f"periods does not see it. Skip more periods (transient_periods=), record more{fix}")
+
+
 def _periodic(recs: list[IOData], period: Any, transient_periods: Any, band: Any, min_excitation: float,
-              estimator: str) -> _Estimate:
+              estimator: str, detrend: Any = "constant") -> _Estimate:
     if estimator != "h1":
         raise DataError(f"estimator={estimator!r} is a Welch estimator; with period= the spectra of the periods are "
                         "averaged (errors-in-variables consistent: Ĥ = mean Y / mean U); leave estimator out")
@@ -340,8 +377,15 @@ def _periodic(recs: list[IOData], period: Any, transient_periods: Any, band: Any
         n_per = N // period
         if skip >= n_per:
             raise DataError(f"transient_periods = {skip} drops every one of the {n_per} periods of record {k}")
-        u = r.u[skip * period:].reshape(n_per - skip, period, m)
-        y = r.y[skip * period:].reshape(n_per - skip, period, p)
+        u, y = r.u[skip * period:], r.y[skip * period:]
+        if detrend == "linear":  # a line over the periods used off each input and output (DC is dropped anyway)
+            ramp = np.column_stack([np.ones(u.shape[0]), np.arange(u.shape[0], dtype=float)])
+            u = u - ramp @ np.linalg.lstsq(ramp, u, rcond=None)[0]
+            y = y - ramp @ np.linalg.lstsq(ramp, y, rcond=None)[0]
+        u = u.reshape(n_per - skip, period, m)
+        y = y.reshape(n_per - skip, period, p)
+        if (text := _not_periodic(y, k, detrend == "linear")) is not None:
+            warnings.warn(text, DataWarning, stacklevel=4)
         Us.append(np.fft.rfft(u, axis=1))
         Ys.append(np.fft.rfft(y, axis=1))
     P = min(U.shape[0] for U in Us)
@@ -389,7 +433,9 @@ def _analyse(data: Any, estimator: Any, period: Any, transient_periods: Any, npe
         return _welch(recs, estimator, nperseg, window, detrend, band, level)
     if nperseg is not None:
         raise DataError("nperseg is a Welch option; with period= every period is one segment: leave nperseg out")
-    return _periodic(recs, period, transient_periods, band, level, estimator)
+    if detrend not in _DETRENDS:
+        raise DataError(f"detrend must be 'constant', 'linear' or False; got {detrend!r}")
+    return _periodic(recs, period, transient_periods, band, level, estimator, detrend)
 
 
 def _hold_factor(w: np.ndarray, dt: float) -> np.ndarray:
@@ -441,7 +487,10 @@ def estimate_frf(data: IOData | Sequence[IOData], *, estimator: str = "h1", peri
         Welch: the segment window (:func:`scipy.signal.get_window`; default ``"hann"``).
     detrend : {"constant", "linear", False}
         Welch: removed from each segment (default ``"constant"``); with a detrend the
-        lowest bin above DC is dropped, as in :func:`symid.estimate_spectra`.
+        lowest bin above DC is dropped, as in :func:`symid.estimate_spectra`. With
+        ``period=``: ``"linear"`` takes a line fitted over the periods used off each input
+        and output (the others change nothing: DC is not used). An output whose mean moves
+        over the periods used is not periodic yet, and a ``DataWarning`` says so.
     band : (float, float), optional
         Keep the lines with ω in [w_low, w_high] rad/s. A band wholly above the Nyquist
         frequency π/dt is refused; one reaching above it warns.
