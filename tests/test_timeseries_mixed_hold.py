@@ -92,3 +92,11 @@ def test_band_limited_points_keep_a_held_input_held():
 def test_bad_holds_are_named(records, hold, match):
     with pytest.raises(si.OptionError, match=match):
         _fit(records, hold)
+
+
+def test_validation_takes_one_hold_per_input(records):
+    """si.validate (and the command line's validation after `--option hold=zoh,foh`) simulates as the fit did."""
+    res = _fit(records, "zoh,foh")
+    val = si.validate(room(), res.theta, records, hold="zoh,foh", initial_state="estimate")
+    assert float(np.min(val.fit_percent)) > 99.99  # noise-free records, the estimate to rounding
+    assert len(val.t_fine) == 1 and val.t_fine[0].size > records.n_samples  # the curve between samples drawn

@@ -507,9 +507,10 @@ def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, ma
         raise DataError(f"max_lag must be an int >= 1 (sample lags), or None for the default; got {max_lag!r}")
     if confidence not in _Z:
         raise DataError(f"confidence must be 0.95 or 0.99; got {confidence!r}")
-    if hold not in ("zoh", "foh", "bandlimited"):
+    per_input = isinstance(hold, (list, tuple)) or (isinstance(hold, str) and "," in hold)  # parse_hold checks them
+    if not per_input and hold not in ("zoh", "foh", "bandlimited"):
         raise DataError(f"hold must be 'zoh' (the input held between samples), 'foh' (linear between them) or "
-                        f"'bandlimited' (a sampled band-limited input); got {hold!r}")
+                        f"'bandlimited' (a sampled band-limited input), or one of them per input; got {hold!r}")
     sim = OutputError(model, data, initial_state=initial_state, variance=variance, hold=hold)
     from symid.fit.identify import unit_mismatches
 
