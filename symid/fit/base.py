@@ -211,9 +211,11 @@ class Estimator(abc.ABC):
         finite = bool(np.all(np.isfinite(theta)))
         cost = self.misfit(theta) if finite else float("inf")
         res = self.residuals(theta) if finite and np.isfinite(cost) else None
+        independent = getattr(self, "residual_independent", None)
         test = fit_test(cost, n_data=self.n_data(), n_parameters=int(theta.size), residuals=res,
                         noise_floor=self.noise_floor, black_box=self.black_box,
-                        local_gain=lambda: self.local_gain(theta))
+                        local_gain=lambda: self.local_gain(theta),
+                        independent=None if independent is None else (lambda: independent(theta)))
         fits, fit_text = test.fits, test.text
         unphysical = physical_check(self.model, theta)  # never a success against the model's declarations
         if unphysical is not None:

@@ -176,7 +176,7 @@ def _one_output_scaled(per: Mapping[str, Any] | None) -> str | None:
     >>> from symid.fit.result import _one_output_scaled
     >>> _one_output_scaled({"names": ["angle", "speed"], "misfit": [0.964, 0.002], "factor": [57.1, 1.0],
     ...                     "scaled_misfit": [0.004, 0.002]})[:86]
-    'output angle is 57.1 times the model's prediction (misfit 0.964; scaled by that factor'
+    "output angle is 57.1 times the model's prediction (misfit 0.964; scaled by that factor"
     """
     if not per or "factor" not in per:
         return None

@@ -39,7 +39,7 @@ import numpy as np
 
 from symid.errors import DataError, DataWarning
 
-__all__ = ["DEFAULT_MAX_LAG", "Validation", "validate"]
+__all__ = ["DEFAULT_MAX_LAG", "Validation", "independence_pvalues", "validate"]
 
 DEFAULT_MAX_LAG = 25  # correlation lags of the residual tests, MATLAB's resid; a quarter of a shorter record
 
@@ -414,6 +414,36 @@ def _independence(rho_e: np.ndarray, rho_u: np.ndarray, rho: np.ndarray, N: int)
             s_stat[j, i] = N * float(np.sum(proj**2 / w[keep]))
             dof[j, i] = float(np.count_nonzero(keep))
     return s_stat, dof
+
+
+def independence_pvalues(residuals: list[np.ndarray], inputs: list[np.ndarray], max_lag: int | None = None
+                         ) -> np.ndarray:
+    """The p-values (p, m) of the residual–input independence test of :func:`validate` (module notes): each output's
+    residual against each input over lags 0 … M (M = ``max_lag``, else 25 or a quarter of the shortest record);
+    NaN for a constant input. ``residuals`` and ``inputs`` hold one (N, p) and one (N, m) array per record.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.fit.validation import independence_pvalues
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.standard_normal((2000, 1))
+    >>> white = rng.standard_normal((2000, 1))
+    >>> bool(independence_pvalues([white], [u])[0, 0] > 0.01)
+    True
+    >>> bool(independence_pvalues([white + 0.3 * np.roll(u, 2, axis=0)], [u])[0, 0] < 1e-6)   # u leaks in
+    True
+    """
+    from scipy.stats import chi2
+
+    shortest = min(e.shape[0] for e in residuals)
+    M = int(max_lag) if max_lag is not None else min(DEFAULT_MAX_LAG, shortest // 4)
+    if M < 1:
+        return np.full((residuals[0].shape[1], inputs[0].shape[1]), np.nan)
+    rho_e, rho_u, rho_eu, _ = _correlations(residuals, inputs, M)
+    N = sum(e.shape[0] for e in residuals)
+    s_stat, s_dof = _independence(rho_e, rho_u, rho_eu[:, :, M:], N)
+    return chi2.sf(s_stat, s_dof)
 
 
 def validate(model: Any, theta: Any, data: Any, *, initial_state: Any = None, max_lag: int | None = None,

@@ -59,7 +59,7 @@ from symid.engine.ipopt import (
     positivity_bounds,
     start_scale,
 )
-from symid.errors import DataError, ModelError, OptionError
+from symid.errors import DataError, ModelError, OptionError, SymidError
 from symid.fit.base import Estimator
 from symid.fit.bounded import bounds_option, clip_into, log_box, named_bounds, on_bounds
 from symid.fit.options import (
@@ -902,6 +902,29 @@ class OutputError(Estimator, FisherInformation):
             out = [(r.y - s) / self._rms for r, s in zip(self.records, sims, strict=True)]
         # the sample times where every output was measured (a missing value has no residual)
         return np.vstack([x[np.all(o, axis=1)] for x, o in zip(out, self._observed, strict=True)])
+
+    def residual_independent(self, theta: Any) -> bool | None:
+        """Whether the residual (as the misfit weighs it, at the sample times where every output was measured) is
+        independent of every non-constant input at 99.9 % (:func:`symid.fit.validation.independence_pvalues`), for
+        the success rule above its 10 % ceiling (:mod:`symid.fit.success`, rule 3); None where it cannot tell."""
+        from symid.fit.validation import independence_pvalues
+
+        try:
+            sims = self.simulate(self.model.theta_vector(theta) if isinstance(theta, dict) else theta)
+        except (SymidError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+            return None
+        res, us = [], []
+        for e, (r, s, o) in enumerate(zip(self.records, sims, self._observed, strict=True)):
+            scale = np.sqrt(self._variance[e]) if self._variance is not None else self._rms
+            keep = np.all(o, axis=1)
+            res.append(((r.y - s) / scale)[keep])
+            us.append(r.u[keep])
+        if not all(np.all(np.isfinite(x)) for x in res) or min(x.shape[0] for x in res) < 8:
+            return None
+        with np.errstate(all="ignore"):
+            pv = independence_pvalues(res, us)
+        pv = pv[np.isfinite(pv)]
+        return None if pv.size == 0 else bool(np.all(pv >= 1e-3))
 
     def n_data(self) -> int:
         """Number of measured output values (missing ones not counted)."""
