@@ -156,3 +156,22 @@ def test_white_sensor_noise_is_fitted_beside_the_model():
     np.testing.assert_allclose(res.options["sensor_noise_levels"], sigma**2 * DT, rtol=0.1)
     assert "sensor noise" in res.summary()
     assert not bare.success
+
+
+def test_welch_spectra_keep_their_averages_through_a_csv_file(records, tmp_path):
+    """A new user's spectra saved (to_csv) and refitted lost `estimated_from`: the refit fell back to equal weights
+    and accepted a local minimum (a mass 430 times its value). The file now carries how they were estimated."""
+    path = tmp_path / "spec.csv"
+    records[0].to_csv(path)
+    back = si.SpectralData.from_csv(path)
+    assert back.estimated_from == pytest.approx(records[0].estimated_from)
+    assert spectra_averages(back) == pytest.approx(spectra_averages(records[0]), rel=1e-12)
+    text = path.read_text(encoding="utf-8")
+    broken = text.replace("# welch_window: hann", "# welch_window: __import__('os')")
+    (tmp_path / "bad.csv").write_text(broken, encoding="utf-8")
+    with pytest.raises(si.DataError, match=r"welch_window.*not a window"):
+        si.SpectralData.from_csv(tmp_path / "bad.csv")
+    partial = "\n".join(line for line in text.splitlines() if not line.startswith("# welch_dt")) + "\n"
+    (tmp_path / "partial.csv").write_text(partial, encoding="utf-8")
+    with pytest.raises(si.DataError, match=r"incomplete \(missing welch_dt\)"):
+        si.SpectralData.from_csv(tmp_path / "partial.csv")

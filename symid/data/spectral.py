@@ -71,7 +71,13 @@ class SpectralData(DataContainer):
         <one row per frequency>
         # end
 
-    Full matrices are written (not only a triangle), row-major, first Φyy then Φuu.
+    Full matrices are written (not only a triangle), row-major, first Φyy then Φuu. Spectra
+    that :func:`symid.estimate_spectra` made carry how (``estimated_from``) in further
+    lines, ``# welch_samples``, ``# welch_nperseg``, ``# welch_noverlap``, ``# welch_dt``,
+    ``# welch_window`` and ``# welch_input``, read back as they were: the number of
+    averages behind each line, which ``method="auto"`` weighs the spectra and judges the
+    fit by (a new user's spectra saved and refitted lost it, and the unweighted fit
+    accepted a local minimum with a mass 430 times its value).
 
     Examples
     --------
@@ -156,7 +162,8 @@ class SpectralData(DataContainer):
         table[:, 1::2] = flat.real
         table[:, 2::2] = flat.imag
         rows = [[_files.fmt(x) for x in row] for row in table.tolist()]
-        _files.write_csv(path, self._kind, {"n_outputs": p, "n_inputs": m}, self._columns(p, m), rows)
+        _files.write_csv(path, self._kind, {"n_outputs": p, "n_inputs": m, **_welch_meta(self.estimated_from)},
+                         self._columns(p, m), rows)
 
     @classmethod
     def from_csv(cls, path: _files.PathLike) -> Self:
@@ -176,7 +183,7 @@ class SpectralData(DataContainer):
         UserWarning
             For a version-1 file, whose completeness cannot be checked.
         """
-        meta, columns, rows = _files.read_csv(path, cls._kind, meta_keys=("n_outputs", "n_inputs"))
+        meta, columns, rows = _files.read_csv(path, cls._kind, meta_keys=("n_outputs", "n_inputs", *_WELCH_KEYS))
         p = _files.meta_int(meta, "n_outputs", path, at_most=len(columns))
         m = _files.meta_int(meta, "n_inputs", path, at_most=len(columns))
         _files.expect_width(columns, 1 + 2 * (p * p + m * m), path, "1 + 2 (n_outputs² + n_inputs²)")
@@ -186,4 +193,52 @@ class SpectralData(DataContainer):
         Phi_yy = flat[:, : p * p].reshape(-1, p, p)
         Phi_uu = flat[:, p * p:].reshape(-1, m, m)
         with naming_file(path):
-            return cls(table[:, 0], Phi_yy, Phi_uu)
+            out = cls(table[:, 0], Phi_yy, Phi_uu)
+        made = _welch_from_meta(meta, path)
+        if made:
+            object.__setattr__(out, "estimated_from", made)
+        return out
+
+
+_WELCH_KEYS = ("welch_samples", "welch_nperseg", "welch_noverlap", "welch_dt", "welch_window", "welch_input")
+
+
+def _welch_meta(made: dict[str, Any]) -> dict[str, Any]:
+    """The CSV metadata lines of ``estimated_from`` (none when it is empty or its window is not a name)."""
+    window = made.get("window")
+    if not made or not isinstance(window, str) or not made.get("nperseg"):
+        return {}
+    return {"welch_samples": int(made["samples"]), "welch_nperseg": int(made["nperseg"]),
+            "welch_noverlap": int(made.get("noverlap", int(made["nperseg"]) // 2)),
+            "welch_dt": repr(float(made["dt"])), "welch_window": window, "welch_input": made.get("input", "given")}
+
+
+def _welch_from_meta(meta: dict[str, str], path: Any) -> dict[str, Any]:
+    """``estimated_from`` from a file's metadata lines; {} without them; a DataError naming a malformed one."""
+    given = [k for k in _WELCH_KEYS if k in meta]
+    if not given:
+        return {}
+    if len(given) != len(_WELCH_KEYS):
+        missing = ", ".join(k for k in _WELCH_KEYS if k not in meta)
+        raise DataError(f"{_files._where(path)}: the Welch metadata lines are incomplete (missing {missing}); "
+                        f"remove them all or write the file again with to_csv")
+    samples = _files.meta_int(meta, "welch_samples", path)
+    nperseg = _files.meta_int(meta, "welch_nperseg", path, at_most=samples)
+    noverlap = _files.meta_int(meta, "welch_noverlap", path, at_most=max(nperseg - 1, 0))
+    dt = _files.meta_float(meta, "welch_dt", path)
+    window, source = meta["welch_window"], meta["welch_input"]
+    if not (window.isascii() and window.replace("_", "").isalnum() and len(window) <= 40):
+        raise DataError(f"{_files._where(path)}: '# welch_window: {window[:40]}' is not a window's name (hann, "
+                        f"hamming, ...)")
+    try:
+        import scipy.signal
+
+        scipy.signal.get_window(window, 8)
+    except (ValueError, TypeError):
+        raise DataError(f"{_files._where(path)}: '# welch_window: {window}' is not a window scipy knows") from None
+    if source not in ("given", "measured"):
+        raise DataError(f"{_files._where(path)}: '# welch_input: {source[:40]}' must be 'given' or 'measured'")
+    if not (dt > 0 and np.isfinite(dt)) or nperseg < 8:
+        raise DataError(f"{_files._where(path)}: the Welch metadata need welch_dt > 0 and welch_nperseg >= 8")
+    return {"dt": dt, "nperseg": nperseg, "window": window, "resolution": 2 * np.pi / (nperseg * dt),
+            "samples": samples, "noverlap": noverlap, "input": source}
