@@ -175,3 +175,19 @@ def test_welch_spectra_keep_their_averages_through_a_csv_file(records, tmp_path)
     (tmp_path / "partial.csv").write_text(partial, encoding="utf-8")
     with pytest.raises(si.DataError, match=r"incomplete \(missing welch_dt\)"):
         si.SpectralData.from_csv(tmp_path / "partial.csv")
+
+
+def test_spectra_of_many_lines_are_said_to_be_slow():
+    """A new user's default Welch estimate (8190 lines, two outputs) ran one IPOPT iteration in 300 s. Beyond
+    MANY_LINES lines IPOPT and auto say so and how to keep the lines around the modes."""
+    from symid.fit.spectra import MANY_LINES, prepare
+
+    m, c, k = si.parameters("m c k", positive=True)
+    model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[1]], C=[[1]])
+    spec = si.simulate_spectra(model, [1.0, 0.5, 4.0], np.linspace(0.5, 3, MANY_LINES + 1), Phi_uu=1.0)
+    with pytest.warns(si.DataWarning, match=r"2001 lines: .* band=\(w_low, w_high\), n_frequencies=500"):
+        prepare(model, spec, "ipopt", {})
+    few = si.simulate_spectra(model, [1.0, 0.5, 4.0], np.linspace(0.5, 3, MANY_LINES), Phi_uu=1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", si.DataWarning)
+        prepare(model, few, "ipopt", {})

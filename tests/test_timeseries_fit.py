@@ -766,3 +766,18 @@ def test_a_gap_in_an_even_grid_is_said_and_an_uneven_schedule_is_not():
         si.identify(model, pk, x0={"a": 0.1, "b": 0.5}, method="oe", initial_state="estimate",
                     identifiability_check=False)
     assert not any("gap" in str(w.message) for w in seen)
+
+
+def test_the_noise_given_is_reported_over_the_measured_values():
+    """A new user's TimeSeries with a missing level and noise_std=0.002 read "noise given per value (rms 0.012)": the
+    placeholder of the missing value counted. The level reported is the rms of the values given for what was
+    measured."""
+    a, b = si.parameters("a b", positive=True)
+    model = si.StateSpaceModel(A=[[-a]], B=[[b]], C=[[1]])
+    u = np.repeat([0.0, 1.0, 0.0, 1.0], 50)
+    io = si.simulate_io(model, {"a": 0.5, "b": 2.0}, u, dt=0.1, noise_std=0.002, seed=1)
+    y = io.y[:, 0].copy()
+    y[37] = np.nan
+    res = si.identify(model, si.TimeSeries(io.t, u, y), x0={"a": 0.5, "b": 2.0}, method="oe", noise_std=0.002,
+                      identifiability_check=False)
+    np.testing.assert_allclose(res.uncertainty.noise_std, [0.002], rtol=1e-12)

@@ -548,7 +548,11 @@ class IdentificationResult:
                              f"{probe['misfit']:.3g}, against {self.cost:.3g} with it held): an input that was "
                              f"measured (sampled from a continuous signal: a shake table, a road profile, a sensor) "
                              f"rather than held by a DAC or a controller? Fit with hold='bandlimited' (--option "
-                             f"hold=bandlimited); .options['hold_probe'] holds that fit's estimate")
+                             f"hold=bandlimited)"
+                             + (", or with one hold per input where some were held by a controller and others "
+                                "measured (hold=['zoh', 'bandlimited', …] in the records' input order; --option "
+                                "hold=zoh,bandlimited)" if probe.get("inputs", 1) > 1 else "")
+                             + "; .options['hold_probe'] holds that fit's estimate")
             elif (flip := self.options.get("polarity")) is not None:
                 # before anything else: no start, bound or unit fixes a response of reversed polarity
                 what = (f"{flip['via']} fits with {flip['flip']} negated (misfit {flip['misfit']:.3g}; the records "

@@ -72,6 +72,7 @@ def hold_probe(model: Any, data: Any, theta: np.ndarray, options: dict[str, Any]
         return None  # records the band-limited interpolation cannot take (unequal sample times), or options it refuses
     if not out.success or not np.all(np.isfinite(out.theta)):
         return None
-    return {"hold": "bandlimited", "misfit": float(out.cost),
+    records = data if isinstance(data, (list, tuple)) else [data]
+    return {"hold": "bandlimited", "misfit": float(out.cost), "inputs": int(np.shape(records[0].u)[1]),
             "theta": dict(zip(model.parameter_names, np.asarray(out.theta, dtype=float).tolist(), strict=True)),
             "seconds": time.perf_counter() - t0}

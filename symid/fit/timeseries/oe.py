@@ -862,7 +862,10 @@ class OutputError(Estimator, FisherInformation):
         between samples (a gain low by about (ω dt)²/12 at the input's frequencies)."""
         if "foh" not in (self.hold if isinstance(self.hold, tuple) else (self.hold,)):
             return ""
-        return ("the input is taken as linear between samples: a band-limited input's interpolation lowers the gain "
+        linear = [] if not isinstance(self.hold, tuple) else [str(j) for j, k in enumerate(self.hold) if k == "foh"]
+        which = ("the input is" if not linear else f"input {linear[0]} is" if len(linear) == 1
+                 else f"inputs {', '.join(linear)} are")
+        return (f"{which} taken as linear between samples: a band-limited input's interpolation lowers the gain "
                 "by about (ω dt)²/12 at frequency ω, a bias the intervals do not include (a gain 1.3 % low with "
                 "sines up to ω dt = 0.48: tests/test_timeseries_fit.py); hold='bandlimited' removes it for a "
                 "sampled band-limited input")
@@ -1332,7 +1335,9 @@ class OutputError(Estimator, FisherInformation):
             if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
                 raise DataError("noise_std must be finite and > 0 everywhere (a standard deviation in data units)")
             std.append((arr * self._sw[e]).T.reshape(-1))  # channel by channel, as the residual
-            given.append(arr.reshape(-1))
+            # the values given for what was measured (a new user's record with a missing value was told the noise
+            # given had rms 0.012 for 0.002: the 1 in its place counted)
+            given.append(arr[self._observed[e]].reshape(-1))
         return np.concatenate(std), np.concatenate(given)
 
     def jacobian(self, theta: Any) -> tuple[np.ndarray, np.ndarray]:
