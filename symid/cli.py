@@ -221,12 +221,51 @@ def _read_data(args: argparse.Namespace, command: str, files: list[str] | None =
     return records
 
 
+def _output_only_spectra(args: argparse.Namespace, command: str, model):
+    """--phi-uu: the output spectra of the one --data table of output-only records (no input column), estimated by
+    Welch with white forces of intensity PHI on every input of the model."""
+    import numpy as np
+
+    from symid.data.table import outputs_from_table
+    from symid.signal.spectra import estimate_spectra
+
+    files = _data_files(args)
+    if len(files) != 1:
+        raise _UsageError(f"symid {command}: error: --phi-uu takes one --data table of output records")
+    if args.columns is None:
+        raise _UsageError(f"symid {command}: error: --phi-uu reads a table of output records: give --columns "
+                          f"time=... output=... and --units time=...")
+    band = None
+    if args.band is not None:
+        low, sep, high = args.band.partition(":")
+        try:
+            band = (float(low), float(high))
+        except ValueError:
+            raise _UsageError(f"symid {command}: error: --band {args.band!r}: give LOW:HIGH in rad/s") from None
+        if not sep:
+            raise _UsageError(f"symid {command}: error: --band {args.band!r}: give LOW:HIGH in rad/s")
+    columns = _pairs(args.columns, "--columns", command, repeatable=("output",))
+    units = _pairs(args.units, "--units", command)
+    time_unit = args.time_unit or getattr(args, "model_time_unit", None) or "s"
+    y, dt = outputs_from_table(files[0], columns=columns, units=units or None, dt=args.dt, time_unit=time_unit,
+                               delimiter="\t" if args.delimiter == "tab" else args.delimiter)
+    return estimate_spectra(y, dt=dt, Phi_uu=args.phi_uu * np.eye(model.n_inputs), nperseg=args.nperseg, band=band,
+                            n_frequencies=args.n_frequencies)
+
+
 def _entry_and_data(args: argparse.Namespace, command: str):
     from symid.zoo import ZooEntry, load_model
 
     entry = load_model(args.model)
     args.model_time_unit = getattr(entry, "time_unit", None)
-    if args.data:
+    if getattr(args, "phi_uu", None) is None and any(getattr(args, k, None) is not None
+                                                     for k in ("nperseg", "band", "n_frequencies")):
+        raise _UsageError(f"symid {command}: error: --nperseg, --band and --n-frequencies shape the spectra of "
+                          f"output-only records: give --phi-uu too")
+    if args.data and getattr(args, "phi_uu", None) is not None:
+        data = _output_only_spectra(args, command, entry.model)
+        source = f"{_data_files(args)[0]} (output spectra, Welch, white input of intensity {args.phi_uu:g})"
+    elif args.data:
         data = _read_data(args, command)
         source = ", ".join(_data_files(args))
     elif args.columns is not None or args.units is not None:
@@ -740,6 +779,17 @@ def _add_data_arguments(p: argparse.ArgumentParser, default: str) -> None:
                         "measured at every time, empty cells)")
     g.add_argument("--delimiter", default=",", choices=(",", ";", "tab", "|", " "), metavar="SEP",
                    help="separator of a CSV table: , ; tab | or a space (default: ,)")
+    g.add_argument("--phi-uu", dest="phi_uu", type=_positive_number, metavar="PHI",
+                   help="output-only records (ambient excitation, no input column): white forces of this two-sided "
+                        "intensity on every input of the model (per Hz, in the input's unit squared times s); "
+                        "their spectra are estimated (si.estimate_spectra) and fitted")
+    g.add_argument("--nperseg", type=_int_in(8), metavar="N",
+                   help="with --phi-uu: samples per Welch segment (default: a power of two near an eighth of the "
+                        "record)")
+    g.add_argument("--band", metavar="LOW:HIGH",
+                   help="with --phi-uu: keep the lines between LOW and HIGH rad/s (e.g. around the modes)")
+    g.add_argument("--n-frequencies", dest="n_frequencies", type=_int_in(1), metavar="N",
+                   help="with --phi-uu: keep at most N lines, nearest to log-spaced frequencies over the band")
 
 
 def _add_method_options(g) -> None:

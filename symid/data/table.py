@@ -65,8 +65,8 @@ from symid.data import _files, checks
 from symid.data.units import DIMENSIONS, canonical_unit, time_factor, unit_tokens
 from symid.errors import DataError, DataWarning
 
-__all__ = ["FRF_ROLES", "MAX_TABLE_BYTES", "SERIES_ROLES", "frequency_data_from_table", "read_data",
-           "series_from_table"]
+__all__ = ["FRF_ROLES", "MAX_TABLE_BYTES", "SERIES_ROLES", "frequency_data_from_table", "outputs_from_table",
+           "read_data", "series_from_table"]
 
 MAX_TABLE_BYTES = 2**30
 """Largest plain CSV file read as a table (1 GiB): larger files are refused before they are read."""
@@ -809,19 +809,43 @@ def _name_list(value: Any, role: str, where: str) -> list[str]:
     return list(names)
 
 
+def outputs_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[str, str] | None = None,
+                       dt: float | None = None, time_unit: str = "s", delimiter: str = ",") -> tuple[np.ndarray, float]:
+    """``(y, dt)``: the equally spaced output records of a table without an input column (output-only data, ambient
+    excitation), read and checked as :meth:`IOData.from_table <symid.data.IOData.from_table>` reads a record, for
+    :func:`symid.estimate_spectra` with the input spectrum given.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.data.table import outputs_from_table
+    >>> table = {"t_ms": np.arange(5) * 10.0, "a1": np.arange(5.0), "a2": np.ones(5)}
+    >>> y, dt = outputs_from_table(table, columns={"time": "t_ms", "output": ["a1", "a2"]}, units={"time": "ms"})
+    >>> y.shape, dt
+    ((5, 2), 0.01)
+    """
+    return series_from_table(table, columns=columns, units=units, dt=dt, time_unit=time_unit, delimiter=delimiter,
+                             outputs_only=True)
+
+
 def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[str, str] | None = None,
                       dt: float | None = None, time_unit: str = "s", uniform: bool = True,
-                      delimiter: str = ",") -> Any:
-    """An :class:`~symid.data.IOData` (``uniform``) or :class:`~symid.data.TimeSeries` from a table (module notes)."""
+                      delimiter: str = ",", outputs_only: bool = False) -> Any:
+    """An :class:`~symid.data.IOData` (``uniform``) or :class:`~symid.data.TimeSeries` from a table (module notes);
+    with ``outputs_only``, ``(y, dt)`` of a table without inputs (:func:`outputs_from_table`)."""
     from symid.data.iodata import IOData
     from symid.data.timeseries import TimeSeries
 
     where = repr(os.fspath(table)) if isinstance(table, (str, os.PathLike)) else "the table"
     roles = _role_map(columns, SERIES_ROLES, where, SERIES_EXAMPLE)
-    for role in ("input", "output"):
+    for role in ("output",) if outputs_only else ("input", "output"):
         if role not in roles:
             raise _fail(where, f"no {role} column declared", SERIES_EXAMPLE)
-    inputs, outputs = _name_list(roles["input"], "input", where), _name_list(roles["output"], "output", where)
+    if outputs_only and "input" in roles:
+        raise _fail(where, "an input column is declared for output-only records: leave it out (the input spectrum "
+                           "is given instead)", SERIES_EXAMPLE)
+    inputs = [] if outputs_only else _name_list(roles["input"], "input", where)
+    outputs = _name_list(roles["output"], "output", where)
     has_time = "time" in roles
     if has_time and dt is not None:
         raise _fail(where, "both a time column and dt= are given: give one", SERIES_EXAMPLE)
@@ -845,10 +869,15 @@ def series_from_table(table: Any, *, columns: Mapping[str, Any], units: Mapping[
         raw = cols.vector(roles["time"])
         _check_time_order(raw, src, roles["time"], declared["time"])
     t = raw * factor if has_time else None
-    u = np.hstack([cols.channels(n) for n in inputs])
     if uniform:  # an output missing in a uniform record: say how to read it (a TimeSeries takes NaN outputs)
         src.missing_hint = "uniform"
     y = np.hstack([cols.channels(n, missing_ok=not uniform) for n in outputs])
+    if outputs_only:
+        if t is None:
+            return y, checks.check_positive_scalar(dt, "dt") * factor
+        _check_gaps(raw, src, roles["time"], declared["time"])
+        return y, _uniform_step(raw, src.where) * factor
+    u = np.hstack([cols.channels(n) for n in inputs])
     with _naming(src.where):
         if not uniform:
             record: TimeSeries | IOData = TimeSeries(t, u, y, time_unit=target)
