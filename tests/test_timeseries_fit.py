@@ -781,3 +781,18 @@ def test_the_noise_given_is_reported_over_the_measured_values():
     res = si.identify(model, si.TimeSeries(io.t, u, y), x0={"a": 0.5, "b": 2.0}, method="oe", noise_std=0.002,
                       identifiability_check=False)
     np.testing.assert_allclose(res.uncertainty.noise_std, [0.002], rtol=1e-12)
+
+
+def test_next_names_an_output_by_its_column(tmp_path):
+    """A new user's two tanks read from a table were told "output 1 is 0.0499 at its first sample" and read it as the
+    first tank: NEXT names the table's column ('h2')."""
+    a, b = si.parameters("a b", positive=True)
+    model = si.StateSpaceModel(A=[[-a, 0], [a, -b]], B=[[1], [0]], C=[[1, 0], [0, 1]])
+    u = np.repeat([0.0, 1.0, 0.0, 1.0], 40)
+    io = si.simulate_io(model, {"a": 0.3, "b": 0.2}, u, dt=0.5, x0=[0.0, 2.0])  # tank 2 starts full
+    np.savetxt(tmp_path / "tanks.csv", np.column_stack([np.arange(160) * 0.5, u, io.y]), delimiter=",",
+               header="t,q,h1,h2", comments="")
+    rec = si.IOData.from_table(tmp_path / "tanks.csv", columns={"time": "t", "input": "q", "output": ["h1", "h2"]},
+                               units={"time": "s"})
+    res = si.identify(model, rec, x0={"a": 0.3, "b": 0.2}, method="oe", identifiability_check=False)
+    assert not res.success and "output 'h2' is 2 at its first sample" in res.summary()

@@ -607,6 +607,9 @@ def identify(model: Any, data: Any, method: str | None = None, *, x0: Any = None
         # a record that does not start where the model does: the likeliest reason a time-series fit fails
         offset = estimator.initial_offset(result.theta_vector)
         if offset is not None:
+            columns = (getattr(records[0], "stated_units", None) or {}).get("output", ())
+            if len(columns) == model.n_outputs:
+                offset = {**offset, "output_names": [str(c[0]) for c in columns]}
             extra["initial_offset"] = offset
     if time_scale is not None:
         extra["time_scale"] = time_scale

@@ -94,28 +94,33 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
     'the residual is mostly a constant offset (out'
     """
     where = f"record {offset['record']}, " if offset["record"] else ""
+    names = offset.get("output_names") or ()
+
+    def name(k: int) -> str:  # the table's column name when read from one (a new user read "output 1" as h1)
+        return f"{names[k]!r}" if k < len(names) else str(k)
+
     drop = ("" if offset.get("after") is None else
             f"this estimate's misfit would fall from {offset['misfit']:.3g} to {offset['after']:.3g}")
     if offset.get("kind", "initial_state") == "initial_state":
-        text = (f"the record does not start where the model does ({where}output {offset['output']} is "
+        text = (f"the record does not start where the model does ({where}output {name(offset['output'])} is "
                 f"{offset['measured']:.6g} at its first sample, the model's {offset['model']:.6g}"
                 f"{'; with the initial state estimated ' + drop if drop else ''}): estimate the initial state "
                 f"(initial_state=\"estimate\"; --option initial_state=estimate) or remove the offset from the data")
         if (level := offset.get("level")) is not None:
-            text += (f". Output {level['output']} also sits at a level (mean {level['mean']:.6g}, standard deviation "
-                     f"{level['std']:.3g}): if the record lies around an operating point that the model's inputs do "
-                     f"not produce, the initial state alone will not fit it; subtract the operating point (deviation "
-                     f"variables) or model it (guide: records around an operating point)")
+            text += (f". Output {name(level['output'])} also sits at a level (mean {level['mean']:.6g}, standard "
+                     f"deviation {level['std']:.3g}): if the record lies around an operating point that the model's "
+                     f"inputs do not produce, the initial state alone will not fit it; subtract the operating point "
+                     f"(deviation variables) or model it (guide: records around an operating point)")
         return text
     if offset.get("kind") == "drift":
-        return (f"the residual drifts ({where}output {offset['output']}: {offset['slope']:.3g} per "
+        return (f"the residual drifts ({where}output {name(offset['output'])}: {offset['slope']:.3g} per "
                 f"{offset.get('time_unit', 's')}, mean residual {offset['mean']:.3g}; with an offset and a ramp on "
                 f"each output removed {drop}): a sensor that drifts or a slow disturbance the model does not hold. "
                 f"Model it: two inputs, a column of ones and a column of time (a ramp), each with a gain that is a "
                 f"parameter on that output, the initial state estimated (guide: records around an operating point)")
     if offset.get("kind") == "level":
-        return (f"{where}output {offset['output']} sits at a level (mean {offset['mean']:.6g}, standard deviation "
-                f"{offset['std']:.3g}): if the record lies around an operating point (absolute levels, "
+        return (f"{where}output {name(offset['output'])} sits at a level (mean {offset['mean']:.6g}, standard "
+                f"deviation {offset['std']:.3g}): if the record lies around an operating point (absolute levels, "
                 f"temperatures, positions), subtract the operating point from the inputs and outputs (deviation "
                 f"variables), or model it: a constant input (a column of ones) whose gain is a parameter, with the "
                 f"initial state estimated (guide: records around an operating point)")
@@ -123,7 +128,7 @@ def _offset_advice(offset: Mapping[str, Any]) -> str:
              1.0 - float(offset["after"]) / float(offset["misfit"]))
     # "mostly" only where the offset explains most of the misfit (a new user's record: 16 % of it was "mostly")
     amount = "mostly" if share is None or share >= 0.5 else f"in part ({share:.0%} of the misfit)"
-    return (f"the residual is {amount} a constant offset ({where}output {offset['output']}: mean residual "
+    return (f"the residual is {amount} a constant offset ({where}output {name(offset['output'])}: mean residual "
             f"{offset['mean']:.6g}; with each output's mean residual removed {drop}): the record lies around an "
             f"operating point. Subtract the operating point from the inputs and outputs (deviation variables), or "
             f"model it: a constant input (a column of ones) whose gain is a parameter, with the initial state "
