@@ -31,9 +31,10 @@ order:
    imprint in its residual, and a wrong unit or a local minimum a residual that is not
    white (``benchmarks/timeseries_loud_noise.py``: a resonance at 12–45 % noise, the right
    model's fit counts on 40 of 40 records, a first-order model's on 0 of 40). The
-   residuals are taken **in the weighting of the misfit** the estimate minimises (for a frequency response (Hᵢ − H(ωᵢ, θ))/‖H‖, noise weights
-   included). Dividing each line by its own level instead, as this rule once did, tests
-   a criterion the estimate did not minimise: with noise proportional to |H| over a few
+   residuals are taken **in the weighting of the misfit** the estimate minimises (for a
+   frequency response (Hᵢ − H(ωᵢ, θ))/‖H‖, noise weights included). Dividing each line
+   by its own level instead, as this rule once did, tests a criterion the estimate did
+   not minimise: with noise proportional to |H| over a few
    decades the least-squares estimate, set by the resonances, leaves at the weak lines a
    relative residual that is a smooth function of frequency, and that rule refused the
    least-squares estimate itself (IPOPT started at the truth) on 14 of the 32 noisy
