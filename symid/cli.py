@@ -509,7 +509,8 @@ def _cmd_identify(args: argparse.Namespace) -> int:
 
         doc = {"model": spec.name, "data": _data_source(args) or source, "time_unit": time_unit, "known": spec.known,
                "result": res.to_dict(),
-               "fitted": fitted, "outside_bounds": {k: v[0] for k, v in outside.items()},
+               "fitted": fitted, "determined": res.determined,
+               "outside_bounds": {k: v[0] for k, v in outside.items()},
                "exit_status": code, "written": [str(p) for p in written]}
         _print_json(doc)
     return code

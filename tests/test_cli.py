@@ -282,7 +282,7 @@ def test_identify_json_for_scripts(capsys):
                  "k1=1.5", "k2=1.5", "--tol", "1e-10", "--json"])
     captured = capsys.readouterr()
     doc = json.loads(captured.out)  # standard output is the JSON document alone
-    assert code == doc["exit_status"] == 0 and doc["fitted"] is True
+    assert code == doc["exit_status"] == 0 and doc["fitted"] is True and doc["determined"] is True
     assert doc["result"]["starts"][0]["start"] == [1.0, 1.0, 0.2, 0.2, 1.5, 1.5]
     assert doc["result"]["options"]["tol"] == 1e-10
     assert "method: ipopt" in captured.err  # the human report moved to standard error

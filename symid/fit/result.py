@@ -719,6 +719,29 @@ class IdentificationResult:
         return derived_quantities(self, quantities)
 
     @property
+    def determined(self) -> bool:
+        """Whether the data determine every parameter: no structural non-identifiability found, no parameter that
+        multiplies only an input the records hold at zero, and a Fisher information that is not near-singular.
+        ``success`` says the estimate fits the data; a fit can succeed with parameters the data leave free (a new
+        user's drive with its motor constant free: success, every parameter 1.44 times the truth, exit status 0),
+        and scripts read this beside it (``"determined"`` in the command line's JSON).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import symid as si
+        >>> m, c, k, g = si.parameters("m c k g", positive=True)
+        >>> model = si.SecondOrderModel(M=[[m]], V=[[c]], K=[[k]], B=[[g]], C=[[1]])   # g scales with m, c, k
+        >>> frf = si.simulate_frf(model, [2.0, 0.8, 50.0, 1.0], np.linspace(1, 10, 30))
+        >>> res = si.identify(model, frf, x0=[1.0, 1.0, 30.0, 1.0])
+        >>> bool(res.success), res.determined
+        (True, False)
+        """
+        unc = self.uncertainty
+        return not (self.options.get("not_identifiable") or self.options.get("not_determined")
+                    or (unc is not None and bool(unc.near_singular)))
+
+    @property
     def on_bounds(self) -> dict[str, str]:
         """The parameters whose estimate sits on a bound the user gave (``options["bounds"]``), by name:
         ``"lower"`` or ``"upper"`` (empty without bounds; the 0 that keeps a positive parameter positive is
