@@ -32,6 +32,7 @@ __all__ = [
     "check_positive_scalar",
     "frequencies",
     "frozen",
+    "grid_jump",
     "shape_text",
 ]
 
@@ -154,6 +155,32 @@ def check_hermitian(Phi: np.ndarray, name: str, rtol: float = HERMITIAN_RTOL) ->
         i = int(bad[0])
         raise DataError(f"{name}[{i}] is not Hermitian: max |Φ − Φᴴ| = {dev[i]:.3g} exceeds "
                         f"{rtol:g} × ||Φ||_F = {rtol * scale[i]:.3g} ({bad.size} frequency(ies) affected)")
+
+
+def grid_jump(t: Any, *, even_share: float = 0.9) -> tuple[int, float, int] | None:
+    """``(k, typical, jumps)`` for sample times on an even grid with holes: the index k of the largest step
+    t[k + 1] − t[k], the typical (median) step, and the number of steps beyond 1.5 typical ones, when at least
+    ``even_share`` of the steps are the typical one (to 1e-3 of it); None for uneven times (a dosing schedule) or
+    fewer than 3 samples. Callers judge the jump: a table refuses one of 1.5 steps (samples missing), a fit warns of
+    one beyond 10.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from symid.data.checks import grid_jump
+    >>> grid_jump(np.concatenate([np.arange(10.0), 15.0 + np.arange(10.0)]))
+    (9, 1.0, 1)
+    >>> grid_jump(np.array([0.0, 0.5, 1, 2, 4, 8])) is None
+    True
+    """
+    t = np.asarray(t, dtype=float)
+    if t.size < 3:
+        return None
+    d = np.diff(t)
+    typical = float(np.median(d))
+    if not typical > 0 or np.mean(np.abs(d - typical) <= 1e-3 * typical) < even_share:
+        return None
+    return int(np.argmax(d)), typical, int(np.count_nonzero(d > 1.5 * typical))
 
 
 def check_positive_scalar(x: Any, name: str) -> float:

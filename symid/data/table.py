@@ -940,19 +940,17 @@ def _check_gaps(t: np.ndarray, src: _Csv | _Arrays, name: str, unit: str) -> Non
     every other step (90 %) is the typical one (samples missing from an even grid), naming the file's lines, the
     times in the file's unit and how many samples are missing (a new user's record with 10 minutes missing was
     told its sample 1000 lay 7.66 sample times off an even grid, in seconds of a file in hours)."""
-    if t.size < 3:
+    jump = checks.grid_jump(t)  # a grid with holes: nearly every step is the typical one
+    if jump is None:
         return
+    k, typical, gaps = jump
     d = np.diff(t)
-    typical = float(np.median(d))
-    k = int(np.argmax(d))
-    even = np.abs(d - typical) <= 1e-3 * typical  # a grid with holes: nearly every step is the typical one
-    if not (typical > 0 and d[k] > 1.5 * typical and np.mean(even) >= 0.9):
+    if not d[k] > 1.5 * typical:
         return
     if isinstance(src, _Csv):
         place = f"{src.where}, lines {src.rows[k][0]} and {src.rows[k + 1][0]}, column {name!r}"
     else:
         place = f"{src.where}, rows {k} and {k + 1}, column {name!r}"
-    gaps = int(np.count_nonzero(d > 1.5 * typical))
     more = f" ({gaps} such gaps in all)" if gaps > 1 else ""
     raise DataError(f"{place}: the times jump from {t[k]:.9g} to {t[k + 1]:.9g} {unit}, {d[k] / typical:.3g} steps "
                     f"of {typical:.6g} {unit}: {_missing(round(d[k] / typical) - 1)}{more}. An "

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from symid.data import IOData
+from symid.data import IOData, checks
 from symid.data.timeseries import TimeSeries
 from symid.errors import DataError, ModelError
 
@@ -171,13 +171,12 @@ def sampling_gap(records: Any) -> str | None:
     recs = list(records) if isinstance(records, (list, tuple)) else [records]
     for e, r in enumerate(recs):
         t = np.asarray(getattr(r, "t", ()), dtype=float)
-        if t.size < 3:
+        jump = checks.grid_jump(t)
+        if jump is None:
             continue
+        k, typical, _ = jump
         d = np.diff(t)
-        typical = float(np.median(d))
-        k = int(np.argmax(d))
-        even = np.abs(d - typical) <= 1e-3 * typical
-        if typical > 0 and d[k] > GAP_STEPS * typical and np.mean(even) >= 0.9:
+        if d[k] > GAP_STEPS * typical:
             unit = getattr(r, "time_unit", "s")
             which = f"record {e}" if len(recs) > 1 else "the record"
             return (f"{which} is sampled every {typical:.6g} {unit} but has a gap of {d[k]:.6g} {unit} (from "
